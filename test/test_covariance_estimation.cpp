@@ -1,0 +1,292 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/covariance_estimation.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/exceptions.h>
+#include <pcl/filters/filter.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+using pcl_probcollision::Covariance;
+using pcl_probcollision::CovarianceEstimation;
+using pcl_probcollision::SensorNoiseModel;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+namespace
+{
+Cloud::Ptr
+grid (int nx, int ny, double h, const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity (),
+      double offset = 0.0)
+{
+  Cloud::Ptr c (new Cloud);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+    {
+      const Eigen::Vector3d p = pose * Eigen::Vector3d (i * h, j * h, 0.0) + Eigen::Vector3d::Constant (offset);
+      c->push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
+    }
+  c->width = nx;
+  c->height = ny;
+  return c;
+}
+
+pcl::PointCloud<Covariance>
+estimate (const Cloud::ConstPtr& cloud, int k, const SensorNoiseModel& noise = SensorNoiseModel (),
+          bool discretization = true)
+{
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setInputCloud (cloud);
+  est.setKSearch (k);
+  est.setSensorNoise (noise);
+  est.setUseDiscretization (discretization);
+  pcl::PointCloud<Covariance> out;
+  est.compute (out);
+  return out;
+}
+
+bool
+isPsd (const Eigen::Matrix3d& m, double tol)
+{
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> (m).eigenvalues ().minCoeff () >= -tol;
+}
+} // namespace
+
+TEST (CovarianceEstimation, InteriorGridPointMatchesThePaulyClosedForm)
+{
+  // METHOD.md 11.7: spacing h, k = 8 (no distance ties), tau = 2 sqrt(k).
+  const double h = 0.01;
+  const auto cloud = grid (7, 7, h);
+  const auto out = estimate (cloud, 8);
+  const Eigen::Matrix3d psi = out[3 * 7 + 3].matrix ();
+  const double e1 = std::exp (-1.0 / 8.0), e2 = std::exp (-1.0 / 4.0);
+  const double expected = h * h * (2 * e1 + 4 * e2) / (4 * e1 + 4 * e2);
+  EXPECT_NEAR (expected / (h * h), 0.734395, 1e-6);
+  EXPECT_NEAR (psi (0, 0), expected, 1e-6 * expected);
+  EXPECT_NEAR (psi (1, 1), expected, 1e-6 * expected);
+  EXPECT_NEAR (psi (2, 2), 0.0, 1e-12);
+  EXPECT_NEAR (psi (0, 1), 0.0, 1e-6 * expected);
+}
+
+TEST (CovarianceEstimation, TiltedPlaneSmallestEigenvectorIsTheNormalAndNoiseAddsAlongIt)
+{
+  const Eigen::Isometry3d pose (Eigen::AngleAxisd (0.6, Eigen::Vector3d (1, -2, 0.5).normalized ()));
+  const Eigen::Vector3d normal = pose.linear () * Eigen::Vector3d::UnitZ ();
+  const auto cloud = grid (15, 15, 0.01, pose);
+  const double sigma = 0.002;
+  const auto clean = estimate (cloud, 10);
+  const auto noisy = estimate (cloud, 10, SensorNoiseModel::isotropic (sigma));
+  for (std::size_t i = 0; i < cloud->size (); ++i)
+  {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (clean[i].matrix ());
+    EXPECT_NEAR (std::abs (eig.eigenvectors ().col (0).dot (normal)), 1.0, 1e-4) << i;
+    EXPECT_NEAR (normal.dot (clean[i].matrix () * normal), 0.0, 1e-9) << i;
+    // Isotropic noise adds sigma^2 I exactly (up to float storage).
+    const Eigen::Matrix3d added = noisy[i].matrix () - clean[i].matrix ();
+    EXPECT_TRUE ((added - sigma * sigma * Eigen::Matrix3d::Identity ()).cwiseAbs ().maxCoeff () < 1e-10) << i;
+    EXPECT_NEAR (normal.dot (noisy[i].matrix () * normal), sigma * sigma, 1e-10) << i;
+  }
+}
+
+TEST (CovarianceEstimation, SphereSamplesGiveRadialNormals)
+{
+  Cloud::Ptr cloud (new Cloud);
+  const int n = 2000;
+  const double golden = M_PI * (3.0 - std::sqrt (5.0));
+  for (int i = 0; i < n; ++i)
+  {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt (1.0 - z * z), phi = golden * i;
+    cloud->push_back (pcl::PointXYZ (static_cast<float> (0.1 * r * std::cos (phi)),
+                                     static_cast<float> (0.1 * r * std::sin (phi)), static_cast<float> (0.1 * z)));
+  }
+  const auto out = estimate (cloud, 10);
+  int radial = 0;
+  for (int i = 0; i < n; ++i)
+  {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (out[i].matrix ());
+    const Eigen::Vector3d radius = (*cloud)[i].getVector3fMap ().cast<double> ().normalized ();
+    radial += std::abs (eig.eigenvectors ().col (0).dot (radius)) > 0.99 ? 1 : 0;
+  }
+  EXPECT_EQ (radial, n);
+}
+
+TEST (CovarianceEstimation, DepthModelGrowsAlongTheViewingRay)
+{
+  // Two fronto-parallel patches at 1 m and 2 m seen from the origin along +z.
+  Cloud::Ptr cloud (new Cloud);
+  for (double z : {1.0, 2.0})
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i)
+        cloud->push_back (pcl::PointXYZ (static_cast<float> (0.01 * (i - 4)), static_cast<float> (0.01 * (j - 4)), static_cast<float> (z)));
+  const auto out = estimate (cloud, 8, SensorNoiseModel::stereo (), /*discretization=*/false);
+  const Eigen::Vector3d ray = Eigen::Vector3d::UnitZ ();
+  const double near_var = ray.dot (out[40].matrix () * ray);       // centre of the z = 1 patch
+  const double far_var = ray.dot (out[81 + 40].matrix () * ray);   // centre of the z = 2 patch
+  EXPECT_NEAR (far_var / near_var, 16.0, 16.0 * 1e-5);  // sigma_a ~ z^2, variance ~ z^4
+}
+
+TEST (CovarianceEstimation, TranslationByOneHundredKilometresChangesNothing)
+{
+  // Spacing 0.25 keeps float coordinates exact at a 1e5 offset, so any difference is ours.
+  const auto at_origin = estimate (grid (9, 9, 0.25), 10);
+  const auto far = estimate (grid (9, 9, 0.25, Eigen::Isometry3d::Identity (), 1e5), 10);
+  for (std::size_t i = 0; i < at_origin.size (); ++i)
+    EXPECT_TRUE ((at_origin[i].matrix () - far[i].matrix ()).cwiseAbs ().maxCoeff () <= 1e-9) << i;
+}
+
+TEST (CovarianceEstimation, OrganizedCloudWithNaNKeepsItsShapeAndMatchesTheDenseCloud)
+{
+  auto cloud = grid (20, 10, 0.01);
+  const float nan = std::numeric_limits<float>::quiet_NaN ();
+  for (int i : {0, 17, 55, 56, 57, 120, 199})
+    (*cloud)[i].x = (*cloud)[i].y = (*cloud)[i].z = nan;
+  (*cloud)[88].z = std::numeric_limits<float>::infinity ();
+  cloud->is_dense = false;
+  const auto out = estimate (cloud, 10, SensorNoiseModel::isotropic (0.001));
+  EXPECT_EQ (out.width, 20u);
+  EXPECT_EQ (out.height, 10u);
+  EXPECT_FALSE (out.is_dense);
+
+  Cloud::Ptr dense (new Cloud);
+  pcl::Indices kept;
+  pcl::removeNaNFromPointCloud (*cloud, *dense, kept);
+  // removeNaNFromPointCloud keeps Inf; drop it by hand so both see the same finite points.
+  Cloud::Ptr finite (new Cloud);
+  std::vector<int> source;
+  for (std::size_t j = 0; j < dense->size (); ++j)
+    if (pcl::isFinite ((*dense)[j]))
+    {
+      finite->push_back ((*dense)[j]);
+      source.push_back (kept[j]);
+    }
+  const auto reference = estimate (finite, 10, SensorNoiseModel::isotropic (0.001));
+  ASSERT_EQ (finite->size (), 192u);
+  std::vector<bool> is_finite (cloud->size (), false);
+  for (std::size_t j = 0; j < finite->size (); ++j)
+  {
+    is_finite[source[j]] = true;
+    EXPECT_TRUE (out[source[j]].isFinite ());
+    EXPECT_TRUE ((out[source[j]].matrix () - reference[j].matrix ()).cwiseAbs ().maxCoeff () < 1e-12) << source[j];
+  }
+  for (std::size_t i = 0; i < cloud->size (); ++i)
+  {
+    if (!is_finite[i])
+    {
+      EXPECT_FALSE (out[i].isFinite ()) << i;
+    }
+  }
+}
+
+TEST (CovarianceEstimation, SetIndicesComputesOnlyThoseInOrder)
+{
+  const auto cloud = grid (10, 10, 0.01);
+  const auto all = estimate (cloud, 10);
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setInputCloud (cloud);
+  pcl::IndicesPtr idx (new pcl::Indices {42, 7, 99});
+  est.setIndices (idx);
+  pcl::PointCloud<Covariance> out;
+  est.compute (out);
+  ASSERT_EQ (out.size (), 3u);
+  for (std::size_t j = 0; j < 3; ++j)
+    EXPECT_TRUE (out[j].matrix ().isApprox (all[(*idx)[j]].matrix (), 1e-12));
+  EXPECT_EQ (est.getNeighbourRadii ().size (), 3u);
+}
+
+TEST (CovarianceEstimation, DegenerateNeighbourhoodsGiveFiniteDocumentedResults)
+{
+  // Fewer points than k: the neighbours there are.
+  Cloud::Ptr few (new Cloud);
+  for (int i = 0; i < 4; ++i)
+    few->push_back (pcl::PointXYZ (0.01f * i, 0.005f * (i % 2), 0.0f));
+  for (const auto& c : estimate (few, 10))
+  {
+    EXPECT_TRUE (c.isFinite ());
+    EXPECT_TRUE (isPsd (c.matrix (), 1e-15));
+    EXPECT_GT (c.matrix ().trace (), 0.0);
+  }
+  // A single point and all-identical points: Psi = 0, plus the sensor noise.
+  Cloud::Ptr same (new Cloud);
+  for (int i = 0; i < 12; ++i)
+    same->push_back (pcl::PointXYZ (1.f, 2.f, 3.f));
+  for (const auto& c : estimate (same, 10, SensorNoiseModel::isotropic (0.003)))
+    EXPECT_TRUE (c.matrix ().isApprox (9e-6 * Eigen::Matrix3d::Identity (), 1e-6));
+  Cloud::Ptr single (new Cloud);
+  single->push_back (pcl::PointXYZ (1.f, 2.f, 3.f));
+  const auto one = estimate (single, 10);
+  ASSERT_EQ (one.size (), 1u);
+  EXPECT_TRUE (one[0].matrix ().isZero (0.0));
+  // Collinear points: rank one, along the line, finite.
+  Cloud::Ptr line (new Cloud);
+  const Eigen::Vector3d dir = Eigen::Vector3d (1, 2, 2) / 3.0;
+  for (int i = 0; i < 30; ++i)
+  {
+    const Eigen::Vector3f p = (0.01 * i * dir).cast<float> ();
+    line->push_back (pcl::PointXYZ (p.x (), p.y (), p.z ()));
+  }
+  for (const auto& c : estimate (line, 6))
+  {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (c.matrix ());
+    EXPECT_LT (eig.eigenvalues ()(1), 1e-10 * eig.eigenvalues ()(2));
+    EXPECT_NEAR (std::abs (eig.eigenvectors ().col (2).dot (dir)), 1.0, 1e-6);
+  }
+}
+
+TEST (CovarianceEstimation, BadParametersAndEmptyInputFailClearly)
+{
+  CovarianceEstimation<pcl::PointXYZ> est;
+  EXPECT_THROW (est.setKSearch (0), pcl::BadArgumentException);
+  EXPECT_THROW (est.setScale (-1.0), pcl::BadArgumentException);
+  EXPECT_THROW (est.setScale (std::nan ("")), pcl::BadArgumentException);
+  EXPECT_NEAR (est.getScale (), 2.0 * std::sqrt (10.0), 1e-12);
+
+  pcl::PointCloud<Covariance> out;
+  out.resize (5);  // stale content must not survive a failed compute
+  est.setInputCloud (Cloud::Ptr (new Cloud));
+  est.compute (out);
+  EXPECT_TRUE (out.empty ());
+
+  out.resize (5);
+  est.setInputCloud (grid (5, 5, 0.01));
+  est.setRadiusSearch (0.05);  // the method is defined on k neighbours
+  est.compute (out);
+  EXPECT_TRUE (out.empty ());
+}
+
+TEST (CovarianceEstimation, RealStereoScanKeepsAlignmentAndGivesFinitePsdCovariances)
+{
+  const std::string file = std::string (PCL_PROBCOLLISION_SHARED_DATA) + "/scans/table_scene_mug_stereo_textured.pcd";
+  pcl::PointCloud<pcl::PointXYZRGBA>::Ptr scan (new pcl::PointCloud<pcl::PointXYZRGBA>);
+  ASSERT_EQ (pcl::io::loadPCDFile (file, *scan), 0) << "missing shared data: " << file;
+  ASSERT_EQ (scan->width, 640u);
+  ASSERT_EQ (scan->height, 480u);
+  CovarianceEstimation<pcl::PointXYZRGBA> est;
+  est.setInputCloud (scan);
+  est.setSensorNoise (SensorNoiseModel::stereo ());
+  pcl::PointCloud<Covariance> out;
+  est.compute (out);
+  ASSERT_EQ (out.size (), scan->size ());
+  EXPECT_EQ (out.width, 640u);
+  EXPECT_EQ (out.height, 480u);
+  std::size_t finite = 0, psd = 0;
+  for (std::size_t i = 0; i < scan->size (); ++i)
+  {
+    const bool point_finite = pcl::isFinite ((*scan)[i]);
+    EXPECT_EQ (out[i].isFinite (), point_finite) << i;
+    if (point_finite)
+    {
+      ++finite;
+      psd += isPsd (out[i].matrix (), 1e-12) && out[i].matrix ().trace () > 0.0 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ (finite, 209280u);  // SCENES.md: finite points of this scan
+  EXPECT_EQ (psd, finite);
+}
