@@ -1,1 +1,548 @@
 // SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/probabilistic_bvh.h>
+
+#include <pcl/exceptions.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace pcl_probcollision
+{
+void
+BVHParams::validate () const
+{
+  if (split_style != SplitStyle::Pca && split_style != SplitStyle::Octree)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] split_style "
+                             << static_cast<int> (split_style) << " is not Pca or Octree");
+  if (n_max < 1)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] n_max " << n_max
+                                                                          << " must be >= 1");
+  if (n_min < 1 || n_min > n_max)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] n_min "
+                             << n_min << " outside [1, n_max = " << n_max << "]");
+  if (!(sigma_max >= 0.0) || !std::isfinite (sigma_max))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] sigma_max "
+                             << sigma_max << " must be finite and >= 0");
+  if (!(epsilon >= 0.0 && epsilon < 0.5))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] epsilon " << epsilon
+                                                                            << " outside [0, 0.5)");
+  if (!(k_sigma >= 0.0) || !std::isfinite (k_sigma))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] k_sigma "
+                             << k_sigma << " must be finite and >= 0");
+  if (leakage_bound != LeakageBound::MinSlab && leakage_bound != LeakageBound::UnionBound)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] leakage_bound "
+                             << static_cast<int> (leakage_bound)
+                             << " is not MinSlab or UnionBound");
+}
+
+namespace
+{
+// Largest accepted cloud: stored indices (with duplication) and node ranges are int32.
+constexpr std::size_t kMaxPoints = std::size_t (1) << 28;
+
+void
+validateCloud (const UncertainCloud& cloud)
+{
+  const std::size_t n = cloud.means.size ();
+  if (cloud.covariances.size () != n)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::build] " << cloud.covariances.size ()
+                             << " covariances for " << n << " means");
+  if (!cloud.area_weights.empty () && cloud.area_weights.size () != n)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::build] " << cloud.area_weights.size ()
+                             << " area weights for " << n << " means");
+  if (!cloud.source_indices.empty () && cloud.source_indices.size () != n)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::build] "
+                             << cloud.source_indices.size () << " source indices for " << n
+                             << " means");
+  if (n > kMaxPoints)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::build] " << n
+                             << " points exceed the limit of " << kMaxPoints);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (!cloud.means[i].allFinite ())
+      PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                           "[pcl_probcollision::ProbabilisticBVH::build] point "
+                               << i << " has a non-finite mean (" << cloud.means[i].x () << ", "
+                               << cloud.means[i].y () << ", " << cloud.means[i].z () << ")");
+    if (!cloud.covariances[i].allFinite ())
+      PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                           "[pcl_probcollision::ProbabilisticBVH::build] point "
+                               << i << " has a non-finite covariance");
+    if (!cloud.area_weights.empty () &&
+        (!(cloud.area_weights[i] >= 0.0) || !std::isfinite (cloud.area_weights[i])))
+      PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                           "[pcl_probcollision::ProbabilisticBVH::build] point "
+                               << i << " has area weight " << cloud.area_weights[i]
+                               << " (must be finite and >= 0)");
+  }
+}
+
+struct BuildTask
+{
+  std::int32_t node;
+  std::int32_t depth;
+  std::vector<int> points;
+};
+
+// Split value along one projection: the mean (FCL's rule); the median when rounding leaves a
+// strict side empty; the mid-range as the last resort. Requires max > min.
+double
+splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<double>& tmp)
+{
+  const std::size_t m = p.size ();
+  double sum = 0.0;
+  for (double v : p)
+    sum += v;
+  double s = sum / static_cast<double> (m);
+  auto both_sides = [&] (double v) {
+    bool below = false, above = false;
+    for (double x : p)
+    {
+      below = below || x < v;
+      above = above || x > v;
+    }
+    return below && above;
+  };
+  if (both_sides (s))
+    return s;
+  tmp.assign (p.begin (), p.end ());
+  std::nth_element (tmp.begin (), tmp.begin () + m / 2, tmp.end ());
+  s = tmp[m / 2];
+  if (both_sides (s))
+    return s;
+  return 0.5 * (pmin + pmax);
+}
+
+// Per-node geometry: everything computed from the node's own points.
+struct NodeGeometry
+{
+  Eigen::Vector3d mean;
+  Eigen::Matrix3d axes;           // columns e3, e2, e1
+  double variation;
+  std::vector<double> q[3];       // projections a_k^T (x - mean)
+  std::vector<double> s[3];       // standard deviations sqrt(a_k^T Sigma a_k)
+  Eigen::Vector3d lo, hi;         // inflated extents in box coordinates about mean
+};
+
+void
+computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, double k_sigma,
+                 NodeGeometry& g)
+{
+  const std::size_t m = points.size ();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero ();
+  for (int j : points)
+    mean += cloud.means[j];
+  mean /= static_cast<double> (m);
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero ();
+  for (int j : points)
+  {
+    const Eigen::Vector3d d = cloud.means[j] - mean;
+    C.noalias () += d * d.transpose ();
+  }
+  C /= static_cast<double> (m);
+
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es (C);
+  Eigen::Vector3d lambda = es.eigenvalues ();
+  Eigen::Matrix3d V = es.eigenvectors ();
+  if (es.info () != Eigen::Success || !V.allFinite ())
+  {
+    lambda.setZero ();
+    V.setIdentity ();
+  }
+  g.mean = mean;
+  g.axes.col (0) = V.col (2);
+  g.axes.col (1) = V.col (1);
+  g.axes.col (2) = V.col (0);
+  if (g.axes.determinant () < 0.0)
+    g.axes.col (2) = -g.axes.col (2);
+  const double l1 = std::max (0.0, lambda (0));
+  const double sum = l1 + std::max (0.0, lambda (1)) + std::max (0.0, lambda (2));
+  g.variation = sum > 0.0 ? l1 / sum : 0.0;
+
+  for (int k = 0; k < 3; ++k)
+  {
+    g.q[k].resize (m);
+    g.s[k].resize (m);
+  }
+  g.lo.setConstant (std::numeric_limits<double>::infinity ());
+  g.hi.setConstant (-std::numeric_limits<double>::infinity ());
+  const Eigen::Matrix3d At = g.axes.transpose ();
+  for (std::size_t i = 0; i < m; ++i)
+  {
+    const int j = points[i];
+    const Eigen::Vector3d q = At * (cloud.means[j] - mean);
+    // Diagonal of A^T Sigma A: the variance along each box axis.
+    const Eigen::Matrix3d S = At * cloud.covariances[j];
+    for (int k = 0; k < 3; ++k)
+    {
+      const double var = S.row (k).dot (g.axes.col (k));
+      const double sd = std::sqrt (std::max (0.0, var));
+      g.q[k][i] = q (k);
+      g.s[k][i] = sd;
+      g.lo (k) = std::min (g.lo (k), q (k) - k_sigma * sd);
+      g.hi (k) = std::max (g.hi (k), q (k) + k_sigma * sd);
+    }
+  }
+}
+
+double
+nodeLeakage (const UncertainCloud& cloud, const std::vector<int>& points, const NodeGeometry& g,
+             detail::LeakageBound bound)
+{
+  const std::size_t m = points.size ();
+  const bool weighted = !cloud.area_weights.empty ();
+  double sum_w = 0.0, sum_wp = 0.0, sum_p = 0.0;
+  for (std::size_t i = 0; i < m; ++i)
+  {
+    const double out0 = detail::slabOutsideProbability (g.lo (0), g.hi (0), g.q[0][i], g.s[0][i]);
+    const double out1 = detail::slabOutsideProbability (g.lo (1), g.hi (1), g.q[1][i], g.s[1][i]);
+    const double out2 = detail::slabOutsideProbability (g.lo (2), g.hi (2), g.q[2][i], g.s[2][i]);
+    const double p = detail::combineSlabs (out0, out1, out2, bound);
+    sum_p += p;
+    if (weighted)
+    {
+      const double w = cloud.area_weights[points[i]];
+      sum_w += w;
+      sum_wp += w * p;
+    }
+  }
+  // All-zero weights in a node carry no area information: fall back to equal weights.
+  double leak = (weighted && sum_w > 0.0) ? sum_wp / sum_w : sum_p / static_cast<double> (m);
+  return std::min (1.0, std::max (0.0, leak));
+}
+
+// Pca split (METHOD.md 8.1, 8.2). Returns false when no split makes progress.
+bool
+splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
+          std::vector<double>& tmp, std::vector<std::vector<int>>& children)
+{
+  const std::vector<double>& p = g.q[0];
+  const std::size_t m = points.size ();
+  const auto mm = std::minmax_element (p.begin (), p.end ());
+  const double pmin = *mm.first, pmax = *mm.second;
+  if (!(pmax > pmin))
+    return false;
+  const double L = pmax - pmin;
+  const double s = splitValue (p, pmin, pmax, tmp);
+  const double eps_try[2] = {epsilon, 0.0};
+  for (int attempt = 0; attempt < (epsilon > 0.0 ? 2 : 1); ++attempt)
+  {
+    const double left_hi = s + eps_try[attempt] * L;
+    const double right_lo = s - eps_try[attempt] * L;
+    std::size_t nl = 0, nr = 0;
+    for (double v : p)
+    {
+      nl += (v <= left_hi);
+      nr += (v >= right_lo);
+    }
+    if (nl == m || nr == m || nl == 0 || nr == 0)
+      continue;
+    children.assign (2, std::vector<int> ());
+    children[0].reserve (nl);
+    children[1].reserve (nr);
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      if (p[i] <= left_hi)
+        children[0].push_back (points[i]);
+      if (p[i] >= right_lo)
+        children[1].push_back (points[i]);
+    }
+    return true;
+  }
+  return false;
+}
+
+// Relative extent below which an octree axis counts as flat (see splitOctree).
+constexpr double kFlatAxisRelative = 1e-9;
+
+// Octree split on the node's principal axes at the mean; each cell grown by epsilon times the
+// parent's extent on each axis; axes along which all points project equally are not split.
+bool
+splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
+             std::vector<double>& tmp, std::vector<std::vector<int>>& children)
+{
+  const std::size_t m = points.size ();
+  bool active[3];
+  double s[3], L[3];
+  bool any = false;
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    const auto mm = std::minmax_element (g.q[k].begin (), g.q[k].end ());
+    lo[k] = *mm.first;
+    hi[k] = *mm.second;
+    L[k] = hi[k] - lo[k];
+  }
+  // An axis whose extent is at the rounding level of the longest one (collinear or coplanar
+  // points) is not split: its "halves" would only sort rounding noise.
+  const double L_max = std::max (L[0], std::max (L[1], L[2]));
+  for (int k = 0; k < 3; ++k)
+  {
+    active[k] = hi[k] > lo[k] && L[k] > kFlatAxisRelative * L_max;
+    s[k] = active[k] ? splitValue (g.q[k], lo[k], hi[k], tmp) : 0.0;
+    any = any || active[k];
+  }
+  if (!any)
+    return false;
+  const double eps_try[2] = {epsilon, 0.0};
+  std::vector<std::vector<int>> cells;
+  for (int attempt = 0; attempt < (epsilon > 0.0 ? 2 : 1); ++attempt)
+  {
+    const double e = eps_try[attempt];
+    cells.assign (8, std::vector<int> ());
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      // Bit k of a cell id: 0 = low side, 1 = high side of axis k.
+      int low_mask = 0, high_mask = 0;
+      for (int k = 0; k < 3; ++k)
+      {
+        const double v = g.q[k][i];
+        const bool low = !active[k] || v <= s[k] + e * L[k];
+        const bool high = active[k] && v >= s[k] - e * L[k];
+        low_mask |= (low ? 1 : 0) << k;
+        high_mask |= (high ? 1 : 0) << k;
+      }
+      for (int c = 0; c < 8; ++c)
+      {
+        bool in = true;
+        for (int k = 0; k < 3 && in; ++k)
+          in = ((c >> k) & 1) ? ((high_mask >> k) & 1) : ((low_mask >> k) & 1);
+        if (in)
+          cells[c].push_back (points[i]);
+      }
+    }
+    bool progress = true;
+    for (const auto& c : cells)
+      progress = progress && c.size () < m;
+    if (!progress)
+      continue;
+    children.clear ();
+    for (auto& c : cells)
+      if (!c.empty ())
+        children.push_back (std::move (c));
+    if (children.size () >= 2)
+      return true;
+  }
+  return false;
+}
+} // namespace
+
+bool
+ProbabilisticBVH::build (const UncertainCloud& cloud, const BVHParams& params)
+{
+  params.validate ();
+  validateCloud (cloud);
+  return buildValidated (UncertainCloud (cloud), params);
+}
+
+bool
+ProbabilisticBVH::build (UncertainCloud&& cloud, const BVHParams& params)
+{
+  params.validate ();
+  validateCloud (cloud);
+  return buildValidated (std::move (cloud), params);
+}
+
+bool
+ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& params)
+{
+  const auto t0 = std::chrono::steady_clock::now ();
+  UncertainCloud copy = std::move (cloud);
+  copy.means.shrink_to_fit ();
+  copy.covariances.shrink_to_fit ();
+  copy.area_weights.shrink_to_fit ();
+  copy.source_indices.shrink_to_fit ();
+  std::vector<Node> nodes;
+  std::vector<int> indices;
+  std::size_t leaf_count = 0;
+  int max_depth = -1;
+  const std::size_t n = copy.size ();
+
+  if (n > 0)
+  {
+    // Rough sizes: about n / 5 nodes, a few percent of duplicated indices.
+    nodes.reserve (n / 4 + 8);
+    indices.reserve (n + n / 4 + 8);
+    std::vector<BuildTask> stack;
+    stack.push_back ({0, 0, std::vector<int> (n)});
+    for (std::size_t i = 0; i < n; ++i)
+      stack.back ().points[i] = static_cast<int> (i);
+    nodes.emplace_back ();
+
+    NodeGeometry g;
+    std::vector<double> tmp;
+    std::vector<std::vector<int>> children;
+    while (!stack.empty ())
+    {
+      BuildTask task = std::move (stack.back ());
+      stack.pop_back ();
+      const std::vector<int>& pts = task.points;
+      const std::size_t m = pts.size ();
+      computeGeometry (copy, pts, params.k_sigma, g);
+
+      Node& node = nodes[task.node];
+      node.box.axes = g.axes;
+      node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
+      node.box.half_extents = 0.5 * (g.hi - g.lo);
+      for (int k = 0; k < 3; ++k)
+        node.max_sigma (k) = static_cast<float> (*std::max_element (g.s[k].begin (), g.s[k].end ()));
+      node.leakage = nodeLeakage (copy, pts, g, params.leakage_bound);
+      node.variation = static_cast<float> (g.variation);
+      node.num_points = static_cast<std::int32_t> (m);
+      node.depth = task.depth;
+      max_depth = std::max (max_depth, task.depth);
+
+      const bool stop_rule = m <= static_cast<std::size_t> (params.n_max) &&
+                             g.variation <= params.sigma_max;
+      bool split = false;
+      if (stop_rule)
+        node.leaf_reason = LeafReason::StopRule;
+      else if (m <= static_cast<std::size_t> (params.n_min))
+        node.leaf_reason = LeafReason::MinSize;
+      else
+      {
+        split = params.split_style == BVHParams::SplitStyle::Pca
+                    ? splitPca (pts, g, params.epsilon, tmp, children)
+                    : splitOctree (pts, g, params.epsilon, tmp, children);
+        if (!split)
+          node.leaf_reason = LeafReason::NoProgress;
+      }
+
+      if (!split)
+      {
+        node.first_child = -1;
+        node.num_children = 0;
+        node.begin = static_cast<std::int32_t> (indices.size ());
+        indices.insert (indices.end (), pts.begin (), pts.end ());
+        node.end = static_cast<std::int32_t> (indices.size ());
+        ++leaf_count;
+        continue;
+      }
+
+      const std::int32_t first = static_cast<std::int32_t> (nodes.size ());
+      const std::size_t nc = children.size ();
+      node.leaf_reason = LeafReason::NotLeaf;
+      node.first_child = first;
+      node.num_children = static_cast<std::uint8_t> (nc);
+      // `node` may dangle after this resize.
+      nodes.resize (nodes.size () + nc);
+      // Reverse push: the first child is processed next, so leaves come out depth-first, left
+      // to right, and every subtree's leaves are contiguous in `indices`.
+      for (std::size_t c = nc; c-- > 0;)
+        stack.push_back ({first + static_cast<std::int32_t> (c), task.depth + 1,
+                          std::move (children[c])});
+    }
+
+    // Internal ranges: children have larger ids than their parent, so one backward pass.
+    for (std::size_t id = nodes.size (); id-- > 0;)
+    {
+      Node& nd = nodes[id];
+      if (nd.isLeaf ())
+        continue;
+      nd.begin = nodes[nd.first_child].begin;
+      nd.end = nodes[nd.first_child + nd.num_children - 1].end;
+    }
+    nodes.shrink_to_fit ();
+    indices.shrink_to_fit ();
+  }
+
+  cloud_ = std::move (copy);
+  params_ = params;
+  nodes_ = std::move (nodes);
+  indices_ = std::move (indices);
+  leaf_count_ = leaf_count;
+  depth_ = max_depth + 1;
+  build_milliseconds_ =
+      std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - t0).count ();
+  return !nodes_.empty ();
+}
+
+void
+ProbabilisticBVH::clear ()
+{
+  cloud_ = UncertainCloud ();
+  nodes_.clear ();
+  nodes_.shrink_to_fit ();
+  indices_.clear ();
+  indices_.shrink_to_fit ();
+  leaf_count_ = 0;
+  depth_ = 0;
+  build_milliseconds_ = 0.0;
+}
+
+ProbabilisticBVH::IndexSpan
+ProbabilisticBVH::indices (const Node& node) const
+{
+  IndexSpan span;
+  if (node.begin < 0 || node.end < node.begin ||
+      static_cast<std::size_t> (node.end) > indices_.size ())
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::indices] node range ["
+                             << node.begin << ", " << node.end << ") outside the "
+                             << indices_.size () << " stored indices");
+  span.data = indices_.data () + node.begin;
+  span.size = static_cast<std::size_t> (node.end - node.begin);
+  return span;
+}
+
+std::size_t
+ProbabilisticBVH::bytes () const
+{
+  return sizeof (*this) + cloud_.means.capacity () * sizeof (Eigen::Vector3d) +
+         cloud_.covariances.capacity () * sizeof (Eigen::Matrix3d) +
+         cloud_.area_weights.capacity () * sizeof (double) +
+         cloud_.source_indices.capacity () * sizeof (int) + nodes_.capacity () * sizeof (Node) +
+         indices_.capacity () * sizeof (int);
+}
+
+PointSetView
+ProbabilisticBVH::gatherPoints (const Node& node, std::vector<Eigen::Vector3d>& means,
+                                std::vector<Eigen::Matrix3d>& covariances) const
+{
+  const IndexSpan span = indices (node);
+  means.resize (span.size);
+  covariances.resize (span.size);
+  for (std::size_t i = 0; i < span.size; ++i)
+  {
+    means[i] = cloud_.means[span[i]];
+    covariances[i] = cloud_.covariances[span[i]];
+  }
+  return PointSetView (means.data (), covariances.data (), span.size);
+}
+
+PointSetView
+ProbabilisticBVH::gatherPoints (const Node& node, const Eigen::Isometry3d& T_dst_src,
+                                std::vector<Eigen::Vector3d>& means,
+                                std::vector<Eigen::Matrix3d>& covariances) const
+{
+  const IndexSpan span = indices (node);
+  means.resize (span.size);
+  covariances.resize (span.size);
+  const Eigen::Matrix3d R = T_dst_src.linear ();
+  const Eigen::Vector3d t = T_dst_src.translation ();
+  for (std::size_t i = 0; i < span.size; ++i)
+  {
+    means[i].noalias () = R * cloud_.means[span[i]];
+    means[i] += t;
+    const Eigen::Matrix3d S = R * cloud_.covariances[span[i]] * R.transpose ();
+    covariances[i] = 0.5 * (S + S.transpose ());
+  }
+  return PointSetView (means.data (), covariances.data (), span.size);
+}
+} // namespace pcl_probcollision

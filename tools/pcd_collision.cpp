@@ -1,2 +1,673 @@
-// placeholder until the CLI lands
-int main () { return 0; }
+// SPDX-License-Identifier: BSD-3-Clause
+// pcd_collision: probability that two point clouds (or meshes) collide, in PCL's tool style.
+// The contract is in docs/CLI.md and `pcd_collision -h`.
+
+#include "cli_options.h"
+#include "mesh_input.h"
+#include "mesh_sampling.h"
+#include "pcd_files.h"
+
+#include <pcl_probcollision/probabilistic_collision.h>
+
+#include <pcl/console/print.h>
+#include <pcl/exceptions.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace pcd_collision
+{
+namespace
+{
+namespace fs = std::filesystem;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+/** \brief A failure with its exit status; main prints "pcd_collision: error: <what>". */
+struct Failure
+{
+  int status;
+  std::string message;
+};
+
+constexpr int kRuntimeFailure = 1;
+constexpr int kUsageError = 2;
+
+double
+msSince (std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON (one object per line; NaN and Inf become null).
+class Json
+{
+public:
+  Json& key (const char* k)
+  {
+    if (comma_)
+      out_ << ',';
+    quoted (k);
+    out_ << ':';
+    comma_ = false;
+    after_key_ = true;
+    return *this;
+  }
+  Json& begin () { return open ('{'); }
+  Json& end () { return close ('}'); }
+  Json& beginArray () { return open ('['); }
+  Json& endArray () { return close (']'); }
+  Json& num (double v)
+  {
+    pre ();
+    if (!std::isfinite (v))
+      out_ << "null";
+    else
+    {
+      char buf[32];
+      std::snprintf (buf, sizeof (buf), "%.10g", v);
+      out_ << buf;
+    }
+    return *this;
+  }
+  Json& count (std::uint64_t v)
+  {
+    pre ();
+    out_ << v;
+    return *this;
+  }
+  Json& integer (long long v)
+  {
+    pre ();
+    out_ << v;
+    return *this;
+  }
+  Json& boolean (bool v)
+  {
+    pre ();
+    out_ << (v ? "true" : "false");
+    return *this;
+  }
+  Json& null ()
+  {
+    pre ();
+    out_ << "null";
+    return *this;
+  }
+  Json& str (const std::string& s)
+  {
+    pre ();
+    quoted (s);
+    return *this;
+  }
+  Json& vec3 (const Eigen::Vector3d& v)
+  {
+    beginArray ();
+    num (v.x ()).num (v.y ()).num (v.z ());
+    return endArray ();
+  }
+  std::string text () const { return out_.str (); }
+
+private:
+  void pre ()
+  {
+    if (!after_key_ && comma_)
+      out_ << ',';
+    after_key_ = false;
+    comma_ = true;
+  }
+  Json& open (char c)
+  {
+    pre ();
+    out_ << c;
+    comma_ = false;
+    return *this;
+  }
+  Json& close (char c)
+  {
+    out_ << c;
+    comma_ = true;
+    return *this;
+  }
+  void quoted (const std::string& s)
+  {
+    out_ << '"';
+    for (const char ch : s)
+    {
+      const auto c = static_cast<unsigned char> (ch);
+      switch (c)
+      {
+        case '"': out_ << "\\\""; break;
+        case '\\': out_ << "\\\\"; break;
+        case '\n': out_ << "\\n"; break;
+        case '\r': out_ << "\\r"; break;
+        case '\t': out_ << "\\t"; break;
+        default:
+          if (c < 0x20 || c == 0x7f)
+          {
+            char buf[8];
+            std::snprintf (buf, sizeof (buf), "\\u%04x", c);
+            out_ << buf;
+          }
+          else
+            out_ << ch;
+      }
+    }
+    out_ << '"';
+  }
+  std::ostringstream out_;
+  bool comma_ = false;
+  bool after_key_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------
+struct Input
+{
+  std::string path;
+  InputKind kind = InputKind::Unsupported;
+  Cloud::Ptr cloud = pcl::make_shared<Cloud> ();  ///< loaded, or sampled from the mesh
+  TriangleMesh mesh;
+  std::size_t finite = 0;
+  double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
+  std::string spacing_source;
+  double load_ms = 0.0;
+  double sample_ms = 0.0;
+};
+
+void
+requireReadable (const std::string& path)
+{
+  std::error_code ec;
+  const auto st = fs::status (path, ec);
+  if (ec || !fs::exists (st))
+    throw Failure{kRuntimeFailure, "cannot read '" + path + "': No such file or directory"};
+  if (fs::is_directory (st))
+    throw Failure{kRuntimeFailure, "cannot read '" + path + "': is a directory"};
+  std::FILE* f = std::fopen (path.c_str (), "rb");
+  if (!f)
+    throw Failure{kRuntimeFailure, "cannot read '" + path + "': " + std::strerror (errno)};
+  std::fclose (f);
+}
+
+std::size_t
+countFinite (const Cloud& cloud)
+{
+  std::size_t n = 0;
+  for (const auto& p : cloud.points)
+    n += std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
+  return n;
+}
+
+void
+loadInput (Input& in, FILE* log)
+{
+  requireReadable (in.path);
+  const auto start = std::chrono::steady_clock::now ();
+  std::string error;
+  if (in.kind == InputKind::Cloud)
+  {
+    if (!loadCloud (in.path, *in.cloud, error))
+      throw Failure{kRuntimeFailure, error};
+    in.finite = countFinite (*in.cloud);
+    if (in.finite == 0)
+      throw Failure{kRuntimeFailure, "'" + in.path + "' has no finite point (" + std::to_string (in.cloud->size ()) +
+                                         " points, all NaN or Inf)"};
+    in.load_ms = msSince (start);
+    std::fprintf (log, "Loading %s [done, %.1f ms : %zu points, %u x %u, %zu finite]\n", in.path.c_str (), in.load_ms,
+                  in.cloud->size (), in.cloud->width, in.cloud->height, in.finite);
+  }
+  else
+  {
+    if (!loadTriangleMesh (in.path, in.mesh, error))
+      throw Failure{kRuntimeFailure, error};
+    in.load_ms = msSince (start);
+    std::fprintf (log, "Loading %s [done, %.1f ms : mesh, %zu vertices, %zu triangles]\n", in.path.c_str (), in.load_ms,
+                  in.mesh.vertices.size (), in.mesh.triangles.size ());
+  }
+}
+
+void
+sampleInput (Input& in, double spacing, const std::string& source, FILE* log)
+{
+  const auto start = std::chrono::steady_clock::now ();
+  if (!(spacing > 0.0) || !std::isfinite (spacing))
+    throw Failure{kRuntimeFailure, "cannot choose a sample spacing for mesh '" + in.path + "' (" + source +
+                                       " is 0); give -mesh_density"};
+  try
+  {
+    *in.cloud = sampleMesh (in.mesh, spacing, Defaults::mesh_sampling_seed);
+  }
+  catch (const std::runtime_error& e)
+  {
+    throw Failure{kRuntimeFailure, "mesh '" + in.path + "': " + e.what ()};
+  }
+  in.finite = in.cloud->size ();
+  in.spacing = spacing;
+  in.spacing_source = source;
+  in.sample_ms = msSince (start);
+  std::fprintf (log, "Sampling %s [done, %.1f ms : %zu points at spacing %g, %s]\n", in.path.c_str (), in.sample_ms,
+                in.cloud->size (), spacing, source.c_str ());
+}
+
+Eigen::Isometry3d
+toIsometry (const Pose& p)
+{
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
+  T.linear () = (Eigen::AngleAxisd (p[5], Eigen::Vector3d::UnitZ ()) * Eigen::AngleAxisd (p[4], Eigen::Vector3d::UnitY ()) *
+                 Eigen::AngleAxisd (p[3], Eigen::Vector3d::UnitX ()))
+                    .toRotationMatrix ();
+  T.translation () = Eigen::Vector3d (p[0], p[1], p[2]);
+  return T;
+}
+
+/** \brief Refuses an -o that is one of the inputs (same file, through any link), and an -o in a
+  * directory that does not exist. */
+void
+checkOutput (const Options& o)
+{
+  if (!o.output)
+    return;
+  const fs::path out (*o.output);
+  std::vector<std::string> inputs = {o.input_a, o.input_b};
+  if (o.poses_file)
+    inputs.push_back (*o.poses_file);
+  std::error_code ec;
+  for (const std::string& in : inputs)
+  {
+    bool same = fs::exists (out, ec) && fs::exists (in, ec) && fs::equivalent (out, in, ec);
+    if (!same)
+    {
+      const fs::path a = fs::weakly_canonical (out, ec);
+      const fs::path b = fs::weakly_canonical (in, ec);
+      same = !ec && a == b;
+    }
+    if (same)
+      throw Failure{kUsageError, "-o '" + *o.output + "' is the input '" + in + "'; refusing to overwrite an input"};
+  }
+  const fs::path dir = out.has_parent_path () ? out.parent_path () : fs::path (".");
+  if (!fs::is_directory (dir, ec))
+    throw Failure{kRuntimeFailure, "cannot write '" + *o.output + "': directory '" + dir.string () + "' does not exist"};
+  if (fs::is_directory (out, ec))
+    throw Failure{kRuntimeFailure, "cannot write '" + *o.output + "': is a directory"};
+}
+
+pcl_probcollision::SensorNoiseModel
+noiseFor (const Options& o, double sigma)
+{
+  if (o.sensor == "isotropic")
+    return pcl_probcollision::SensorNoiseModel::isotropic (sigma);
+  return pcl_probcollision::SensorNoiseModel::fromName (o.sensor);
+}
+
+pcl_probcollision::CollisionRequest
+requestFor (const Options& o)
+{
+  pcl_probcollision::CollisionRequest r;
+  r.free_below = o.free_below;
+  r.collision_above = o.collision_above;
+  r.exhaustive = o.exhaustive || o.output.has_value ();
+  r.per_point = o.output.has_value ();
+  r.enable_timings = true;
+  r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
+                             : pcl_probcollision::TraversalMode::ExpectedWeight;
+  r.seed = o.seed;
+  r.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
+                                                : pcl_probcollision::BVHParams::SplitStyle::Pca;
+  r.hierarchy.n_max = o.n_max;
+  r.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
+  r.hierarchy.sigma_max = o.sigma_max;
+  r.hierarchy.epsilon = o.epsilon;
+  return r;
+}
+
+void
+inputJson (Json& j, const Input& in)
+{
+  j.begin ();
+  j.key ("path").str (in.path);
+  if (in.kind == InputKind::Cloud)
+  {
+    j.key ("kind").str ("cloud");
+    j.key ("points").count (in.cloud->size ());
+    j.key ("finite").count (in.finite);
+    j.key ("width").count (in.cloud->width);
+    j.key ("height").count (in.cloud->height);
+  }
+  else
+  {
+    j.key ("kind").str ("mesh");
+    j.key ("vertices").count (in.mesh.vertices.size ());
+    j.key ("triangles").count (in.mesh.triangles.size ());
+    j.key ("points").count (in.cloud->size ());
+    j.key ("spacing").num (in.spacing);
+    j.key ("spacing_source").str (in.spacing_source);
+  }
+  j.end ();
+}
+
+std::string
+resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcollision::CollisionResult& r,
+            const Pose& pose, long long pose_index, const std::optional<double>& write_ms,
+            std::size_t points_written)
+{
+  const auto& rq = requestFor (o);
+  Json j;
+  j.begin ();
+  if (pose_index >= 0)
+    j.key ("pose_index").integer (pose_index);
+  j.key ("pose").beginArray ();
+  for (const double v : pose)
+    j.num (v);
+  j.endArray ();
+  j.key ("verdict").str (pcl_probcollision::verdictName (r.verdict));
+  j.key ("probability").num (r.probability);
+  j.key ("lower_bound").boolean (r.lower_bound);
+  j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
+  j.key ("points_a").count (r.points_a);
+  j.key ("points_b").count (r.points_b);
+  j.key ("points_skipped_nonfinite").count (r.points_skipped_nonfinite);
+  j.key ("leaf_pairs").count (r.leaf_pairs_tested);
+  j.key ("bv_tests").count (r.bv_tests);
+  j.key ("kernel_leaf_pairs").count (r.kernel_leaf_pairs);
+  j.key ("degenerate_leaf_pairs").count (r.degenerate_leaf_pairs);
+  j.key ("classifier_iterations").count (r.classifier_iterations);
+  j.key ("build_ms").num (r.build_ms);
+  j.key ("query_ms").num (r.query_ms);
+  j.key ("witness");
+  if (r.witness_side == 0)
+    j.null ();
+  else
+  {
+    j.begin ();
+    j.key ("point").vec3 (r.witness_point);
+    j.key ("side").str (r.witness_side > 0 ? "a" : "b");
+    j.key ("index").integer (r.witness_index);
+    j.key ("normal").vec3 (r.witness_normal);
+    j.end ();
+  }
+  j.key ("timings_ms").begin ();
+  j.key ("load_a").num (a.load_ms);
+  j.key ("load_b").num (b.load_ms);
+  j.key ("sample_meshes").num (a.sample_ms + b.sample_ms);
+  j.key ("build").num (r.build_ms);
+  j.key ("query").num (r.query_ms);
+  if (write_ms)
+    j.key ("write").num (*write_ms);
+  j.end ();
+  j.key ("inputs").begin ();
+  j.key ("a");
+  inputJson (j, a);
+  j.key ("b");
+  inputJson (j, b);
+  j.end ();
+  j.key ("parameters").begin ();
+  j.key ("sensor").str (o.sensor);
+  j.key ("sigma_a");
+  (o.sensor == "isotropic" && a.kind == InputKind::Cloud) ? j.num (o.sigma_a) : j.null ();
+  j.key ("sigma_b");
+  (o.sensor == "isotropic" && b.kind == InputKind::Cloud) ? j.num (o.sigma_b) : j.null ();
+  j.key ("k").integer (o.k);
+  j.key ("thresholds").beginArray ().num (o.free_below).num (o.collision_above).endArray ();
+  j.key ("traversal").str (o.stochastic ? "stochastic" : "deterministic");
+  j.key ("seed").count (o.seed);
+  j.key ("exhaustive").boolean (rq.exhaustive);
+  j.key ("nmax").integer (rq.hierarchy.n_max);
+  j.key ("nmin").integer (rq.hierarchy.n_min);
+  j.key ("sigma_max").num (rq.hierarchy.sigma_max);
+  j.key ("epsilon").num (rq.hierarchy.epsilon);
+  j.key ("split").str (o.split);
+  j.end ();
+  if (o.output)
+  {
+    j.key ("output").begin ();
+    j.key ("path").str (*o.output);
+    j.key ("points").count (points_written);
+    j.end ();
+  }
+  j.end ();
+  return j.text ();
+}
+
+std::string
+humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
+{
+  char buf[512];
+  const std::string prefix = pose_index >= 0 ? "pose " + std::to_string (pose_index) + ": " : std::string ();
+  std::snprintf (buf, sizeof (buf),
+                 "%s%-9s P %s %.6f   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "query %.1f ms]",
+                 prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
+                 r.probability, r.points_a, r.points_b, r.points_skipped_nonfinite, r.leaf_pairs_tested,
+                 std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
+  return buf;
+}
+
+std::string
+witnessLine (const pcl_probcollision::CollisionResult& r)
+{
+  if (r.witness_side == 0)
+    return "  witness: none (no leaf pair tested)";
+  char buf[256];
+  std::snprintf (buf, sizeof (buf), "  witness: %s[%d] at (%.4f, %.4f, %.4f), normal (%.3f, %.3f, %.3f)",
+                 r.witness_side > 0 ? "a" : "b", r.witness_index, r.witness_point.x (), r.witness_point.y (),
+                 r.witness_point.z (), r.witness_normal.x (), r.witness_normal.y (), r.witness_normal.z ());
+  return buf;
+}
+
+/** \brief "\r[12/300 poses]" on stderr when it is a terminal, at most every 0.2 s, first after
+  * 0.2 s (short runs show nothing); erased at the end and before summary lines that share the
+  * terminal. */
+class Progress
+{
+public:
+  Progress (std::size_t total, bool enabled)
+    : total_ (total), enabled_ (enabled && total > 1), last_ (std::chrono::steady_clock::now ()) {}
+  void show (std::size_t done)
+  {
+    if (!enabled_ || done >= total_)
+      return;
+    const auto now = std::chrono::steady_clock::now ();
+    if (now - last_ < std::chrono::milliseconds (200))
+      return;
+    last_ = now;
+    std::fprintf (stderr, "\r[%zu/%zu poses]", done, total_);
+    std::fflush (stderr);
+    shown_ = true;
+  }
+  void clear ()
+  {
+    if (!shown_)
+      return;
+    std::fprintf (stderr, "\r\033[K");
+    std::fflush (stderr);
+    shown_ = false;
+  }
+
+private:
+  std::size_t total_;
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point last_;
+};
+
+int
+run (int argc, char** argv)
+{
+  const ParseResult parsed = parseCommandLine (argc, argv);
+  if (parsed.kind == ParseResult::Kind::Help)
+  {
+    std::fputs (helpText ().c_str (), stdout);
+    return 0;
+  }
+  if (parsed.kind == ParseResult::Kind::Error)
+    throw Failure{kUsageError, parsed.error};
+  const Options& o = parsed.options;
+
+  if (!o.verbose)
+  {
+    pcl::console::setVerbosityLevel (pcl::console::L_ALWAYS);
+    setVtkMessages (false);
+  }
+  FILE* const log = stderr;                           // progress and stage lines
+  FILE* const human = o.json ? stderr : stdout;       // the summary
+
+  checkOutput (o);
+
+  // Poses first: a malformed file fails before the (slow) loading.
+  std::vector<Pose> poses;
+  const bool batch = o.poses_file.has_value ();
+  if (batch)
+  {
+    requireReadable (*o.poses_file);
+    std::ifstream f (*o.poses_file);
+    if (!f)
+      throw Failure{kRuntimeFailure, "cannot read '" + *o.poses_file + "'"};
+    std::string error;
+    if (!parsePoses (f, *o.poses_file, poses, error))
+      throw Failure{kRuntimeFailure, error};
+  }
+  else
+    poses.push_back (o.pose.value_or (Pose{0, 0, 0, 0, 0, 0}));
+
+  Input a, b;
+  a.path = o.input_a;
+  a.kind = inputKindOf (a.path);
+  b.path = o.input_b;
+  b.kind = inputKindOf (b.path);
+  loadInput (a, log);
+  loadInput (b, log);
+
+  // MeshSampled mode: spacing from -mesh_density, the other cloud, or the meshes' size.
+  for (Input* m : {&a, &b})
+  {
+    if (m->kind != InputKind::Mesh)
+      continue;
+    const Input& other = (m == &a) ? b : a;
+    if (o.mesh_spacing)
+      sampleInput (*m, *o.mesh_spacing, "-mesh_density", log);
+    else if (other.kind == InputKind::Cloud)
+      sampleInput (*m, medianSpacing (*other.cloud), "median nearest-neighbour spacing of '" + other.path + "'", log);
+    else
+      sampleInput (*m, Defaults::mesh_spacing_fraction * std::max (meshDiagonal (a.mesh), meshDiagonal (b.mesh)),
+                   "both inputs are meshes: 1/100 of the larger bounding-box diagonal", log);
+  }
+
+  pcl_probcollision::ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (a.cloud);
+  pc.setTargetCloud (b.cloud);
+  pc.setKSearch (o.k);
+  if (a.kind == InputKind::Mesh)
+    pc.setInputCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (a.cloud->width, a.cloud->height));
+  else
+    pc.setInputNoise (noiseFor (o, o.sigma_a));
+  if (b.kind == InputKind::Mesh)
+    pc.setTargetCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (b.cloud->width, b.cloud->height));
+  else
+    pc.setTargetNoise (noiseFor (o, o.sigma_b));
+  pc.setRequest (requestFor (o));
+
+  Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));
+  // Summary lines on a terminal that also shows the progress: erase the progress first.
+  const bool shares_terminal = !o.json && ::isatty (STDOUT_FILENO);
+  for (std::size_t i = 0; i < poses.size (); ++i)
+  {
+    const Eigen::Isometry3d T = toIsometry (poses[i]);
+    pcl_probcollision::CollisionResult result;
+    const bool ok = pc.compute (T, result);
+    if (!ok || !result.ok () || shares_terminal)
+      progress.clear ();
+    if (!ok || !result.ok ())
+      throw Failure{kRuntimeFailure, (batch ? "pose " + std::to_string (i) + ": " : std::string ()) + "query failed: " +
+                                         (result.message.empty () ? std::string ("compute() returned false") : result.message)};
+
+    std::optional<double> write_ms;
+    std::size_t written = 0;
+    if (o.output)
+    {
+      const auto start = std::chrono::steady_clock::now ();
+      Cloud moved (*a.cloud);
+      for (auto& p : moved.points)
+        p.getVector3fMap () = (T.cast<float> () * p.getVector3fMap ());
+      std::vector<LabelledCloud> sides (2);
+      sides[0].cloud = &moved;
+      sides[0].probabilities = &result.probabilities_a;
+      sides[0].label = 0;
+      sides[1].cloud = b.cloud.get ();
+      sides[1].probabilities = &result.probabilities_b;
+      sides[1].label = 1;
+      const Eigen::Vector4f origin = b.kind == InputKind::Cloud ? b.cloud->sensor_origin_ : Eigen::Vector4f::Zero ();
+      const Eigen::Quaternionf orientation =
+          b.kind == InputKind::Cloud ? b.cloud->sensor_orientation_ : Eigen::Quaternionf::Identity ();
+      std::string error;
+      if (!writeResultCloud (*o.output, sides, o.free_below, o.collision_above, origin, orientation, written, error))
+        throw Failure{kRuntimeFailure, error};
+      write_ms = msSince (start);
+    }
+
+    const long long index = batch ? static_cast<long long> (i) : -1;
+    if (o.json)
+    {
+      std::fprintf (stdout, "%s\n", resultJson (o, a, b, result, poses[i], index, write_ms, written).c_str ());
+      std::fflush (stdout);
+    }
+    else
+    {
+      std::fprintf (human, "%s\n", humanLine (result, index).c_str ());
+      if (!batch)
+        std::fprintf (human, "%s\n", witnessLine (result).c_str ());
+      std::fflush (human);
+    }
+    if (o.output)
+      std::fprintf (log, "Writing %s [done, %.1f ms : %zu points, a then b, fields x y z intensity rgb label]\n",
+                    o.output->c_str (), *write_ms, written);
+    progress.show (i + 1);
+  }
+  progress.clear ();
+  return 0;
+}
+} // namespace
+} // namespace pcd_collision
+
+int
+main (int argc, char** argv)
+{
+  try
+  {
+    return pcd_collision::run (argc, argv);
+  }
+  catch (const pcd_collision::Failure& f)
+  {
+    std::fprintf (stderr, "pcd_collision: error: %s\n", f.message.c_str ());
+    return f.status;
+  }
+  catch (const pcl::PCLException& e)
+  {
+    // what() is "function in file @ line : description"; keep the description.
+    std::string message = e.what ();
+    const std::size_t sep = message.find (": ");
+    if (sep != std::string::npos)
+      message = message.substr (sep + 2);
+    std::fprintf (stderr, "pcd_collision: error: %s\n", message.c_str ());
+    return 1;
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf (stderr, "pcd_collision: error: %s\n", e.what ());
+    return 1;
+  }
+  catch (...)
+  {
+    std::fprintf (stderr, "pcd_collision: error: unknown exception\n");
+    return 1;
+  }
+}

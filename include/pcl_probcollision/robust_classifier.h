@@ -27,6 +27,13 @@ enum class TrainingMode
   Robust     ///< chance-constrained SVM with the gamma cap of METHOD.md 5.2
 };
 
+/** \brief Loss on the margin violation v of METHOD.md 5.3. */
+enum class Loss
+{
+  SquaredHinge,  ///< l(v) = max(0, v)^2 / 2, the L2-loss SVM (default)
+  Huber          ///< Huberised hinge of width h = 0.01: closer to the L1 hinge of (5.1)
+};
+
 /** \brief The model actually fitted for one problem. */
 enum class Rung
 {
@@ -63,11 +70,34 @@ struct ClassifierParams
   double ladder_depth_sigmas = 3.0;
   /** \brief Ladder: escalate when the fraction of misclassified points exceeds this, [0, 1). */
   double ladder_fraction = 0.0;
-  /** \brief Newton / L-BFGS iteration cap (>= 1). */
+  /** \brief Newton iteration cap of the linear rung (>= 1). The RFF rung runs L-BFGS, whose
+    * iterations are much cheaper and less effective; it gets 10 * max_iterations. */
   int max_iterations = 100;
+  /** \brief Loss on the margin violation (METHOD.md 5.3). */
+  Loss loss = Loss::SquaredHinge;
 
   /** \brief Throws pcl::BadArgumentException naming the first parameter out of range. */
   void validate () const;
+
+  /** \brief Field-wise equality (every field, loss included). */
+  bool operator== (const ClassifierParams& other) const;
+  bool operator!= (const ClassifierParams& other) const { return !(*this == other); }
+};
+
+/** \brief The separating function fitted by one classification, in a form that
+  * RobustClassifier::evaluate() can evaluate anywhere.
+  *
+  * With x' = scale * (x - centroid) + (0.5, 0.5, 0.5) the unit-cube coordinates of an input
+  * point x (Uniform scaling, METHOD.md 4), the function is f(x') = w^T x' + b (Linear) or
+  * f(x') = w^T phi(x') + b with phi the random Fourier feature map of D = weights.size ()
+  * features (RFF, RFFLarge). f > 0 on A's side. */
+struct SeparatorModel
+{
+  Rung rung = Rung::None;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  double scale = std::numeric_limits<double>::quiet_NaN ();  ///< 1 / (2 r_c), 1 when r_c = 0
+  Eigen::VectorXd weights;  ///< w: 3 entries (Linear) or D entries (RFF)
+  double bias = std::numeric_limits<double>::quiet_NaN ();  ///< b
 };
 
 /** \brief What one classification produced. Probabilities are per point, index-aligned with
@@ -94,6 +124,15 @@ struct ClassifierResult
   /** \brief Signed distance of the witness to the surface, first order, input units; positive
     * on its own side. */
   double witness_distance = std::numeric_limits<double>::quiet_NaN ();
+
+  /** \brief Points of the fitted rung on the wrong side by more than ladder_depth_sigmas of
+    * their own standard deviation along the gradient (any wrong-side point when that standard
+    * deviation is zero), plus points where the gradient collapsed (|grad f| < 1e-8). */
+  std::size_t misclassified = 0;
+  /** \brief Number of rungs fitted (1 unless the Ladder escalated). */
+  int rungs_tried = 0;
+  /** \brief The fitted function, for RobustClassifier::evaluate(). */
+  SeparatorModel separator;
 };
 
 /** \brief Chance-constrained (robust) SVM between two uncertain point sets and the per-point
@@ -101,7 +140,21 @@ struct ClassifierResult
   *
   * Points of A carry label +1, points of B label -1; f > 0 on A's side. The problem is
   * normalised into the unit cube with Uniform scaling first, so results are invariant under a
-  * common rigid motion and change of units.
+  * common rigid motion and change of units (exactly for Linear, in distribution for RFF).
+  *
+  * Training (METHOD.md 5.2-5.5): the Standard problem is solved first (damped Newton on (w, b)
+  * for the plane, L-BFGS with memory 10 on the D + 1 unknowns for RFF); for Robust training
+  * t_hat = min c_i f_i / s_i over the points with s_i > 0, gamma_eff = min(gamma, gamma_cap *
+  * max(0, t_hat)), and the problem is re-solved from the Standard solution when gamma_eff > 0.
+  * A collapsed Standard solution (|w| < 1e-8) has no t_hat: gamma_eff = 0.
+  *
+  * Ladder rule (METHOD.md 5.7): the plane is fitted first. A point is misclassified when
+  * c_i f(x_i) < -ladder_depth_sigmas * sqrt(g_i^T Sigma_i g_i) (with zero standard deviation
+  * along g_i: when it is on the wrong side at all, u_i < -1e-12), or when |g_i| < 1e-8. The
+  * ladder escalates to RFF with rff_features, then to rff_features_large, while the fit is
+  * degenerate (every gradient collapsed) or misclassifies more than ladder_fraction of all
+  * points. Of the rungs fitted it keeps the non-degenerate one with the fewest misclassified
+  * points; ties go to the simpler rung, and when every rung is degenerate the plane is kept.
   *
   * \note Thread safety: classify() is const and may run concurrently on one instance.
   */
@@ -121,6 +174,17 @@ public:
     * \return result.ok */
   bool classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result) const;
 
+  /** \brief Evaluates a fitted separator at an input-frame point.
+    * \param[in] model result.separator of a classify() call on this instance (RFF models use
+    *            this instance's random features)
+    * \param[in] x a point in the frame of the inputs
+    * \param[out] gradient if not null, the gradient of the returned value with respect to x
+    *            (input units; its direction is that of the unit-cube gradient)
+    * \return f at x, in the unit-cube scale of the problem (positive on A's side); NaN when
+    *         the model is empty or does not belong to this instance */
+  double evaluate (const SeparatorModel& model, const Eigen::Vector3d& x,
+                   Eigen::Vector3d* gradient = nullptr) const;
+
 private:
   ClassifierParams params_;
   // Random Fourier feature draws in unit-cube coordinates, rows of Omega and phases beta,
@@ -131,6 +195,7 @@ private:
 
 /** \brief Standard normal CDF, Phi(z) = erfc(-z / sqrt 2) / 2, accurate in both tails. */
 double normalCdf (double z);
-/** \brief Inverse of normalCdf for p in (0, 1). */
+/** \brief Inverse of normalCdf for p in (0, 1): Acklam's rational approximation refined by one
+  * Halley step on erfc (relative error ~1e-15). Returns -inf at 0, +inf at 1, NaN outside. */
 double normalQuantile (double p);
 } // namespace pcl_probcollision

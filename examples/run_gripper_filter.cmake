@@ -1,0 +1,21 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Runs the example on a scan and checks that it succeeds and writes a non-empty cloud.
+# cmake -DEXE=... -DSCAN=... -DOUT=... -P run_gripper_filter.cmake
+file(REMOVE "${OUT}")
+execute_process(COMMAND "${EXE}" "${SCAN}" "${OUT}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "${out}${err}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "gripper_filter exited with ${rc}")
+endif()
+if(NOT EXISTS "${OUT}")
+  message(FATAL_ERROR "gripper_filter wrote no ${OUT}")
+endif()
+file(STRINGS "${OUT}" points REGEX "^POINTS [0-9]+$" LIMIT_COUNT 1)
+string(REGEX REPLACE "^POINTS " "" points "${points}")
+if(NOT points GREATER 0)
+  message(FATAL_ERROR "${OUT} has no points ('${points}')")
+endif()
+if(EXISTS "${OUT}.tmp")
+  message(FATAL_ERROR "temporary file ${OUT}.tmp left behind")
+endif()
+message(STATUS "${OUT}: ${points} points")

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/robust_classifier.h>
+
+#include <cstdint>
+
+namespace pcl_probcollision
+{
+/** \brief How the traversal treats node pairs whose boxes are disjoint (METHOD.md 8.5). */
+enum class TraversalMode
+{
+  /** \brief Deterministic (default): a disjoint pair multiplies the reach weight rho by
+    * q = 1 - Pcov(a) Pcov(b) and is pruned once rho < rho_min; a leaf pair contributes
+    * rho * P_leaf. */
+  ExpectedWeight,
+  /** \brief A disjoint pair is opened when u < q, u drawn from a generator seeded with `seed`:
+    * the same inputs and seed give the same result. */
+  Stochastic,
+  /** \brief No leakage: boxes grown to expanded_k_sigma point standard deviations and only
+    * overlapping pairs opened (the reference code's inflated boxes). Deterministic. */
+  ExpandedBV
+};
+
+/** \brief What a collision query computes and how. Every member has a documented default;
+  * validate() throws pcl::BadArgumentException naming the first member out of range.
+  *
+  * Verdict thresholds are on the collision probability P (METHOD.md 7 states them on
+  * 1 - P as A = 1 - free_below and B = 1 - collision_above): P < free_below is Free,
+  * P > collision_above is InCollision, anything between is InContact.
+  */
+struct CollisionRequest
+{
+  /** \brief Below this P the pair is Free; [0, 0.5]. Default 0.1 (METHOD.md 7, A = 0.9). */
+  double free_below = 0.1;
+  /** \brief Above this P the pair is InCollision; [0.5, 1], >= free_below. Default 0.9. */
+  double collision_above = 0.9;
+  /** \brief false (default): stop as soon as a leaf pair's contribution exceeds
+    * collision_above (the verdict is then final and P a lower bound). true: visit every leaf
+    * pair the traversal reaches, e.g. to get every point's probability. */
+  bool exhaustive = false;
+  /** \brief Fill per-point probabilities in the result (implies nothing about exhaustive). */
+  bool per_point = false;
+  /** \brief Fill the timings of the result. */
+  bool enable_timings = false;
+
+  TraversalMode traversal = TraversalMode::ExpectedWeight;
+  /** \brief ExpectedWeight: prune once the reach weight falls below this; [0, 1]. Default 1e-3. */
+  double rho_min = 1e-3;
+  /** \brief Seed of the Stochastic traversal. Default 1. */
+  std::uint64_t seed = 1;
+  /** \brief ExpandedBV: box growth in point standard deviations, >= 0. Default 3. */
+  double expanded_k_sigma = 3.0;
+
+  /** \brief The separator fitted at each leaf pair (Ladder, Robust, kappa = 0.9, C = 10). */
+  ClassifierParams classifier;
+  /** \brief The hierarchy built for each cloud (PCA split, n_max 20, sigma_max 0.05,
+    * epsilon 0.02, k_sigma 1). */
+  BVHParams hierarchy;
+
+  void validate () const;
+  bool operator== (const CollisionRequest& o) const;
+  bool operator!= (const CollisionRequest& o) const { return !(*this == o); }
+};
+} // namespace pcl_probcollision

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace pcl_probcollision
+{
+/** \brief The three-way decision of METHOD.md 7. */
+enum class Verdict
+{
+  Unknown,     ///< not computed (the query failed)
+  Free,        ///< P < free_below
+  InContact,   ///< free_below <= P <= collision_above: touching or too noisy to tell
+  InCollision  ///< P > collision_above
+};
+
+/** \brief "free", "contact", "collision" or "unknown". */
+const char* verdictName (Verdict verdict);
+
+/** \brief Outcome of a query. Anything not computed is NaN (numbers) or Unknown. */
+struct CollisionResult
+{
+  enum class Status
+  {
+    Ok,
+    InvalidInput,     ///< see message: no cloud, no finite point, non-finite pose, ...
+    NumericalFailure  ///< see message: a classifier produced no usable separator
+  };
+  Status status = Status::InvalidInput;
+  std::string message;
+
+  Verdict verdict = Verdict::Unknown;
+  /** \brief P(A, B) in [0, 1]: the largest reach-weighted leaf-pair probability. */
+  double probability = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
+    * InCollision and final). */
+  bool lower_bound = false;
+  /** \brief True when no leaf pair was reached: the boxes never came near (P = 0). */
+  bool no_leaf_tested = false;
+
+  /** \brief The point attaining P: side +1 = input (A), -1 = target (B), 0 = none. */
+  int witness_side = 0;
+  /** \brief Its index in its own input cloud (-1 when none). */
+  int witness_index = -1;
+  /** \brief Its position and the separator's unit normal there (pointing toward A's side),
+    * both in the target's (B's) frame, where the pose puts A. */
+  Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+
+  // Counters.
+  std::size_t points_a = 0;                  ///< finite points of A used
+  std::size_t points_b = 0;                  ///< finite points of B used
+  std::size_t points_skipped_nonfinite = 0;  ///< NaN / Inf points skipped, both clouds
+  std::size_t bv_tests = 0;                  ///< node pairs tested
+  std::size_t leaf_pairs_tested = 0;         ///< classifiers fitted
+  std::size_t kernel_leaf_pairs = 0;         ///< of which needed an RFF rung
+  std::size_t degenerate_leaf_pairs = 0;     ///< of which had no separating direction
+  std::size_t classifier_iterations = 0;     ///< solver iterations, all leaf pairs
+
+  /** \brief Milliseconds; NaN unless request.enable_timings. build covers covariance
+    * estimation and hierarchies (0 when they were reused), query the traversal. */
+  double build_ms = std::numeric_limits<double>::quiet_NaN ();
+  double query_ms = std::numeric_limits<double>::quiet_NaN ();
+
+  /** \brief Per-point P_i when request.per_point, index-aligned with each input cloud (its
+    * full size, not its indices); the maximum over the leaf pairs a point took part in. NaN
+    * for points that were not used (non-finite, outside the indices) or that no tested leaf
+    * pair contained (the traversal never came near them). */
+  std::vector<float> probabilities_a;
+  std::vector<float> probabilities_b;
+
+  bool ok () const { return status == Status::Ok; }
+};
+} // namespace pcl_probcollision

@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The linear rung (METHOD.md 5.3): damped Newton on theta = (w, b) in R^4 for
+//   J = |w|^2 / 2 + eta_b b^2 / 2 + sum_i C_i l(v_i),
+//   v_i = 1 - c_i (w^T x_i + b) + gamma sqrt(w^T Sigma_i w + eps_s^2).
+// Internal: not API.
+#pragma once
+
+#include <pcl_probcollision/detail/kernels.h>
+#include <pcl_probcollision/detail/separator_problem.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief Damped Newton for the 4 unknowns of the plane. Keeps its work arrays between calls,
+  * so one instance solves the Standard and the Robust problem without reallocating. */
+class LinearSeparatorSolver
+{
+public:
+  LinearSeparatorSolver (const SeparatorProblem& problem, const MarginLoss& loss)
+    : p_ (problem), loss_ (loss), v_ (problem.n), s_ (problem.n), v_trial_ (problem.n),
+      s_trial_ (problem.n)
+  {
+    points_ = LinearPoints{static_cast<std::size_t> (p_.n), p_.x.data (), p_.y.data (), p_.z.data (),
+                           p_.sxx.data (), p_.sxy.data (), p_.sxz.data (), p_.syy.data (), p_.syz.data (),
+                           p_.szz.data (), p_.label.data (), p_.weight.data ()};
+  }
+
+  /** \brief The start of METHOD.md 5.3: f(m_+) = 1, f(m_-) = -1 with m_+- the class means;
+    * theta = 0 when the means coincide or when that start is worse than theta = 0 (means
+    * that nearly coincide would give an enormous w). */
+  Eigen::Vector4d
+  start ()
+  {
+    const Eigen::Index n = p_.n, na = p_.n_a, nb = n - na;
+    const Eigen::Vector3d mp (p_.x.head (na).mean (), p_.y.head (na).mean (), p_.z.head (na).mean ());
+    const Eigen::Vector3d mm (p_.x.tail (nb).mean (), p_.y.tail (nb).mean (), p_.z.tail (nb).mean ());
+    const Eigen::Vector3d d = mp - mm;
+    Eigen::Vector4d zero = Eigen::Vector4d::Zero ();
+    if (d.squaredNorm () == 0.0)
+      return zero;
+    Eigen::Vector4d theta;
+    theta.head<3> () = 2.0 * d / d.squaredNorm ();
+    theta (3) = -theta.head<3> ().dot (0.5 * (mp + mm));
+    if (!theta.allFinite () || objective (theta, 0.0, v_, s_) > objective (zero, 0.0, v_, s_))
+      return zero;
+    return theta;
+  }
+
+  /** \brief J at theta; fills v and s (s_i = sqrt(w^T Sigma_i w + eps_s^2), only when gamma > 0). */
+  double
+  objective (const Eigen::Vector4d& theta, double gamma, Eigen::ArrayXd& v, Eigen::ArrayXd& s) const
+  {
+    const double data = linearLoss (points_, theta.data (), gamma, loss_.huber ? loss_.width : 0.0,
+                                    kSigmaFloor, v.data (), s.data ());
+    return 0.5 * theta.head<3> ().squaredNorm () + 0.5 * kBiasRidge * theta (3) * theta (3) + data;
+  }
+
+  /** \brief Minimises J from theta (in/out).
+    * Stops when |grad J| <= 1e-10 max(1, |J|) (converged), when an accepted step is shorter
+    * than 1e-12 (converged: no representable progress left), when the line search cannot
+    * decrease J (not converged unless the gradient test holds) or after max_iterations. */
+  SolverReport
+  solve (Eigen::Vector4d& theta, double gamma, int max_iterations)
+  {
+    SolverReport report;
+    double value = objective (theta, gamma, v_, s_);
+    for (;;)
+    {
+      Eigen::Vector4d gradient;
+      Eigen::Matrix4d hessian;
+      derivatives (theta, gamma, gradient, hessian);
+      if (gradient.norm () <= 1e-10 * std::max (1.0, std::abs (value)))
+      {
+        report.converged = true;
+        break;
+      }
+      if (report.iterations >= max_iterations)
+        break;
+      // Cholesky of H, with lambda I (1e-10, x10) when it fails
+      Eigen::LLT<Eigen::Matrix4d> llt (hessian);
+      double lambda = 1e-10;
+      while (llt.info () != Eigen::Success && lambda < 1e10)
+      {
+        llt.compute (hessian + lambda * Eigen::Matrix4d::Identity ());
+        lambda *= 10.0;
+      }
+      const Eigen::Vector4d step = llt.solve (-gradient);
+      const double slope = gradient.dot (step);
+      if (!(slope < 0.0))
+        break;
+      // Armijo backtracking, c = 1e-4, halving (at most 60 times: t >= 2^-60)
+      double t = 1.0, trial_value = 0.0;
+      bool accepted = false;
+      for (int halvings = 0; halvings <= 60; ++halvings)
+      {
+        trial_value = objective (theta + t * step, gamma, v_trial_, s_trial_);
+        if (trial_value <= value + 1e-4 * t * slope)
+        {
+          accepted = true;
+          break;
+        }
+        t *= 0.5;
+      }
+      if (!accepted)
+        break;
+      theta += t * step;
+      value = trial_value;
+      v_.swap (v_trial_);
+      s_.swap (s_trial_);
+      ++report.iterations;
+      if (t * step.norm () < 1e-12)
+      {
+        report.converged = true;
+        break;
+      }
+    }
+    report.objective = value;
+    return report;
+  }
+
+private:
+  /** \brief Gradient and generalised Hessian at theta, from the v_ and s_ of theta. */
+  void
+  derivatives (const Eigen::Vector4d& theta, double gamma, Eigen::Vector4d& gradient,
+               Eigen::Matrix4d& hessian) const
+  {
+    double t[20];
+    linearDerivatives (points_, theta.data (), gamma, loss_.huber ? loss_.width : 0.0, v_.data (),
+                       s_.data (), t);
+    const double* g = t;
+    const double* h = t + 4;
+    const double* r = t + 14;
+    gradient << theta (0) + g[0], theta (1) + g[1], theta (2) + g[2], kBiasRidge * theta (3) + g[3];
+    hessian << 1.0 + h[0] + r[0], h[1] + r[1], h[2] + r[2], h[3],
+               0.0, 1.0 + h[4] + r[3], h[5] + r[4], h[6],
+               0.0, 0.0, 1.0 + h[7] + r[5], h[8],
+               0.0, 0.0, 0.0, kBiasRidge + h[9];
+    hessian.triangularView<Eigen::StrictlyLower> () = hessian.triangularView<Eigen::StrictlyUpper> ().transpose ();
+  }
+
+  const SeparatorProblem& p_;
+  MarginLoss loss_;
+  LinearPoints points_;
+  Eigen::ArrayXd v_, s_, v_trial_, s_trial_;
+};
+} // namespace detail
+} // namespace pcl_probcollision

@@ -1,0 +1,256 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/uncertain_points.h>
+#include <pcl_probcollision/detail/leakage.h>
+#include <pcl_probcollision/detail/obb.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace pcl_probcollision
+{
+/** \brief Parameters of the epsilon-overlap hierarchy, with their defaults (METHOD.md 8.7). */
+struct BVHParams
+{
+  /** \brief How a node is divided (METHOD.md 8.1). */
+  enum class SplitStyle
+  {
+    Pca,    ///< two children along the longest principal axis e3, at the mean projection
+    Octree  ///< up to eight children on the node's principal axes, at the mean; empty cells dropped
+  };
+  /** \brief How the per-axis slab probabilities combine into a point's outside probability. */
+  using LeakageBound = detail::LeakageBound;
+
+  /** \brief Split style; Pca by default. */
+  SplitStyle split_style = SplitStyle::Pca;
+  /** \brief A node with more points than n_max is split (>= 1). */
+  int n_max = 20;
+  /** \brief A node with at most n_min points is never split, whatever its variation
+    * (1 <= n_min <= n_max). */
+  int n_min = 8;
+  /** \brief A node whose variation lambda_1 / (lambda_1 + lambda_2 + lambda_3) exceeds this is
+    * split (dimensionless, >= 0; values >= 1/3 disable the variation rule). */
+  double sigma_max = 0.05;
+  /** \brief Sibling overlap as a fraction of the parent's extent L along the split axis:
+    * left = {p <= s + epsilon L}, right = {p >= s - epsilon L} (dimensionless, [0, 0.5)). */
+  double epsilon = 0.02;
+  /** \brief Box inflation in point standard deviations along each box axis (>= 0). */
+  double k_sigma = 1.0;
+  /** \brief MinSlab (default, METHOD.md 8.4) or the UnionBound variant. */
+  LeakageBound leakage_bound = LeakageBound::MinSlab;
+
+  /** \brief Throws pcl::BadArgumentException naming the first parameter out of range and its
+    * value. */
+  void validate () const;
+
+  /** \brief Member-wise equality. */
+  bool operator== (const BVHParams& o) const
+  {
+    return split_style == o.split_style && n_max == o.n_max && n_min == o.n_min &&
+           sigma_max == o.sigma_max && epsilon == o.epsilon && k_sigma == o.k_sigma &&
+           leakage_bound == o.leakage_bound;
+  }
+  /** \brief Member-wise inequality. */
+  bool operator!= (const BVHParams& o) const { return !(*this == o); }
+};
+
+/** \brief Epsilon-overlap bounding-volume hierarchy over uncertain points, with per-node
+  * leakage and coverage probabilities (Pan, Chitta and Manocha 2011, thesis Sec. 7.5;
+  * METHOD.md 8.1 - 8.4). Build once per cloud, query many times under rigid motion.
+  *
+  * Construction is top-down on the point means. Each node gets an oriented box with axes
+  * (e3, e2, e1) of its own points' covariance, inflated by k_sigma point standard deviations,
+  * and the area-weighted mean probability that its points lie outside that box (leakage).
+  * Siblings overlap by epsilon times the parent's extent, so points near a split are stored in
+  * both children; storedPoints() counts them with this duplication.
+  *
+  * Everything is expressed in the cloud's own frame; the traversal
+  * (detail/bvh_traversal.h) maps the boxes of one hierarchy into the other's frame on the fly.
+  *
+  * \note Thread safety: all const methods may run concurrently on one instance (traversals
+  * share hierarchies). build() and clear() must not run concurrently with anything else on the
+  * same instance.
+  */
+class ProbabilisticBVH
+{
+public:
+  /** \brief Shared pointer to a hierarchy. */
+  using Ptr = std::shared_ptr<ProbabilisticBVH>;
+  /** \brief Shared pointer to a const hierarchy (what concurrent queries share). */
+  using ConstPtr = std::shared_ptr<const ProbabilisticBVH>;
+
+  /** \brief Why a node is a leaf. */
+  enum class LeafReason : std::uint8_t
+  {
+    NotLeaf,    ///< internal node
+    StopRule,   ///< m <= n_max and variation <= sigma_max
+    MinSize,    ///< the stop rule failed but m <= n_min
+    NoProgress  ///< a split was wanted but could not separate the points (METHOD.md 8.2 guard)
+  };
+
+  /** \brief One node. Children of a node are stored contiguously. */
+  struct Node
+  {
+    /** \brief Inflated oriented box in the cloud's frame (metres). */
+    detail::OrientedBox box;
+    /** \brief P_leak: area-weighted mean over the node's points of the probability of lying
+      * outside box (METHOD.md 8.4), in [0, 1]. */
+    double leakage = 0.0;
+    /** \brief Per box axis, the largest point standard deviation sqrt(a^T Sigma a) (metres);
+      * lets a traversal inflate the box further (ExpandedBV). */
+    Eigen::Vector3f max_sigma = Eigen::Vector3f::Zero ();
+    /** \brief Variation sigma_n = lambda_1 / (lambda_1 + lambda_2 + lambda_3) of the node's
+      * means, in [0, 1/3]; 0 when all means coincide. */
+    float variation = 0.0f;
+    /** \brief Id of the first child, -1 for a leaf. */
+    std::int32_t first_child = -1;
+    /** \brief Start of the range [begin, end) into pointIndices(): for a leaf its points, for
+      * an internal node the concatenation of its leaves' points (with duplicates). */
+    std::int32_t begin = 0;
+    /** \brief End of the range [begin, end) into pointIndices(). */
+    std::int32_t end = 0;
+    /** \brief Number of distinct points of the node (m). */
+    std::int32_t num_points = 0;
+    /** \brief Depth below the root (root = 0). */
+    std::int32_t depth = 0;
+    /** \brief Number of children: 0 (leaf), 2 (Pca) or 1..8 (Octree). */
+    std::uint8_t num_children = 0;
+    /** \brief Why the node is a leaf, NotLeaf for internal nodes. */
+    LeafReason leaf_reason = LeafReason::NotLeaf;
+
+    /** \brief True for a leaf. */
+    bool isLeaf () const { return num_children == 0; }
+    /** \brief P_cov = 1 - P_leak (METHOD.md 8.4). */
+    double coverage () const { return 1.0 - leakage; }
+  };
+
+  /** \brief A read-only range of point indices (into cloud()). */
+  struct IndexSpan
+  {
+    /** \brief First index (into pointIndices()). */
+    const int* data = nullptr;
+    /** \brief Number of indices. */
+    std::size_t size = 0;
+    /** \brief Iterator to the first index. */
+    const int* begin () const { return data; }
+    /** \brief Iterator past the last index. */
+    const int* end () const { return data + size; }
+    /** \brief The i-th point index (unchecked). */
+    int operator[] (std::size_t i) const { return data[i]; }
+  };
+
+  /** \brief An empty hierarchy. */
+  ProbabilisticBVH () = default;
+
+  /** \brief Builds at construction; see build(). */
+  explicit ProbabilisticBVH (const UncertainCloud& cloud, const BVHParams& params = BVHParams ())
+  {
+    build (cloud, params);
+  }
+
+  /** \brief Builds the hierarchy over a copy of cloud, replacing any previous one.
+    * \param[in] cloud points with covariances in one frame (metres, square metres); its
+    *            area_weights (empty = equal weights) weight the leakage; it is copied.
+    * \param[in] params construction parameters
+    * \return true when a hierarchy was built; false for an empty cloud, which leaves an empty
+    *         hierarchy (empty() == true, no nodes).
+    * \throws pcl::BadArgumentException for invalid params, sizes that disagree (covariances,
+    *         non-empty area_weights or source_indices not matching means), a non-finite mean
+    *         or covariance, a negative or non-finite area weight, or more than 2^28 points.
+    *         On throw the previous hierarchy is left untouched. */
+  bool build (const UncertainCloud& cloud, const BVHParams& params = BVHParams ());
+
+  /** \brief As build(const UncertainCloud&, const BVHParams&), but takes the cloud over
+    * instead of copying it. The cloud is moved from only after validation succeeds; on throw
+    * it is left untouched. */
+  bool build (UncertainCloud&& cloud, const BVHParams& params = BVHParams ());
+
+  /** \brief Drops the hierarchy and the stored cloud. */
+  void clear ();
+
+  /** \brief True when there is no hierarchy (never built, cleared, or built from no points). */
+  bool empty () const { return nodes_.empty (); }
+
+  /** \brief Number of distinct points (the size of the stored cloud). */
+  std::size_t size () const { return cloud_.size (); }
+
+  /** \brief All nodes; the root is nodes()[0] when not empty. */
+  const std::vector<Node>& nodes () const { return nodes_; }
+
+  /** \brief Node by id, 0 <= id < nodes().size() (unchecked). */
+  const Node& node (std::int32_t id) const { return nodes_[static_cast<std::size_t> (id)]; }
+
+  /** \brief Id of the root node. */
+  static constexpr std::int32_t rootId () { return 0; }
+
+  /** \brief The flat index array: leaves' point indices (into cloud()), leaves in depth-first
+    * order, ascending within a leaf. Its length is storedPoints(). */
+  const std::vector<int>& pointIndices () const { return indices_; }
+
+  /** \brief The point indices of a node (duplicates included for internal nodes). */
+  IndexSpan indices (const Node& node) const;
+
+  /** \brief Points stored in the leaves, counted with duplication (>= size()). */
+  std::size_t storedPoints () const { return indices_.size (); }
+
+  /** \brief Number of leaves. */
+  std::size_t leafCount () const { return leaf_count_; }
+
+  /** \brief Number of levels: 0 when empty, 1 for a single leaf. */
+  int depth () const { return depth_; }
+
+  /** \brief Memory held by this object in bytes: the stored cloud (means, covariances, weights,
+    * source indices), the nodes and the index array, by capacity. */
+  std::size_t bytes () const;
+
+  /** \brief Wall time of the hierarchy construction in the last build() (milliseconds;
+    * input validation and the copy of a const cloud excluded). */
+  double buildMilliseconds () const { return build_milliseconds_; }
+
+  /** \brief The stored copy of the cloud, in its own frame. */
+  const UncertainCloud& cloud () const { return cloud_; }
+
+  /** \brief The parameters of the last successful build(). */
+  const BVHParams& params () const { return params_; }
+
+  /** \brief Copies a node's points into caller-provided buffers in the cloud's own frame.
+    * The buffers are resized to the node's point count (capacity is reused).
+    * \param[in] node a node of this hierarchy (normally a leaf)
+    * \param[out] means point means (metres)
+    * \param[out] covariances point covariances (square metres)
+    * \return a view over the buffers
+    * \throws pcl::BadArgumentException when node's range lies outside pointIndices() */
+  PointSetView gatherPoints (const Node& node, std::vector<Eigen::Vector3d>& means,
+                             std::vector<Eigen::Matrix3d>& covariances) const;
+
+  /** \brief Copies a node's points into caller-provided buffers, mapped into another frame:
+    * means x -> T_dst_src x, covariances Sigma -> R Sigma R^T (R = T_dst_src.linear()),
+    * symmetrised. For the leaf test of B in A's frame pass T_a_b.
+    * \param[in] node a node of this hierarchy (normally a leaf)
+    * \param[in] T_dst_src rigid transform from this cloud's frame to the destination frame
+    * \param[out] means transformed means (metres)
+    * \param[out] covariances transformed covariances (square metres)
+    * \return a view over the buffers
+    * \throws pcl::BadArgumentException when node's range lies outside pointIndices() */
+  PointSetView gatherPoints (const Node& node, const Eigen::Isometry3d& T_dst_src,
+                             std::vector<Eigen::Vector3d>& means,
+                             std::vector<Eigen::Matrix3d>& covariances) const;
+
+private:
+  bool buildValidated (UncertainCloud&& cloud, const BVHParams& params);
+
+  UncertainCloud cloud_;
+  BVHParams params_;
+  std::vector<Node> nodes_;
+  std::vector<int> indices_;
+  std::size_t leaf_count_ = 0;
+  int depth_ = 0;
+  double build_milliseconds_ = 0.0;
+};
+} // namespace pcl_probcollision

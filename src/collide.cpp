@@ -1,0 +1,189 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/detail/bvh_traversal.h>
+
+#include <pcl/exceptions.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace
+{
+constexpr float kNotReached = std::numeric_limits<float>::quiet_NaN ();
+
+void
+fail (CollisionResult& result, CollisionResult::Status status, const std::string& message)
+{
+  result.status = status;
+  result.message = message;
+  result.verdict = Verdict::Unknown;
+  result.probability = std::numeric_limits<double>::quiet_NaN ();
+}
+
+// Keeps the larger of a stored per-point value and a new one; NaN means "not reached yet".
+void
+keepMax (float& slot, double value)
+{
+  const float v = static_cast<float> (value);
+  if (std::isnan (slot) || v > slot)
+    slot = v;
+}
+
+detail::TraversalParams
+traversalParams (const CollisionRequest& request)
+{
+  detail::TraversalParams p;
+  switch (request.traversal)
+  {
+    case TraversalMode::ExpectedWeight: p.mode = detail::TraversalMode::ExpectedWeight; break;
+    case TraversalMode::Stochastic: p.mode = detail::TraversalMode::Stochastic; break;
+    case TraversalMode::ExpandedBV: p.mode = detail::TraversalMode::ExpandedBV; break;
+  }
+  p.rho_min = request.rho_min;
+  p.seed = request.seed;
+  p.expanded_k_sigma = request.expanded_k_sigma;
+  p.exhaustive = request.exhaustive;
+  // In decision mode a contribution above collision_above makes InCollision final (METHOD.md 7).
+  p.stop_probability = request.collision_above;
+  return p;
+}
+} // namespace
+
+Verdict
+verdictFor (double probability, const CollisionRequest& request)
+{
+  if (std::isnan (probability))
+    return Verdict::Unknown;
+  if (probability < request.free_below)
+    return Verdict::Free;
+  if (probability > request.collision_above)
+    return Verdict::InCollision;
+  return Verdict::InContact;
+}
+
+bool
+collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
+         const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
+{
+  const auto start = std::chrono::steady_clock::now ();
+  result = CollisionResult ();
+  try
+  {
+    request.validate ();
+  }
+  catch (const pcl::PCLException& e)
+  {
+    fail (result, CollisionResult::Status::InvalidInput, e.what ());
+    return false;
+  }
+  if (a.empty () || b.empty ())
+  {
+    fail (result, CollisionResult::Status::InvalidInput,
+          a.empty () ? "hierarchy A is empty (no finite point)" : "hierarchy B is empty (no finite point)");
+    return false;
+  }
+  if (!T_a_b.matrix ().allFinite ())
+  {
+    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b is not finite");
+    return false;
+  }
+  const Eigen::Matrix3d R = T_a_b.linear ();
+  if (!(R.transpose () * R).isIdentity (1e-6) || R.determinant () < 0.0)
+  {
+    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b is not a rotation plus translation");
+    return false;
+  }
+
+  // The caller's classifier carries the random-feature draw; without one, draw it here.
+  std::optional<RobustClassifier> own;
+  if (!classifier)
+    classifier = &own.emplace (request.classifier);
+
+  result.points_a = a.size ();
+  result.points_b = b.size ();
+  if (request.per_point)
+  {
+    result.probabilities_a.assign (a.size (), kNotReached);
+    result.probabilities_b.assign (b.size (), kNotReached);
+  }
+
+  std::vector<Eigen::Vector3d> means_a, means_b;
+  std::vector<Eigen::Matrix3d> covs_a, covs_b;
+  ClassifierResult leaf;
+  double best = -1.0;
+  std::string failure;
+  auto leaf_test = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
+    const PointSetView view_a = a.gatherPoints (leaf_a, means_a, covs_a);
+    const PointSetView view_b = b.gatherPoints (leaf_b, T_a_b, means_b, covs_b);
+    if (!classifier->classify (view_a, view_b, leaf))
+    {
+      if (failure.empty ())
+        failure = leaf.message;
+      return std::numeric_limits<double>::quiet_NaN ();
+    }
+    ++result.leaf_pairs_tested;
+    result.classifier_iterations += static_cast<std::size_t> (leaf.iterations);
+    result.kernel_leaf_pairs += leaf.rung == Rung::RFF || leaf.rung == Rung::RFFLarge ? 1 : 0;
+    result.degenerate_leaf_pairs += leaf.degenerate ? 1 : 0;
+    const auto span_a = a.indices (leaf_a);
+    const auto span_b = b.indices (leaf_b);
+    if (request.per_point)
+    {
+      for (std::size_t i = 0; i < span_a.size; ++i)
+        keepMax (result.probabilities_a[span_a[i]], rho * leaf.probabilities_a[i]);
+      for (std::size_t j = 0; j < span_b.size; ++j)
+        keepMax (result.probabilities_b[span_b[j]], rho * leaf.probabilities_b[j]);
+    }
+    const double contribution = rho * leaf.probability;
+    if (contribution > best)
+    {
+      best = contribution;
+      const bool on_a = leaf.witness_side > 0;
+      const int local = on_a ? span_a[leaf.witness_index] : span_b[leaf.witness_index];
+      const UncertainCloud& cloud = on_a ? a.cloud () : b.cloud ();
+      result.witness_side = on_a ? 1 : -1;
+      result.witness_index = cloud.source_indices.empty () ? local : cloud.source_indices[local];
+      result.witness_point = on_a ? means_a[leaf.witness_index] : means_b[leaf.witness_index];
+      result.witness_normal = leaf.witness_normal;
+    }
+    return leaf.probability;
+  };
+
+  detail::TraversalResult traversal;
+  try
+  {
+    traversal = detail::traverseHierarchies (a, b, T_a_b, traversalParams (request), leaf_test);
+  }
+  catch (const pcl::PCLException& e)
+  {
+    fail (result, CollisionResult::Status::InvalidInput, e.what ());
+    return false;
+  }
+  result.bv_tests = traversal.node_pairs_tested;
+  if (traversal.invalid_leaf_results > 0)
+  {
+    // A leaf pair without a usable separator would make the maximum a guess: report it.
+    fail (result, CollisionResult::Status::NumericalFailure,
+          "classifier failed on " + std::to_string (traversal.invalid_leaf_results) + " leaf pair(s): " + failure);
+    return false;
+  }
+  result.status = CollisionResult::Status::Ok;
+  result.probability = traversal.probability;
+  result.lower_bound = traversal.lower_bound;
+  result.no_leaf_tested = traversal.no_leaf_tested;
+  if (result.no_leaf_tested)
+  {
+    result.witness_side = 0;
+    result.witness_index = -1;
+  }
+  result.verdict = verdictFor (result.probability, request);
+  if (request.enable_timings)
+    result.query_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+  return true;
+}
+} // namespace pcl_probcollision

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/collision_request.h>
+#include <pcl_probcollision/collision_result.h>
+
+#include <pcl/exceptions.h>
+
+#include <cmath>
+
+namespace pcl_probcollision
+{
+void
+CollisionRequest::validate () const
+{
+  const char* where = "[pcl_probcollision::CollisionRequest::validate] ";
+  if (!(free_below >= 0.0 && free_below <= 0.5))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "free_below " << free_below << " outside [0, 0.5]");
+  if (!(collision_above >= 0.5 && collision_above <= 1.0))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         where << "collision_above " << collision_above << " outside [0.5, 1]");
+  if (!(rho_min >= 0.0 && rho_min <= 1.0))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "rho_min " << rho_min << " outside [0, 1]");
+  if (!(expanded_k_sigma >= 0.0 && std::isfinite (expanded_k_sigma)))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         where << "expanded_k_sigma " << expanded_k_sigma << " must be finite and >= 0");
+  if (traversal != TraversalMode::ExpectedWeight && traversal != TraversalMode::Stochastic &&
+      traversal != TraversalMode::ExpandedBV)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "traversal mode " << static_cast<int> (traversal) << " is unknown");
+  classifier.validate ();
+  hierarchy.validate ();
+}
+
+bool
+CollisionRequest::operator== (const CollisionRequest& o) const
+{
+  const ClassifierParams& c = classifier;
+  const ClassifierParams& d = o.classifier;
+  const bool same_classifier = c.kernel == d.kernel && c.training == d.training &&
+                               c.confidence == d.confidence && c.gamma_cap == d.gamma_cap && c.C == d.C &&
+                               c.rbf_gamma == d.rbf_gamma && c.rff_features == d.rff_features &&
+                               c.rff_features_large == d.rff_features_large && c.rff_seed == d.rff_seed &&
+                               c.ladder_depth_sigmas == d.ladder_depth_sigmas &&
+                               c.ladder_fraction == d.ladder_fraction && c.max_iterations == d.max_iterations;
+  return free_below == o.free_below && collision_above == o.collision_above && exhaustive == o.exhaustive &&
+         per_point == o.per_point && enable_timings == o.enable_timings && traversal == o.traversal &&
+         rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && same_classifier &&
+         hierarchy == o.hierarchy;
+}
+
+const char*
+verdictName (Verdict verdict)
+{
+  switch (verdict)
+  {
+    case Verdict::Free: return "free";
+    case Verdict::InContact: return "contact";
+    case Verdict::InCollision: return "collision";
+    case Verdict::Unknown: break;
+  }
+  return "unknown";
+}
+} // namespace pcl_probcollision

@@ -1,0 +1,206 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The command-line parser of pcd_collision on its own (tools/cli_options.h): no files, no PCL.
+
+#include "cli_options.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+using namespace pcd_collision;
+using Kind = ParseResult::Kind;
+
+namespace
+{
+ParseResult
+parse (std::vector<std::string> extra, bool with_inputs = true)
+{
+  std::vector<std::string> args;
+  if (with_inputs)
+    args = {"a.pcd", "b.obj"};
+  args.insert (args.end (), extra.begin (), extra.end ());
+  return parseCommandLine (args);
+}
+
+void
+expectUsageError (const std::vector<std::string>& extra, const std::string& mention)
+{
+  const ParseResult r = parse (extra);
+  EXPECT_EQ (r.kind, Kind::Error) << mention;
+  EXPECT_NE (r.error.find (mention), std::string::npos) << r.error;
+}
+} // namespace
+
+TEST (CliOptions, Defaults)
+{
+  const ParseResult r = parse ({});
+  ASSERT_EQ (r.kind, Kind::Run) << r.error;
+  const Options& o = r.options;
+  EXPECT_EQ (o.input_a, "a.pcd");
+  EXPECT_EQ (o.input_b, "b.obj");
+  EXPECT_FALSE (o.pose);
+  EXPECT_FALSE (o.poses_file);
+  EXPECT_EQ (o.sensor, "isotropic");
+  EXPECT_EQ (o.sigma_a, 0.005);
+  EXPECT_EQ (o.sigma_b, 0.005);
+  EXPECT_EQ (o.k, 10);
+  EXPECT_EQ (o.free_below, 0.1);
+  EXPECT_EQ (o.collision_above, 0.9);
+  EXPECT_EQ (o.seed, 1u);
+  EXPECT_EQ (o.n_max, 20);
+  EXPECT_EQ (o.sigma_max, 0.05);
+  EXPECT_EQ (o.epsilon, 0.02);
+  EXPECT_EQ (o.split, "pca");
+  EXPECT_FALSE (o.stochastic);
+  EXPECT_FALSE (o.exhaustive);
+  EXPECT_FALSE (o.mesh_spacing);
+  EXPECT_FALSE (o.output);
+  EXPECT_FALSE (o.json);
+}
+
+TEST (CliOptions, EveryOption)
+{
+  const ParseResult r = parse ({"-pose", "1,2,3,0.1,-0.2,3e-1", "-sigma", "0.01", "-sigma_b", "0.02", "-k", "7",
+                                "-thresholds", "0.2,0.8", "-seed", "18446744073709551615", "-nmax", "5", "-sigma_max",
+                                "0.1", "-epsilon", "0", "-split", "octree", "-stochastic", "-exhaustive",
+                                "-mesh_density", "0.004", "-o", "out.PCD", "-json", "-v"});
+  ASSERT_EQ (r.kind, Kind::Run) << r.error;
+  const Options& o = r.options;
+  ASSERT_TRUE (o.pose);
+  EXPECT_EQ ((*o.pose)[0], 1.0);
+  EXPECT_EQ ((*o.pose)[4], -0.2);
+  EXPECT_EQ ((*o.pose)[5], 0.3);
+  EXPECT_EQ (o.sigma_a, 0.01);
+  EXPECT_EQ (o.sigma_b, 0.02);  // -sigma_b overrides -sigma whatever the order
+  EXPECT_EQ (o.k, 7);
+  EXPECT_EQ (o.free_below, 0.2);
+  EXPECT_EQ (o.collision_above, 0.8);
+  EXPECT_EQ (o.seed, 18446744073709551615ull);
+  EXPECT_EQ (o.n_max, 5);
+  EXPECT_EQ (o.sigma_max, 0.1);
+  EXPECT_EQ (o.epsilon, 0.0);
+  EXPECT_EQ (o.split, "octree");
+  EXPECT_TRUE (o.stochastic);
+  EXPECT_TRUE (o.exhaustive);
+  EXPECT_EQ (*o.mesh_spacing, 0.004);
+  EXPECT_EQ (*o.output, "out.PCD");
+  EXPECT_TRUE (o.json);
+  EXPECT_TRUE (o.verbose);
+}
+
+TEST (CliOptions, Help)
+{
+  EXPECT_EQ (parse ({"-h"}, false).kind, Kind::Help);
+  EXPECT_EQ (parse ({"--help"}, false).kind, Kind::Help);
+  EXPECT_EQ (parse ({"-sigma", "bad", "-h"}).kind, Kind::Help);
+  EXPECT_NE (helpText ().find ("= 0.005"), std::string::npos);
+}
+
+TEST (CliOptions, MalformedNumbersNameTheFlag)
+{
+  expectUsageError ({"-sigma", "-1"}, "-sigma");
+  expectUsageError ({"-sigma", "1O"}, "-sigma");
+  expectUsageError ({"-sigma", "0.01x"}, "-sigma");
+  expectUsageError ({"-sigma", ""}, "-sigma");
+  expectUsageError ({"-sigma", " 1"}, "-sigma");
+  expectUsageError ({"-sigma", "nan"}, "-sigma");
+  expectUsageError ({"-sigma", "inf"}, "-sigma");
+  expectUsageError ({"-sigma", "1e999"}, "-sigma");
+  expectUsageError ({"-sigma_a", "-0.1"}, "-sigma_a");
+  expectUsageError ({"-k", "1O"}, "-k");
+  expectUsageError ({"-k", "0"}, "-k");
+  expectUsageError ({"-k", "2.5"}, "-k");
+  expectUsageError ({"-k", "99999999999"}, "-k");
+  expectUsageError ({"-seed", "-1"}, "-seed");
+  expectUsageError ({"-seed", "18446744073709551616"}, "-seed");
+  expectUsageError ({"-nmax", "0"}, "-nmax");
+  expectUsageError ({"-sigma_max", "-0.1"}, "-sigma_max");
+  expectUsageError ({"-epsilon", "0.5"}, "-epsilon");
+  expectUsageError ({"-mesh_density", "0"}, "-mesh_density");
+  expectUsageError ({"-thresholds", "0.2"}, "-thresholds");
+  expectUsageError ({"-thresholds", "0.6,0.9"}, "-thresholds");
+  expectUsageError ({"-thresholds", "0.1,0.4"}, "-thresholds");
+  expectUsageError ({"-thresholds", "0.1,,0.9"}, "-thresholds");
+  expectUsageError ({"-pose", "0,0,0,0,0"}, "-pose");
+  expectUsageError ({"-pose", "0,0,0,0,0,0,0"}, "-pose");
+  expectUsageError ({"-pose", "0,0,0,0,0,x"}, "-pose");
+  expectUsageError ({"-sensor", "sonar"}, "-sensor");
+  expectUsageError ({"-split", "kd"}, "-split");
+  expectUsageError ({"-o", "out.ply"}, "-o");
+}
+
+TEST (CliOptions, FlagsAndPositionals)
+{
+  expectUsageError ({"-sigm", "0.1"}, "-sigm");
+  expectUsageError ({"--sigma", "0.1"}, "--sigma");
+  expectUsageError ({"-sigma"}, "-sigma");
+  expectUsageError ({"-sigma", "0.1", "-sigma", "0.2"}, "more than once");
+  expectUsageError ({"c.pcd"}, "two input files");
+  expectUsageError ({"-pose", "0,0,0,0,0,0", "-poses", "p.txt"}, "-poses");
+  expectUsageError ({"-poses", "p.txt", "-o", "x.pcd"}, "-o");
+  expectUsageError ({"-deterministic", "-stochastic"}, "-stochastic");
+  expectUsageError ({"-sensor", "kinect", "-sigma", "0.01"}, "-sigma");
+  EXPECT_EQ (parse ({}, false).kind, Kind::Error);
+  const ParseResult txt = parseCommandLine (std::vector<std::string>{"a.txt", "b.pcd"});
+  EXPECT_EQ (txt.kind, Kind::Error);
+  EXPECT_NE (txt.error.find ("a.txt"), std::string::npos);
+  // Negative pose values are values, not flags; "--" ends the options.
+  const ParseResult neg = parse ({"-pose", "-1,-2,-3,0,0,0"});
+  ASSERT_EQ (neg.kind, Kind::Run) << neg.error;
+  EXPECT_EQ ((*neg.options.pose)[2], -3.0);
+  const ParseResult dashed = parseCommandLine (std::vector<std::string>{"-json", "--", "-a.pcd", "b.STL"});
+  ASSERT_EQ (dashed.kind, Kind::Run) << dashed.error;
+  EXPECT_EQ (dashed.options.input_a, "-a.pcd");
+  EXPECT_TRUE (dashed.options.json);
+  EXPECT_EQ (parse ({"-deterministic"}).kind, Kind::Run);
+  EXPECT_EQ (parse ({"-sensor", "kinect"}).options.sensor, "kinect");
+}
+
+TEST (CliOptions, InputKinds)
+{
+  EXPECT_EQ (inputKindOf ("x.pcd"), InputKind::Cloud);
+  EXPECT_EQ (inputKindOf ("X.PCD"), InputKind::Cloud);
+  for (const char* m : {"m.ply", "m.obj", "m.STL", "dir.pcd/m.vtk"})
+    EXPECT_EQ (inputKindOf (m), InputKind::Mesh) << m;
+  for (const char* u : {"m.xyz", "pcd", "m.pcd.gz", ""})
+    EXPECT_EQ (inputKindOf (u), InputKind::Unsupported) << u;
+}
+
+TEST (CliOptions, PoseLines)
+{
+  Pose p{};
+  std::string e;
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 6", p, e), 1);
+  EXPECT_EQ (p[5], 6.0);
+  EXPECT_EQ (parsePoseLine ("  1,2,3,4,5,6  # comment", p, e), 1);
+  EXPECT_EQ (parsePoseLine ("1, 2, 3 ,4 , 5,\t6\r", p, e), 1);
+  EXPECT_EQ (p[0], 1.0);
+  EXPECT_EQ (parsePoseLine ("", p, e), 0);
+  EXPECT_EQ (parsePoseLine ("   # only a comment", p, e), 0);
+  EXPECT_EQ (parsePoseLine ("\r", p, e), 0);
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5", p, e), -1);
+  EXPECT_NE (e.find ("got 5"), std::string::npos) << e;
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 6 7", p, e), -1);
+  EXPECT_EQ (parsePoseLine ("1,,2,3,4,5,6", p, e), -1);
+  EXPECT_EQ (parsePoseLine (",1,2,3,4,5,6", p, e), -1);
+  EXPECT_EQ (parsePoseLine ("1,2,3,4,5,6,", p, e), -1);
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 six", p, e), -1);
+  EXPECT_NE (e.find ("six"), std::string::npos) << e;
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 nan", p, e), -1);
+}
+
+TEST (CliOptions, PoseFiles)
+{
+  std::vector<Pose> poses;
+  std::string e;
+  std::istringstream good ("# header\n\n0 0 0.1 0 0 0\n0,0,0.2,0,0,0\n");
+  ASSERT_TRUE (parsePoses (good, "p.txt", poses, e)) << e;
+  ASSERT_EQ (poses.size (), 2u);
+  EXPECT_EQ (poses[1][2], 0.2);
+  std::istringstream bad ("0 0 0.1 0 0 0\n\n0 0 0.2 0 0\n");
+  EXPECT_FALSE (parsePoses (bad, "p.txt", poses, e));
+  EXPECT_EQ (e.rfind ("p.txt:3: ", 0), 0u) << e;
+  std::istringstream empty ("# nothing\n\n");
+  EXPECT_FALSE (parsePoses (empty, "p.txt", poses, e));
+  EXPECT_NE (e.find ("no pose"), std::string::npos) << e;
+}

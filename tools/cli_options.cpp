@@ -1,0 +1,508 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "cli_options.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <set>
+#include <sstream>
+
+namespace pcd_collision
+{
+namespace
+{
+std::string
+lower (std::string s)
+{
+  std::transform (s.begin (), s.end (), s.begin (),
+                  [] (unsigned char c) { return static_cast<char> (std::tolower (c)); });
+  return s;
+}
+
+bool
+endsWith (const std::string& s, const std::string& suffix)
+{
+  return s.size () >= suffix.size () && s.compare (s.size () - suffix.size (), suffix.size (), suffix) == 0;
+}
+
+std::string
+fmt (double v)
+{
+  std::ostringstream os;
+  os << v;
+  return os.str ();
+}
+
+// Flags that take one value, and flags that take none.
+const std::set<std::string> kValueFlags = {
+  "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-k", "-thresholds", "-seed",
+  "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
+const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
+                                            "-v"};
+
+ParseResult
+usage (const std::string& message)
+{
+  ParseResult r;
+  r.kind = ParseResult::Kind::Error;
+  r.error = message;
+  return r;
+}
+} // namespace
+
+bool
+parseDouble (const std::string& text, double& value)
+{
+  if (text.empty () || std::isspace (static_cast<unsigned char> (text[0])))
+    return false;
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod (text.c_str (), &end);
+  if (end != text.c_str () + text.size ())
+    return false;
+  if (!std::isfinite (v))
+    return false;
+  value = v;
+  return true;
+}
+
+bool
+parseInt (const std::string& text, int& value)
+{
+  if (text.empty () || std::isspace (static_cast<unsigned char> (text[0])))
+    return false;
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll (text.c_str (), &end, 10);
+  if (end != text.c_str () + text.size () || errno == ERANGE)
+    return false;
+  if (v < std::numeric_limits<int>::min () || v > std::numeric_limits<int>::max ())
+    return false;
+  value = static_cast<int> (v);
+  return true;
+}
+
+bool
+parseUint64 (const std::string& text, std::uint64_t& value)
+{
+  if (text.empty () || !std::isdigit (static_cast<unsigned char> (text[0])))
+    return false;  // also rejects "-1", which strtoull would wrap around
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull (text.c_str (), &end, 10);
+  if (end != text.c_str () + text.size () || errno == ERANGE)
+    return false;
+  value = static_cast<std::uint64_t> (v);
+  return true;
+}
+
+bool
+parseDoubleList (const std::string& text, std::size_t count, std::vector<double>& values)
+{
+  values.clear ();
+  std::size_t start = 0;
+  while (true)
+  {
+    const std::size_t comma = text.find (',', start);
+    const std::string item = text.substr (start, comma == std::string::npos ? std::string::npos : comma - start);
+    double v = 0.0;
+    if (!parseDouble (item, v))
+      return false;
+    values.push_back (v);
+    if (comma == std::string::npos)
+      break;
+    start = comma + 1;
+  }
+  return values.size () == count;
+}
+
+InputKind
+inputKindOf (const std::string& path)
+{
+  const std::string l = lower (path);
+  if (endsWith (l, ".pcd"))
+    return InputKind::Cloud;
+  for (const char* ext : {".ply", ".obj", ".stl", ".vtk"})
+    if (endsWith (l, ext))
+      return InputKind::Mesh;
+  return InputKind::Unsupported;
+}
+
+int
+parsePoseLine (const std::string& line, Pose& pose, std::string& error)
+{
+  const std::string body = line.substr (0, line.find ('#'));
+  // Tokens are separated by blanks and/or one comma; an empty field (two commas in a row, a
+  // leading or a trailing comma) is an error, not a silently skipped number.
+  std::vector<std::string> tokens;
+  std::string current;
+  int commas = 0;  // commas since the last token
+  for (const char c : body)
+  {
+    if (c == ',' || std::isspace (static_cast<unsigned char> (c)))
+    {
+      if (!current.empty ())
+      {
+        tokens.push_back (current);
+        current.clear ();
+        commas = 0;
+      }
+      if (c == ',' && (++commas > 1 || tokens.empty ()))
+      {
+        error = "empty field between commas";
+        return -1;
+      }
+    }
+    else
+      current.push_back (c);
+  }
+  if (!current.empty ())
+    tokens.push_back (current);
+  else if (commas > 0)
+  {
+    error = "trailing comma";
+    return -1;
+  }
+  if (tokens.empty ())
+    return 0;
+  if (tokens.size () != 6)
+  {
+    error = "expected 6 numbers (tx ty tz roll pitch yaw), got " + std::to_string (tokens.size ());
+    return -1;
+  }
+  for (std::size_t i = 0; i < 6; ++i)
+  {
+    if (!parseDouble (tokens[i], pose[i]))
+    {
+      error = "'" + tokens[i] + "' is not a finite number";
+      return -1;
+    }
+  }
+  return 1;
+}
+
+bool
+parsePoses (std::istream& in, const std::string& name, std::vector<Pose>& poses, std::string& error)
+{
+  poses.clear ();
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline (in, line))
+  {
+    ++number;
+    Pose pose{};
+    std::string why;
+    const int r = parsePoseLine (line, pose, why);
+    if (r < 0)
+    {
+      error = name + ":" + std::to_string (number) + ": " + why;
+      return false;
+    }
+    if (r > 0)
+      poses.push_back (pose);
+  }
+  if (in.bad ())
+  {
+    error = name + ": read error";
+    return false;
+  }
+  if (poses.empty ())
+  {
+    error = name + ": no pose in the file";
+    return false;
+  }
+  return true;
+}
+
+ParseResult
+parseCommandLine (int argc, const char* const* argv)
+{
+  std::vector<std::string> args;
+  for (int i = 1; i < argc; ++i)
+    args.emplace_back (argv[i] ? argv[i] : "");
+  return parseCommandLine (args);
+}
+
+ParseResult
+parseCommandLine (const std::vector<std::string>& args)
+{
+  for (const std::string& a : args)
+  {
+    if (a == "--")
+      break;
+    if (a == "-h" || a == "--help" || a == "-help")
+    {
+      ParseResult r;
+      r.kind = ParseResult::Kind::Help;
+      return r;
+    }
+  }
+
+  Options o;
+  std::vector<std::string> positional;
+  std::set<std::string> seen;
+  std::optional<double> sigma, sigma_a, sigma_b;
+  bool deterministic = false;
+  bool only_positional = false;
+
+  for (std::size_t i = 0; i < args.size (); ++i)
+  {
+    const std::string& a = args[i];
+    if (only_positional || a.empty () || a[0] != '-' || a == "-")
+    {
+      positional.push_back (a);
+      continue;
+    }
+    if (a == "--")
+    {
+      only_positional = true;
+      continue;
+    }
+    const bool takes_value = kValueFlags.count (a) > 0;
+    if (!takes_value && kSwitchFlags.count (a) == 0)
+      return usage ("unknown option '" + a + "' (see -h)");
+    if (!seen.insert (a).second)
+      return usage ("option " + a + " given more than once");
+    if (!takes_value)
+    {
+      if (a == "-deterministic")
+        deterministic = true;
+      else if (a == "-stochastic")
+        o.stochastic = true;
+      else if (a == "-exhaustive")
+        o.exhaustive = true;
+      else if (a == "-json")
+        o.json = true;
+      else if (a == "-v")
+        o.verbose = true;
+      continue;
+    }
+    if (i + 1 >= args.size ())
+      return usage ("option " + a + " needs a value (see -h)");
+    const std::string v = args[++i];
+    const std::string bad = "option " + a + ": '" + v + "' ";
+
+    auto nonNegative = [&] (std::optional<double>& out) -> std::optional<ParseResult> {
+      double d = 0.0;
+      if (!parseDouble (v, d))
+        return usage (bad + "is not a number");
+      if (d < 0.0)
+        return usage (bad + "must be >= 0");
+      out = d;
+      return std::nullopt;
+    };
+
+    if (a == "-pose")
+    {
+      std::vector<double> vals;
+      if (!parseDoubleList (v, 6, vals))
+        return usage (bad + "must be six comma-separated numbers tx,ty,tz,roll,pitch,yaw");
+      Pose p{};
+      std::copy (vals.begin (), vals.end (), p.begin ());
+      o.pose = p;
+    }
+    else if (a == "-poses")
+    {
+      if (v.empty ())
+        return usage ("option -poses needs a file name");
+      o.poses_file = v;
+    }
+    else if (a == "-sigma")
+    {
+      if (auto e = nonNegative (sigma))
+        return *e;
+    }
+    else if (a == "-sigma_a")
+    {
+      if (auto e = nonNegative (sigma_a))
+        return *e;
+    }
+    else if (a == "-sigma_b")
+    {
+      if (auto e = nonNegative (sigma_b))
+        return *e;
+    }
+    else if (a == "-sensor")
+    {
+      if (v != "none" && v != "isotropic" && v != "kinect" && v != "stereo" && v != "lidar")
+        return usage (bad + "must be one of isotropic, kinect, stereo, lidar, none");
+      o.sensor = v;
+    }
+    else if (a == "-k")
+    {
+      if (!parseInt (v, o.k))
+        return usage (bad + "is not an integer");
+      if (o.k < 1)
+        return usage (bad + "must be >= 1");
+    }
+    else if (a == "-thresholds")
+    {
+      std::vector<double> vals;
+      if (!parseDoubleList (v, 2, vals))
+        return usage (bad + "must be two comma-separated numbers LOW,HIGH");
+      if (!(vals[0] >= 0.0 && vals[0] <= 0.5))
+        return usage (bad + "LOW must be in [0, 0.5]");
+      if (!(vals[1] >= 0.5 && vals[1] <= 1.0))
+        return usage (bad + "HIGH must be in [0.5, 1]");
+      o.free_below = vals[0];
+      o.collision_above = vals[1];
+    }
+    else if (a == "-seed")
+    {
+      if (!parseUint64 (v, o.seed))
+        return usage (bad + "is not a non-negative 64-bit integer");
+    }
+    else if (a == "-nmax")
+    {
+      if (!parseInt (v, o.n_max))
+        return usage (bad + "is not an integer");
+      if (o.n_max < 1)
+        return usage (bad + "must be >= 1");
+    }
+    else if (a == "-sigma_max")
+    {
+      if (!parseDouble (v, o.sigma_max))
+        return usage (bad + "is not a number");
+      if (o.sigma_max < 0.0)
+        return usage (bad + "must be >= 0");
+    }
+    else if (a == "-epsilon")
+    {
+      if (!parseDouble (v, o.epsilon))
+        return usage (bad + "is not a number");
+      if (!(o.epsilon >= 0.0 && o.epsilon < 0.5))
+        return usage (bad + "must be in [0, 0.5)");
+    }
+    else if (a == "-split")
+    {
+      if (v != "pca" && v != "octree")
+        return usage (bad + "must be pca or octree");
+      o.split = v;
+    }
+    else if (a == "-mesh_density")
+    {
+      double d = 0.0;
+      if (!parseDouble (v, d))
+        return usage (bad + "is not a number");
+      if (!(d > 0.0))
+        return usage (bad + "must be > 0 (a sample spacing in data units)");
+      o.mesh_spacing = d;
+    }
+    else if (a == "-o")
+    {
+      if (lower (v).size () <= 4 || !endsWith (lower (v), ".pcd"))
+        return usage (bad + "must name a .pcd file");
+      o.output = v;
+    }
+  }
+
+  if (positional.size () != 2)
+    return usage ("expected two input files <a> <b>, got " + std::to_string (positional.size ()) +
+                  " (see -h)");
+  for (const std::string& p : positional)
+    if (inputKindOf (p) == InputKind::Unsupported)
+      return usage ("input '" + p + "': unsupported file type (expected .pcd, .ply, .obj, .stl or .vtk)");
+  o.input_a = positional[0];
+  o.input_b = positional[1];
+
+  if (o.pose && o.poses_file)
+    return usage ("options -pose and -poses cannot be combined");
+  if (o.output && o.poses_file)
+    return usage ("option -o writes one query's result and cannot be combined with -poses");
+  if (deterministic && o.stochastic)
+    return usage ("options -deterministic and -stochastic cannot be combined");
+  if (o.sensor != "isotropic" && (sigma || sigma_a || sigma_b))
+    return usage ("options -sigma, -sigma_a and -sigma_b need -sensor isotropic (got -sensor " + o.sensor + ")");
+  if (sigma)
+    o.sigma_a = o.sigma_b = *sigma;
+  if (sigma_a)
+    o.sigma_a = *sigma_a;
+  if (sigma_b)
+    o.sigma_b = *sigma_b;
+
+  ParseResult r;
+  r.kind = ParseResult::Kind::Run;
+  r.options = o;
+  return r;
+}
+
+std::string
+helpText ()
+{
+  using D = Defaults;
+  std::ostringstream h;
+  h << "Probabilistic collision check between two noisy point clouds or meshes (pcl_probcollision).\n"
+       "\n"
+       "Syntax: pcd_collision <a> <b> [options]\n"
+       "\n"
+       "  <a>, <b>   a .pcd point cloud with x y z fields (any point type; organized clouds and NaN\n"
+       "             points are fine) or a triangle mesh .ply .obj .stl .vtk. <a> is moved by the pose,\n"
+       "             <b> stays where it is. Both must be in the same units.\n"
+       "\n"
+       "Pose of <a> (p' = Rz(yaw) Ry(pitch) Rx(roll) p + t; data units and radians):\n"
+       "  -pose tx,ty,tz,roll,pitch,yaw   = 0,0,0,0,0,0\n"
+       "  -poses FILE     batch mode: one pose per line, six numbers separated by spaces or commas,\n"
+       "                  '#' comments and blank lines allowed; hierarchies are built once\n"
+       "\n"
+       "Uncertainty (mesh inputs are exact: zero covariance, no noise):\n"
+       "  -sensor isotropic|kinect|stereo|lidar|none   = "
+    << D::sensor
+    << "\n"
+       "                  sensor noise added to both clouds; depth models use each PCD's VIEWPOINT\n"
+       "  -sigma S        = "
+    << fmt (D::sigma)
+    << "   isotropic noise sigma of both clouds, data units (-sensor isotropic only)\n"
+       "  -sigma_a S      = -sigma   isotropic sigma of <a> only\n"
+       "  -sigma_b S      = -sigma   isotropic sigma of <b> only\n"
+       "  -k K            = "
+    << D::k
+    << "      neighbours of the covariance estimation\n"
+       "\n"
+       "Query:\n"
+       "  -thresholds LOW,HIGH   = "
+    << fmt (D::free_below) << "," << fmt (D::collision_above)
+    << "   P < LOW is free, P > HIGH is collision, else contact\n"
+       "  -deterministic  (default) expected-weight traversal\n"
+       "  -stochastic     stochastic traversal, seeded by -seed\n"
+       "  -seed N         = "
+    << D::seed
+    << "       seed of the stochastic traversal\n"
+       "  -exhaustive     visit every reachable leaf pair (no early stop; P is then exact, not a bound)\n"
+       "  -nmax N         = "
+    << D::n_max
+    << "      hierarchy: a node with more points is split (n_min = min(" << D::n_min
+    << ", nmax))\n"
+       "  -sigma_max S    = "
+    << fmt (D::sigma_max)
+    << "    hierarchy: a node with more variation is split\n"
+       "  -epsilon E      = "
+    << fmt (D::epsilon)
+    << "    hierarchy: sibling overlap, fraction of the parent's extent, [0, 0.5)\n"
+       "  -split pca|octree   = "
+    << D::split
+    << "\n"
+       "  -mesh_density S = median nearest-neighbour spacing of the other cloud\n"
+       "                  (both meshes: "
+    << fmt (D::mesh_spacing_fraction)
+    << " x the larger bounding-box diagonal); mesh sample spacing,\n"
+       "                  data units: samples uniform by area (fixed seed) plus every vertex\n"
+       "\n"
+       "Output:\n"
+       "  -o FILE.pcd     write both clouds after the pose (a then b) with fields intensity (per-point\n"
+       "                  collision probability, NaN = not evaluated), rgb (free green, contact yellow,\n"
+       "                  collision red, not evaluated grey) and label (0 = a, 1 = b); implies\n"
+       "                  -exhaustive; never overwrites an input; not with -poses\n"
+       "  -json           one JSON object per query on stdout (one line each); human text to stderr\n"
+       "  -v              also show PCL's and VTK's own messages\n"
+       "  -h, --help      this help\n"
+       "\n"
+       "Exit status: 0 the query ran (whatever the verdict), 1 runtime failure (unreadable or\n"
+       "malformed file, including a malformed -poses line; no finite point; write failure; query\n"
+       "failed), 2 usage error (unknown option, malformed or out-of-range value, wrong number of\n"
+       "inputs, unsupported file type, -o naming an input).\n";
+  return h.str ();
+}
+} // namespace pcd_collision

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+// Command line of pcd_collision: a pure function from argv to Options or a usage error, and
+// the parser of -poses files. No PCL and no file-system access here, so it can be unit-tested
+// and fuzzed on its own.
+
+#include <array>
+#include <cstdint>
+#include <istream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pcd_collision
+{
+/** \brief tx, ty, tz, roll, pitch, yaw (data units, radians):
+  * p' = Rz(yaw) Ry(pitch) Rx(roll) p + t. */
+using Pose = std::array<double, 6>;
+
+/** \brief Defaults, shown by printHelp(). */
+struct Defaults
+{
+  static constexpr const char* sensor = "isotropic";
+  static constexpr double sigma = 0.005;
+  static constexpr int k = 10;
+  static constexpr double free_below = 0.1;
+  static constexpr double collision_above = 0.9;
+  static constexpr std::uint64_t seed = 1;
+  static constexpr int n_max = 20;
+  static constexpr int n_min = 8;
+  static constexpr double sigma_max = 0.05;
+  static constexpr double epsilon = 0.02;
+  static constexpr const char* split = "pca";
+  /** \brief Mesh spacing when both inputs are meshes: this fraction of the larger bounding-box
+    * diagonal. */
+  static constexpr double mesh_spacing_fraction = 0.01;
+  /** \brief Seed of the mesh surface sampling (fixed; -seed does not change it). */
+  static constexpr std::uint64_t mesh_sampling_seed = 20111;
+};
+
+struct Options
+{
+  std::string input_a;
+  std::string input_b;
+
+  /** \brief -pose (single query); identity when absent. */
+  std::optional<Pose> pose;
+  /** \brief -poses FILE (batch mode). */
+  std::optional<std::string> poses_file;
+
+  /** \brief -sensor: none, isotropic, kinect, stereo, lidar. */
+  std::string sensor = Defaults::sensor;
+  /** \brief Isotropic sigma of each input (data units); -sigma sets both, -sigma_a / -sigma_b
+    * one each. Only meaningful with sensor == "isotropic". */
+  double sigma_a = Defaults::sigma;
+  double sigma_b = Defaults::sigma;
+  int k = Defaults::k;
+
+  double free_below = Defaults::free_below;
+  double collision_above = Defaults::collision_above;
+  std::uint64_t seed = Defaults::seed;
+  int n_max = Defaults::n_max;
+  double sigma_max = Defaults::sigma_max;
+  double epsilon = Defaults::epsilon;
+  std::string split = Defaults::split;
+  bool stochastic = false;
+  bool exhaustive = false;
+
+  /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
+  std::optional<double> mesh_spacing;
+
+  /** \brief -o FILE.pcd */
+  std::optional<std::string> output;
+  bool json = false;
+  bool verbose = false;
+};
+
+struct ParseResult
+{
+  enum class Kind
+  {
+    Run,    ///< options are valid
+    Help,   ///< -h / --help: print the help and exit 0
+    Error   ///< usage error: print `error` and exit 2
+  };
+  Kind kind = Kind::Error;
+  Options options;
+  std::string error;
+};
+
+/** \brief Parses argv[1..argc-1]. Strict: unknown flags, missing or malformed values, values
+  * out of range, repeated flags, conflicting flags and a wrong number of positional arguments
+  * are usage errors naming the flag or argument. */
+ParseResult parseCommandLine (const std::vector<std::string>& args);
+ParseResult parseCommandLine (int argc, const char* const* argv);
+
+/** \brief The -h text; its syntax lines show every default. */
+std::string helpText ();
+
+/** \brief The input kinds the tool reads, by file extension (case-insensitive). */
+enum class InputKind
+{
+  Unsupported,
+  Cloud,  ///< .pcd
+  Mesh    ///< .ply .obj .stl .vtk
+};
+InputKind inputKindOf (const std::string& path);
+
+/** \brief Strict number parsing: the whole string must be consumed, finite, no empty string. */
+bool parseDouble (const std::string& text, double& value);
+bool parseInt (const std::string& text, int& value);
+bool parseUint64 (const std::string& text, std::uint64_t& value);
+/** \brief Splits on ',' (the CLI forms, e.g. -pose 0,0,0.1,0,0,0) and parses each as a double. */
+bool parseDoubleList (const std::string& text, std::size_t count, std::vector<double>& values);
+
+/** \brief One line of a -poses file: six numbers separated by spaces, tabs and/or commas; a
+  * '#' starts a comment. Returns 1 with the pose, 0 for a blank or comment-only line, -1 with
+  * a reason in error for a malformed line. */
+int parsePoseLine (const std::string& line, Pose& pose, std::string& error);
+
+/** \brief A whole -poses file; false with "NAME:LINE: reason" in error on the first malformed
+  * line, or when it holds no pose at all. */
+bool parsePoses (std::istream& in, const std::string& name, std::vector<Pose>& poses,
+                 std::string& error);
+} // namespace pcd_collision

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+// Triangle-mesh input of pcd_collision. Loading goes through PCL's VTK readers
+// (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its headers are heavy.
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace pcd_collision
+{
+struct TriangleMesh
+{
+  std::vector<std::array<double, 3>> vertices;
+  /** \brief Vertex indices; polygons with more than three vertices are fan-triangulated. */
+  std::vector<std::array<int, 3>> triangles;
+};
+
+/** \brief Loads a .ply, .obj, .stl or .vtk mesh (extension case-insensitive). False with a
+  * reason in error (naming the file) when the file cannot be read, has no vertex or no triangle,
+  * or refers to a missing vertex. Triangles with a non-finite vertex are dropped. */
+bool loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& error);
+
+/** \brief Silences (or restores) VTK's own warning and error windows. */
+void setVtkMessages (bool enabled);
+} // namespace pcd_collision

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "mesh_sampling.h"
+
+#include <pcl/kdtree/kdtree_flann.h>
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace pcd_collision
+{
+namespace
+{
+/** \brief Uniform in [0, 1) from the top 53 bits (std::uniform_real_distribution is
+  * implementation-defined; this is not). */
+double
+uniform01 (std::mt19937_64& rng)
+{
+  return static_cast<double> (rng () >> 11) * (1.0 / 9007199254740992.0);
+}
+
+Eigen::Vector3d
+vertex (const TriangleMesh& mesh, int i)
+{
+  const auto& v = mesh.vertices[static_cast<std::size_t> (i)];
+  return {v[0], v[1], v[2]};
+}
+
+double
+triangleArea (const TriangleMesh& mesh, const std::array<int, 3>& t)
+{
+  const Eigen::Vector3d a = vertex (mesh, t[0]);
+  return 0.5 * (vertex (mesh, t[1]) - a).cross (vertex (mesh, t[2]) - a).norm ();
+}
+} // namespace
+
+double
+meshArea (const TriangleMesh& mesh)
+{
+  double area = 0.0;
+  for (const auto& t : mesh.triangles)
+    area += triangleArea (mesh, t);
+  return area;
+}
+
+double
+meshDiagonal (const TriangleMesh& mesh)
+{
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& t : mesh.triangles)
+    for (const int i : t)
+    {
+      lo = lo.cwiseMin (vertex (mesh, i));
+      hi = hi.cwiseMax (vertex (mesh, i));
+    }
+  return mesh.triangles.empty () ? 0.0 : (hi - lo).norm ();
+}
+
+pcl::PointCloud<pcl::PointXYZ>
+sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points)
+{
+  if (!(spacing > 0.0) || !std::isfinite (spacing))
+    throw std::runtime_error ("mesh sample spacing must be finite and > 0");
+  const double expected = meshArea (mesh) / (spacing * spacing);
+  if (!(expected < static_cast<double> (max_points)))
+    throw std::runtime_error ("sampling the mesh at spacing " + std::to_string (spacing) + " would give about " +
+                              std::to_string (static_cast<long long> (std::min (expected, 1e18))) +
+                              " points (limit " + std::to_string (max_points) + "); raise -mesh_density");
+
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::vector<char> used (mesh.vertices.size (), 0);
+  for (const auto& t : mesh.triangles)
+    for (const int i : t)
+      used[static_cast<std::size_t> (i)] = 1;
+  for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
+    if (used[i])
+      cloud.push_back (pcl::PointXYZ (static_cast<float> (mesh.vertices[i][0]), static_cast<float> (mesh.vertices[i][1]),
+                                      static_cast<float> (mesh.vertices[i][2])));
+
+  std::mt19937_64 rng (seed);
+  for (const auto& t : mesh.triangles)
+  {
+    const double n_expected = triangleArea (mesh, t) / (spacing * spacing);
+    const auto n = static_cast<std::size_t> (std::floor (n_expected + uniform01 (rng)));
+    const Eigen::Vector3d a = vertex (mesh, t[0]), b = vertex (mesh, t[1]), c = vertex (mesh, t[2]);
+    for (std::size_t s = 0; s < n; ++s)
+    {
+      const double r1 = std::sqrt (uniform01 (rng));
+      const double r2 = uniform01 (rng);
+      const Eigen::Vector3d p = (1.0 - r1) * a + r1 * (1.0 - r2) * b + r1 * r2 * c;
+      cloud.push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
+    }
+  }
+  cloud.width = static_cast<std::uint32_t> (cloud.size ());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  return cloud;
+}
+
+double
+medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_queries)
+{
+  auto finite = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>> ();
+  for (const auto& p : cloud.points)
+    if (std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z))
+      finite->push_back (p);
+  if (finite->size () < 2)
+    return 0.0;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud (finite);
+  const std::size_t stride = std::max<std::size_t> (1, (finite->size () + max_queries - 1) / max_queries);
+  std::vector<double> d;
+  pcl::Indices idx;
+  std::vector<float> sq;
+  for (std::size_t i = 0; i < finite->size (); i += stride)
+  {
+    // The nearest other point at a positive distance: duplicates are skipped by asking for a
+    // few more neighbours.
+    for (int k = 2; k <= 16; k *= 2)
+    {
+      if (tree.nearestKSearch ((*finite)[i], k, idx, sq) <= 0)
+        break;
+      const auto it = std::find_if (sq.begin (), sq.end (), [] (float v) { return v > 0.f; });
+      if (it != sq.end ())
+      {
+        d.push_back (std::sqrt (static_cast<double> (*it)));
+        break;
+      }
+      if (static_cast<std::size_t> (k) >= finite->size ())
+        break;
+    }
+  }
+  if (d.empty ())
+    return 0.0;
+  std::nth_element (d.begin (), d.begin () + static_cast<std::ptrdiff_t> (d.size () / 2), d.end ());
+  return d[d.size () / 2];
+}
+} // namespace pcd_collision

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+// MeshSampled mode (METHOD.md 9): a mesh becomes an exact point cloud, sampled uniformly by
+// area plus every vertex, with zero covariance.
+
+#include "mesh_input.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstddef>
+#include <cstdint>
+
+namespace pcd_collision
+{
+/** \brief Samples the surface: each triangle gets floor(area / spacing^2 + u) points (u uniform
+  * in [0, 1)), uniform over the triangle, and every vertex used by a triangle is added once;
+  * the expected density is one sample per spacing^2 of area. Deterministic for a given seed
+  * (std::mt19937_64 and its raw bits only, so identical across standard libraries).
+  * Throws std::runtime_error when more than max_points would be produced. */
+pcl::PointCloud<pcl::PointXYZ> sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed,
+                                           std::size_t max_points = 20000000);
+
+/** \brief Total triangle area. */
+double meshArea (const TriangleMesh& mesh);
+
+/** \brief Diagonal of the axis-aligned bounding box of the vertices used by triangles. */
+double meshDiagonal (const TriangleMesh& mesh);
+
+/** \brief Median over the finite points (at most max_queries of them, evenly strided) of the
+  * distance to the nearest other finite point; 0 when there are fewer than two points or
+  * they all coincide. */
+double medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_queries = 20000);
+} // namespace pcd_collision

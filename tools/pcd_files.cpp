@@ -1,0 +1,249 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "pcd_files.h"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+namespace pcd_collision
+{
+namespace
+{
+/** \brief One field value as double, whatever its PCD type. */
+double
+readField (const std::uint8_t* p, std::uint8_t datatype)
+{
+  switch (datatype)
+  {
+    case pcl::PCLPointField::INT8: { std::int8_t v; std::memcpy (&v, p, 1); return v; }
+    case pcl::PCLPointField::UINT8: { std::uint8_t v; std::memcpy (&v, p, 1); return v; }
+    case pcl::PCLPointField::INT16: { std::int16_t v; std::memcpy (&v, p, 2); return v; }
+    case pcl::PCLPointField::UINT16: { std::uint16_t v; std::memcpy (&v, p, 2); return v; }
+    case pcl::PCLPointField::INT32: { std::int32_t v; std::memcpy (&v, p, 4); return v; }
+    case pcl::PCLPointField::UINT32: { std::uint32_t v; std::memcpy (&v, p, 4); return v; }
+    case pcl::PCLPointField::FLOAT32: { float v; std::memcpy (&v, p, 4); return v; }
+    case pcl::PCLPointField::FLOAT64: { double v; std::memcpy (&v, p, 8); return v; }
+    default: return std::numeric_limits<double>::quiet_NaN ();
+  }
+}
+
+std::size_t
+fieldSize (std::uint8_t datatype)
+{
+  switch (datatype)
+  {
+    case pcl::PCLPointField::INT8: case pcl::PCLPointField::UINT8: return 1;
+    case pcl::PCLPointField::INT16: case pcl::PCLPointField::UINT16: return 2;
+    case pcl::PCLPointField::INT32: case pcl::PCLPointField::UINT32: case pcl::PCLPointField::FLOAT32: return 4;
+    case pcl::PCLPointField::FLOAT64: return 8;
+    default: return 0;
+  }
+}
+} // namespace
+
+bool
+loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error)
+{
+  cloud.clear ();
+  pcl::PCDReader reader;
+  pcl::PCLPointCloud2 blob;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0, data_type = 0;
+  unsigned int data_idx = 0;
+  if (reader.readHeader (path, blob, origin, orientation, version, data_type, data_idx) < 0)
+  {
+    error = "'" + path + "' is not a PCD file (malformed or missing header)";
+    return false;
+  }
+  if (blob.fields.empty ())
+  {
+    error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
+    return false;
+  }
+  if (static_cast<std::size_t> (blob.width) * blob.height == 0)
+  {
+    error = "'" + path + "' has no points (empty cloud)";
+    return false;
+  }
+  int idx[3];
+  const char* names[3] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i)
+  {
+    idx[i] = pcl::getFieldIndex (blob, names[i]);
+    if (idx[i] < 0)
+    {
+      error = "'" + path + "' has no '" + names[i] + "' field (a PCD input needs x y z)";
+      return false;
+    }
+    if (fieldSize (blob.fields[idx[i]].datatype) == 0)
+    {
+      error = "'" + path + "': field '" + names[i] + "' has an unknown type";
+      return false;
+    }
+  }
+  if (reader.read (path, blob, origin, orientation, version) < 0)
+  {
+    error = "'" + path + "' is truncated or corrupt (PCD data could not be read)";
+    return false;
+  }
+  const std::size_t n = static_cast<std::size_t> (blob.width) * blob.height;
+  if (n == 0)
+  {
+    error = "'" + path + "' has no points";
+    return false;
+  }
+  if (blob.data.size () < n * blob.point_step)
+  {
+    error = "'" + path + "' is truncated (fewer data bytes than its header announces)";
+    return false;
+  }
+  bool all_float = true;
+  for (int i = 0; i < 3; ++i)
+    all_float = all_float && blob.fields[idx[i]].datatype == pcl::PCLPointField::FLOAT32;
+  if (all_float)
+    pcl::fromPCLPointCloud2 (blob, cloud);
+  else
+  {
+    cloud.resize (n);
+    for (std::size_t j = 0; j < n; ++j)
+    {
+      const std::uint8_t* row = blob.data.data () + j * blob.point_step;
+      cloud[j].x = static_cast<float> (readField (row + blob.fields[idx[0]].offset, blob.fields[idx[0]].datatype));
+      cloud[j].y = static_cast<float> (readField (row + blob.fields[idx[1]].offset, blob.fields[idx[1]].datatype));
+      cloud[j].z = static_cast<float> (readField (row + blob.fields[idx[2]].offset, blob.fields[idx[2]].datatype));
+    }
+    cloud.width = blob.width;
+    cloud.height = blob.height;
+    cloud.is_dense = false;
+  }
+  cloud.header = pcl::PCLHeader ();
+  cloud.sensor_origin_ = origin;
+  cloud.sensor_orientation_ = orientation;
+  bool dense = true;
+  for (const auto& p : cloud.points)
+    dense = dense && std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
+  cloud.is_dense = dense;
+  return true;
+}
+
+std::uint32_t
+verdictColour (float probability, double free_below, double collision_above)
+{
+  if (!std::isfinite (probability))
+    return 0x808080u;  // not evaluated: grey
+  if (probability < free_below)
+    return 0x00c000u;  // free: green
+  if (probability > collision_above)
+    return 0xff0000u;  // collision: red
+  return 0xffff00u;    // contact: yellow
+}
+
+bool
+writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides, double free_below,
+                  double collision_above, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+                  std::size_t& points_written, std::string& error)
+{
+  pcl::PCLPointCloud2 blob;
+  auto field = [&] (const char* name, std::uint32_t offset, std::uint8_t type) {
+    pcl::PCLPointField f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = type;
+    f.count = 1;
+    blob.fields.push_back (f);
+  };
+  field ("x", 0, pcl::PCLPointField::FLOAT32);
+  field ("y", 4, pcl::PCLPointField::FLOAT32);
+  field ("z", 8, pcl::PCLPointField::FLOAT32);
+  field ("intensity", 12, pcl::PCLPointField::FLOAT32);
+  field ("rgb", 16, pcl::PCLPointField::FLOAT32);  // PCL's packed-colour convention
+  field ("label", 20, pcl::PCLPointField::UINT32);
+  blob.point_step = 24;
+  std::size_t n = 0;
+  for (const auto& s : sides)
+    n += s.cloud->size ();
+  blob.width = static_cast<std::uint32_t> (n);
+  blob.height = 1;
+  blob.row_step = blob.point_step * blob.width;
+  blob.is_bigendian = false;
+  blob.data.resize (n * blob.point_step);
+  bool dense = true;
+  std::uint8_t* out = blob.data.data ();
+  for (const auto& s : sides)
+  {
+    for (std::size_t i = 0; i < s.cloud->size (); ++i, out += blob.point_step)
+    {
+      const auto& p = (*s.cloud)[i];
+      const float prob = (s.probabilities && i < s.probabilities->size ()) ? (*s.probabilities)[i]
+                                                                           : std::numeric_limits<float>::quiet_NaN ();
+      const std::uint32_t rgb = verdictColour (prob, free_below, collision_above);
+      std::memcpy (out + 0, &p.x, 4);
+      std::memcpy (out + 4, &p.y, 4);
+      std::memcpy (out + 8, &p.z, 4);
+      std::memcpy (out + 12, &prob, 4);
+      std::memcpy (out + 16, &rgb, 4);
+      std::memcpy (out + 20, &s.label, 4);
+      dense = dense && std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
+    }
+  }
+  blob.is_dense = dense;
+
+  namespace fs = std::filesystem;
+  const fs::path target (path);
+  const fs::path dir = target.has_parent_path () ? target.parent_path () : fs::path (".");
+  std::string tmpl = (dir / ("." + target.filename ().string () + ".tmp-XXXXXX")).string ();
+  std::vector<char> buf (tmpl.begin (), tmpl.end ());
+  buf.push_back ('\0');
+  const int fd = ::mkstemp (buf.data ());
+  if (fd < 0)
+  {
+    error = "cannot write '" + path + "': " + std::strerror (errno);
+    return false;
+  }
+  // mkstemp creates 0600; give the result the usual 0666 & ~umask.
+  const mode_t mask = ::umask (0);
+  ::umask (mask);
+  ::fchmod (fd, 0666 & ~mask);
+  ::close (fd);
+  const std::string tmp (buf.data ());
+
+  int rc = -1;
+  try
+  {
+    pcl::PCDWriter writer;
+    rc = writer.writeBinary (tmp, blob, origin, orientation);
+  }
+  catch (const std::exception&)
+  {
+    rc = -1;
+  }
+  if (rc != 0)
+  {
+    std::remove (tmp.c_str ());
+    error = "cannot write '" + path + "' (writing the PCD data failed)";
+    return false;
+  }
+  if (std::rename (tmp.c_str (), path.c_str ()) != 0)
+  {
+    const int e = errno;
+    std::remove (tmp.c_str ());
+    error = "cannot write '" + path + "': " + std::strerror (e);
+    return false;
+  }
+  points_written = n;
+  return true;
+}
+} // namespace pcd_collision

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+// PCD input and output of pcd_collision (pcl/io/pcd_io.h stays in pcd_files.cpp).
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <string>
+#include <vector>
+
+namespace pcd_collision
+{
+/** \brief Loads any PCD with x y z fields into PointXYZ, keeping width/height (organization),
+  * NaN points and the VIEWPOINT (sensor_origin_, sensor_orientation_). x y z of any numeric
+  * type are converted. False with a reason naming the file when the file is unreadable,
+  * malformed or truncated, has no x y z, or has no points. */
+bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error);
+
+/** \brief One side of the -o output. */
+struct LabelledCloud
+{
+  const pcl::PointCloud<pcl::PointXYZ>* cloud = nullptr;  ///< already in the output frame
+  const std::vector<float>* probabilities = nullptr;     ///< per point (NaN = not evaluated); may be null
+  std::uint32_t label = 0;
+};
+
+/** \brief Writes the sides one after the other as a binary PCD with fields x y z intensity
+  * (probability) rgb (verdict colour under the thresholds) label, atomically: a temporary file
+  * in the target directory, then rename (removed on failure). False with a reason on failure. */
+bool writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides, double free_below,
+                       double collision_above, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+                       std::size_t& points_written, std::string& error);
+
+/** \brief The verdict colour of one probability, packed as PCL's rgb (0x00RRGGBB). */
+std::uint32_t verdictColour (float probability, double free_below, double collision_above);
+} // namespace pcd_collision
