@@ -32,17 +32,9 @@ CollisionRequest::validate () const
 bool
 CollisionRequest::operator== (const CollisionRequest& o) const
 {
-  const ClassifierParams& c = classifier;
-  const ClassifierParams& d = o.classifier;
-  const bool same_classifier = c.kernel == d.kernel && c.training == d.training &&
-                               c.confidence == d.confidence && c.gamma_cap == d.gamma_cap && c.C == d.C &&
-                               c.rbf_gamma == d.rbf_gamma && c.rff_features == d.rff_features &&
-                               c.rff_features_large == d.rff_features_large && c.rff_seed == d.rff_seed &&
-                               c.ladder_depth_sigmas == d.ladder_depth_sigmas &&
-                               c.ladder_fraction == d.ladder_fraction && c.max_iterations == d.max_iterations;
   return free_below == o.free_below && collision_above == o.collision_above && exhaustive == o.exhaustive &&
          per_point == o.per_point && enable_timings == o.enable_timings && traversal == o.traversal &&
-         rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && same_classifier &&
+         rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && classifier == o.classifier &&
          hierarchy == o.hierarchy;
 }
 

@@ -3,9 +3,9 @@
 // (METHOD.md 4, 5.1-5.3, 5.5, 5.7, 6.1-6.2).
 #include <pcl_probcollision/robust_classifier.h>
 
+#include <pcl_probcollision/detail/kernels.h>
 #include <pcl_probcollision/detail/linear_separator.h>
 #include <pcl_probcollision/detail/rff_features.h>
-#include <pcl_probcollision/detail/kernels.h>
 #include <pcl_probcollision/detail/rff_separator.h>
 #include <pcl_probcollision/detail/separator_problem.h>
 
@@ -15,7 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <type_traits>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -27,11 +27,13 @@ constexpr double kInf = std::numeric_limits<double>::infinity ();
 constexpr double kCollapse = 1e-8;
 /** \brief Standard deviation along the gradient below this counts as none (METHOD.md 6.1). */
 constexpr double kNoSpread = 1e-12;
-/** \brief Gradient tolerance of L-BFGS, relative to max(1, |J|). Newton reaches 1e-10
-  * (METHOD.md 5.3) in a few steps; L-BFGS gets there only slowly. An error of e in grad J
-  * moves f by at most e (J is 1-strongly convex in w and |phi| = O(1)), far below what
-  * changes P_i, whose scale is the per-point standard deviation along g. */
+/** \brief Gradient tolerance of L-BFGS, relative to max(1, |J|) (Newton uses 1e-10, METHOD.md
+  * 5.3). J is 1-strongly convex in w and |phi_i| <= 1, so an error e in grad J moves w, and f
+  * through it, by about e; at 1e-9 |J| that is far below the per-point standard deviations
+  * along g that scale P_i. */
 constexpr double kRffTolerance = 1e-9;
+/** \brief RFF feature storage (doubles) kept per thread between calls: 4 MB. */
+constexpr std::size_t kWorkspaceKeep = std::size_t (1) << 19;
 /** \brief L-BFGS iterations allowed per unit of ClassifierParams::max_iterations. */
 constexpr int kRffIterationFactor = 10;
 
@@ -184,9 +186,19 @@ fitRff (const detail::SeparatorProblem& p, const ClassifierParams& params,
 {
   RungFit fit;
   fit.rung = rung;
-  // per-thread storage for the n x D feature matrices, kept between calls (classify() stays
-  // const and reentrant); it holds the largest problem seen on the thread
+  // Per-thread storage for the n x D feature matrices, kept between calls so that leaf after
+  // leaf reuses it (classify() stays const and reentrant). Above kWorkspaceKeep doubles it is
+  // released after the fit: big problems are rare and pay their own allocation.
   thread_local std::vector<double> workspace;
+  struct Release
+  {
+    std::vector<double>& w;
+    ~Release ()
+    {
+      if (w.capacity () > kWorkspaceKeep)
+        std::vector<double> ().swap (w);
+    }
+  } release{workspace};
   detail::RffSeparatorSolver solver (p, loss, omega, beta, features, workspace);
   const int max_iterations = kRffIterationFactor * params.max_iterations;
   Eigen::VectorXd theta = Eigen::VectorXd::Zero (features + 1);
@@ -592,282 +604,6 @@ rffFeatureRows (std::size_t n, std::size_t features, const double* x, const doub
   }
 }
 
-// Row blocks (4 rows for f alone, 2 rows for f and g) give 4 to 8 independent accumulator
-// chains: one chain per row would leave the loop waiting on FMA latency.
-PCL_PROBCOLLISION_CLONES void
-rffForward (std::size_t n, std::size_t features, const double* __restrict phi,
-            const double* __restrict sm, const double* __restrict w, const double* __restrict wx,
-            const double* __restrict wy, const double* __restrict wz, double* __restrict f,
-            double* __restrict gx, double* __restrict gy, double* __restrict gz)
-{
-  const std::size_t d = features;
-  std::size_t i = 0;
-  if (!wx)
-  {
-    for (; i + 4 <= n; i += 4)
-    {
-      const double* p0 = phi + i * d;
-      const double* p1 = p0 + d;
-      const double* p2 = p1 + d;
-      const double* p3 = p2 + d;
-      double a0[kLanes] = {}, a1[kLanes] = {}, a2[kLanes] = {}, a3[kLanes] = {};
-      std::size_t k = 0;
-      for (; k + kLanes <= d; k += kLanes)
-        for (std::size_t j = 0; j < kLanes; ++j)
-        {
-          const double wk = w[k + j];
-          a0[j] += p0[k + j] * wk;
-          a1[j] += p1[k + j] * wk;
-          a2[j] += p2[k + j] * wk;
-          a3[j] += p3[k + j] * wk;
-        }
-      double s0 = laneSum (a0), s1 = laneSum (a1), s2 = laneSum (a2), s3 = laneSum (a3);
-      for (; k < d; ++k)
-      {
-        s0 += p0[k] * w[k];
-        s1 += p1[k] * w[k];
-        s2 += p2[k] * w[k];
-        s3 += p3[k] * w[k];
-      }
-      f[i] = s0;
-      f[i + 1] = s1;
-      f[i + 2] = s2;
-      f[i + 3] = s3;
-    }
-    for (; i < n; ++i)
-    {
-      const double* p0 = phi + i * d;
-      double a0[kLanes] = {};
-      std::size_t k = 0;
-      for (; k + kLanes <= d; k += kLanes)
-        for (std::size_t j = 0; j < kLanes; ++j)
-          a0[j] += p0[k + j] * w[k + j];
-      double s0 = laneSum (a0);
-      for (; k < d; ++k)
-        s0 += p0[k] * w[k];
-      f[i] = s0;
-    }
-    return;
-  }
-  for (; i + 2 <= n; i += 2)
-  {
-    const double* p0 = phi + i * d;
-    const double* p1 = p0 + d;
-    const double* q0 = sm + i * d;
-    const double* q1 = q0 + d;
-    double f0[kLanes] = {}, x0[kLanes] = {}, y0[kLanes] = {}, z0[kLanes] = {};
-    double f1[kLanes] = {}, x1[kLanes] = {}, y1[kLanes] = {}, z1[kLanes] = {};
-    std::size_t k = 0;
-    for (; k + kLanes <= d; k += kLanes)
-      for (std::size_t j = 0; j < kLanes; ++j)
-      {
-        const double wk = w[k + j], xk = wx[k + j], yk = wy[k + j], zk = wz[k + j];
-        const double sa = q0[k + j], sb = q1[k + j];
-        f0[j] += p0[k + j] * wk;
-        f1[j] += p1[k + j] * wk;
-        x0[j] += sa * xk;
-        x1[j] += sb * xk;
-        y0[j] += sa * yk;
-        y1[j] += sb * yk;
-        z0[j] += sa * zk;
-        z1[j] += sb * zk;
-      }
-    double sf0 = laneSum (f0), sx0 = laneSum (x0), sy0 = laneSum (y0), sz0 = laneSum (z0);
-    double sf1 = laneSum (f1), sx1 = laneSum (x1), sy1 = laneSum (y1), sz1 = laneSum (z1);
-    for (; k < d; ++k)
-    {
-      sf0 += p0[k] * w[k];
-      sf1 += p1[k] * w[k];
-      sx0 += q0[k] * wx[k];
-      sx1 += q1[k] * wx[k];
-      sy0 += q0[k] * wy[k];
-      sy1 += q1[k] * wy[k];
-      sz0 += q0[k] * wz[k];
-      sz1 += q1[k] * wz[k];
-    }
-    f[i] = sf0;
-    gx[i] = sx0;
-    gy[i] = sy0;
-    gz[i] = sz0;
-    f[i + 1] = sf1;
-    gx[i + 1] = sx1;
-    gy[i + 1] = sy1;
-    gz[i + 1] = sz1;
-  }
-  for (; i < n; ++i)
-  {
-    const double* p0 = phi + i * d;
-    const double* q0 = sm + i * d;
-    double f0[kLanes] = {}, x0[kLanes] = {}, y0[kLanes] = {}, z0[kLanes] = {};
-    std::size_t k = 0;
-    for (; k + kLanes <= d; k += kLanes)
-      for (std::size_t j = 0; j < kLanes; ++j)
-      {
-        f0[j] += p0[k + j] * w[k + j];
-        x0[j] += q0[k + j] * wx[k + j];
-        y0[j] += q0[k + j] * wy[k + j];
-        z0[j] += q0[k + j] * wz[k + j];
-      }
-    double sf0 = laneSum (f0), sx0 = laneSum (x0), sy0 = laneSum (y0), sz0 = laneSum (z0);
-    for (; k < d; ++k)
-    {
-      sf0 += p0[k] * w[k];
-      sx0 += q0[k] * wx[k];
-      sy0 += q0[k] * wy[k];
-      sz0 += q0[k] * wz[k];
-    }
-    f[i] = sf0;
-    gx[i] = sx0;
-    gy[i] = sy0;
-    gz[i] = sz0;
-  }
-}
-
-// Three rows at a time: 9 accumulator chains.
-PCL_PROBCOLLISION_CLONES void
-rffGradients (std::size_t count, const long* __restrict rows, std::size_t features,
-              const double* __restrict sm, const double* __restrict wx,
-              const double* __restrict wy, const double* __restrict wz, double* __restrict gx,
-              double* __restrict gy, double* __restrict gz)
-{
-  const std::size_t d = features;
-  std::size_t a = 0;
-  for (; a + 3 <= count; a += 3)
-  {
-    const std::size_t i0 = static_cast<std::size_t> (rows[a]), i1 = static_cast<std::size_t> (rows[a + 1]),
-                      i2 = static_cast<std::size_t> (rows[a + 2]);
-    const double* q0 = sm + i0 * d;
-    const double* q1 = sm + i1 * d;
-    const double* q2 = sm + i2 * d;
-    double x0[kLanes] = {}, y0[kLanes] = {}, z0[kLanes] = {};
-    double x1[kLanes] = {}, y1[kLanes] = {}, z1[kLanes] = {};
-    double x2[kLanes] = {}, y2[kLanes] = {}, z2[kLanes] = {};
-    std::size_t k = 0;
-    for (; k + kLanes <= d; k += kLanes)
-      for (std::size_t j = 0; j < kLanes; ++j)
-      {
-        const double xk = wx[k + j], yk = wy[k + j], zk = wz[k + j];
-        const double sa = q0[k + j], sb = q1[k + j], sc = q2[k + j];
-        x0[j] += sa * xk;
-        y0[j] += sa * yk;
-        z0[j] += sa * zk;
-        x1[j] += sb * xk;
-        y1[j] += sb * yk;
-        z1[j] += sb * zk;
-        x2[j] += sc * xk;
-        y2[j] += sc * yk;
-        z2[j] += sc * zk;
-      }
-    double sx0 = laneSum (x0), sy0 = laneSum (y0), sz0 = laneSum (z0);
-    double sx1 = laneSum (x1), sy1 = laneSum (y1), sz1 = laneSum (z1);
-    double sx2 = laneSum (x2), sy2 = laneSum (y2), sz2 = laneSum (z2);
-    for (; k < d; ++k)
-    {
-      sx0 += q0[k] * wx[k];
-      sy0 += q0[k] * wy[k];
-      sz0 += q0[k] * wz[k];
-      sx1 += q1[k] * wx[k];
-      sy1 += q1[k] * wy[k];
-      sz1 += q1[k] * wz[k];
-      sx2 += q2[k] * wx[k];
-      sy2 += q2[k] * wy[k];
-      sz2 += q2[k] * wz[k];
-    }
-    gx[i0] = sx0;
-    gy[i0] = sy0;
-    gz[i0] = sz0;
-    gx[i1] = sx1;
-    gy[i1] = sy1;
-    gz[i1] = sz1;
-    gx[i2] = sx2;
-    gy[i2] = sy2;
-    gz[i2] = sz2;
-  }
-  for (; a < count; ++a)
-  {
-    const std::size_t i0 = static_cast<std::size_t> (rows[a]);
-    const double* q0 = sm + i0 * d;
-    double x0[kLanes] = {}, y0[kLanes] = {}, z0[kLanes] = {};
-    std::size_t k = 0;
-    for (; k + kLanes <= d; k += kLanes)
-      for (std::size_t j = 0; j < kLanes; ++j)
-      {
-        x0[j] += q0[k + j] * wx[k + j];
-        y0[j] += q0[k + j] * wy[k + j];
-        z0[j] += q0[k + j] * wz[k + j];
-      }
-    double sx0 = laneSum (x0), sy0 = laneSum (y0), sz0 = laneSum (z0);
-    for (; k < d; ++k)
-    {
-      sx0 += q0[k] * wx[k];
-      sy0 += q0[k] * wy[k];
-      sz0 += q0[k] * wz[k];
-    }
-    gx[i0] = sx0;
-    gy[i0] = sy0;
-    gz[i0] = sz0;
-  }
-}
-
-// Pairs of rows share the loads and stores of grad (and of Omega).
-PCL_PROBCOLLISION_CLONES void
-rffBackward (std::size_t count, const long* __restrict rows, std::size_t features,
-             const double* __restrict phi, const double* __restrict sm, const double* __restrict r,
-             const double* __restrict t0, const double* __restrict t1, const double* __restrict t2,
-             const double* __restrict ox, const double* __restrict oy, const double* __restrict oz,
-             double* __restrict grad)
-{
-  const std::size_t d = features;
-  std::size_t a = 0;
-  for (; a + 2 <= count; a += 2)
-  {
-    const std::size_t i0 = static_cast<std::size_t> (rows[a]), i1 = static_cast<std::size_t> (rows[a + 1]);
-    const double* p0 = phi + i0 * d;
-    const double* p1 = phi + i1 * d;
-    const double r0 = r[i0], r1 = r[i1];
-    std::size_t k = 0;
-    if (!t0)
-    {
-      for (; k + kLanes <= d; k += kLanes)
-        for (std::size_t j = 0; j < kLanes; ++j)
-          grad[k + j] += r0 * p0[k + j] + r1 * p1[k + j];
-      for (; k < d; ++k)
-        grad[k] += r0 * p0[k] + r1 * p1[k];
-      continue;
-    }
-    const double* q0 = sm + i0 * d;
-    const double* q1 = sm + i1 * d;
-    const double u0 = t0[i0], u1 = t1[i0], u2 = t2[i0];
-    const double v0 = t0[i1], v1 = t1[i1], v2 = t2[i1];
-    for (; k + kLanes <= d; k += kLanes)
-      for (std::size_t j = 0; j < kLanes; ++j)
-      {
-        const double xk = ox[k + j], yk = oy[k + j], zk = oz[k + j];
-        grad[k + j] += (r0 * p0[k + j] + q0[k + j] * (xk * u0 + yk * u1 + zk * u2)) +
-                       (r1 * p1[k + j] + q1[k + j] * (xk * v0 + yk * v1 + zk * v2));
-      }
-    for (; k < d; ++k)
-      grad[k] += (r0 * p0[k] + q0[k] * (ox[k] * u0 + oy[k] * u1 + oz[k] * u2)) +
-                 (r1 * p1[k] + q1[k] * (ox[k] * v0 + oy[k] * v1 + oz[k] * v2));
-  }
-  for (; a < count; ++a)
-  {
-    const std::size_t i0 = static_cast<std::size_t> (rows[a]);
-    const double* p0 = phi + i0 * d;
-    const double r0 = r[i0];
-    if (!t0)
-    {
-      for (std::size_t k = 0; k < d; ++k)
-        grad[k] += r0 * p0[k];
-      continue;
-    }
-    const double* q0 = sm + i0 * d;
-    const double u0 = t0[i0], u1 = t1[i0], u2 = t2[i0];
-    for (std::size_t k = 0; k < d; ++k)
-      grad[k] += r0 * p0[k] + q0[k] * (ox[k] * u0 + oy[k] * u1 + oz[k] * u2);
-  }
-}
-
 namespace
 {
 /** \brief C l(v) and C l'(v). */
@@ -1112,6 +848,30 @@ rffObjective (const RffRows& q, const double* __restrict w, double b, const doub
   }
   *grad_b += gb;
   return total;
+}
+
+PCL_PROBCOLLISION_CLONES void
+rffForward (std::size_t n, std::size_t features, const double* __restrict phi,
+            const double* __restrict sm, const double* __restrict w, const double* __restrict wx,
+            const double* __restrict wy, const double* __restrict wz, double* __restrict f,
+            double* __restrict gx, double* __restrict gy, double* __restrict gz)
+{
+  const std::size_t d = features;
+  for (std::size_t i0 = 0; i0 < n; i0 += 4)
+  {
+    const std::size_t m = n - i0 < 4 ? n - i0 : 4;
+    const std::size_t r1 = i0 + (m > 1 ? 1 : 0), r2 = i0 + (m > 2 ? 2 : 0), r3 = i0 + (m > 3 ? 3 : 0);
+    double ff[4], x[4], y[4], z[4];
+    rowDots4 (phi + i0 * d, phi + r1 * d, phi + r2 * d, phi + r3 * d, w, d, ff);
+    rowGradients4 (sm + i0 * d, sm + r1 * d, sm + r2 * d, sm + r3 * d, wx, wy, wz, d, x, y, z);
+    for (std::size_t r = 0; r < m; ++r)
+    {
+      f[i0 + r] = ff[r];
+      gx[i0 + r] = x[r];
+      gy[i0 + r] = y[r];
+      gz[i0 + r] = z[r];
+    }
+  }
 }
 
 PCL_PROBCOLLISION_CLONES void
@@ -1369,6 +1129,13 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
 
   // Output (METHOD.md 6.1-6.2)
+  if (!best.theta.allFinite () || !best.probability.allFinite ())
+  {
+    // a numeric failure gives NaN and a status, never a plausible-looking number
+    result.message = "[pcl_probcollision::RobustClassifier::classify] the solver produced a "
+                     "non-finite separator";
+    return false;
+  }
   result.ok = true;
   result.rung = best.rung;
   result.converged = best.converged;

@@ -361,6 +361,135 @@ TEST (RobustClassifier, SymmetricMidCrossingCollapses)
 }
 
 // ---------------------------------------------------------------------------------------------
+// The linear solver and the robust procedure (METHOD.md 5.2, 5.3), checked from the definition
+// ---------------------------------------------------------------------------------------------
+
+namespace
+{
+/** \brief J(w, b) of METHOD.md 5.3 (squared hinge), written out independently of the library:
+  * Uniform normalisation, class-balanced C_i, eps_s = 1e-12, eta_b = 1e-10. */
+struct LinearObjective
+{
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Matrix3d> sigma;
+  std::vector<double> label, weight;
+  double gamma = 0.0;
+
+  LinearObjective (const Cloud& a, const Cloud& b, double c, double gamma_)
+    : gamma (gamma_)
+  {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
+    for (const Cloud* side : {&a, &b})
+      for (const Eigen::Vector3d& m : side->means)
+        centroid += m;
+    const double n = static_cast<double> (a.size () + b.size ());
+    centroid /= n;
+    double r = 0.0;
+    for (const Cloud* side : {&a, &b})
+      for (const Eigen::Vector3d& m : side->means)
+        r = std::max (r, (m - centroid).norm ());
+    const double scale = 0.5 / r;
+    for (const Cloud* side : {&a, &b})
+      for (std::size_t i = 0; i < side->size (); ++i)
+      {
+        x.push_back (scale * (side->means[i] - centroid) + Eigen::Vector3d::Constant (0.5));
+        sigma.push_back (scale * scale * side->covariances[i]);
+        label.push_back (side == &a ? 1.0 : -1.0);
+        weight.push_back (c * n / (2.0 * static_cast<double> (side->size ())));
+      }
+  }
+
+  double operator() (const Eigen::Vector4d& theta) const
+  {
+    const Eigen::Vector3d w = theta.head<3> ();
+    double j = 0.5 * w.squaredNorm () + 0.5 * 1e-10 * theta (3) * theta (3);
+    for (std::size_t i = 0; i < x.size (); ++i)
+    {
+      const double v = 1.0 - label[i] * (w.dot (x[i]) + theta (3)) + gamma * std::sqrt (w.dot (sigma[i] * w) + 1e-24);
+      j += weight[i] * 0.5 * std::max (v, 0.0) * std::max (v, 0.0);
+    }
+    return j;
+  }
+};
+
+Eigen::Vector4d
+theta (const ClassifierResult& r)
+{
+  Eigen::Vector4d t;
+  t << r.separator.weights, r.separator.bias;
+  return t;
+}
+} // namespace
+
+TEST (RobustClassifier, LinearSolutionMinimisesTheObjective)
+{
+  // The returned (w, b) must be the minimiser of J: J is convex, so a point where no
+  // direction decreases J (beyond rounding, ~1e-13 |J|) and the central-difference slope
+  // vanishes (the solver stops at |grad J| <= 1e-10 max(1, |J|)) is the global minimum.
+  Cloud a, b;
+  genericPatches (a, b);
+  std::mt19937_64 rng (17);
+  std::normal_distribution<double> z (0.0, 1.0);
+  for (TrainingMode mode : {TrainingMode::Standard, TrainingMode::Robust})
+  {
+    ClassifierParams p = oracle (mode);
+    p.C = 10.0;
+    const ClassifierResult r = classify (p, a, b);
+    ASSERT_TRUE (r.converged);
+    const LinearObjective objective (a, b, p.C, r.gamma_effective);
+    const Eigen::Vector4d t = theta (r);
+    const double j0 = objective (t);
+    EXPECT_NEAR (j0, r.objective, 1e-12 * j0);
+    for (int k = 0; k < 100; ++k)
+    {
+      const Eigen::Vector4d dir = Eigen::Vector4d (z (rng), z (rng), z (rng), z (rng)).normalized ();
+      const double h = 1e-4 * t.norm ();
+      EXPECT_GE (objective (t + h * dir) - j0, -1e-13 * j0);
+      // J is piecewise quadratic, so the central difference has no truncation error away from
+      // the hinges; its rounding error is at most n eps |J| / step (n summed terms)
+      const double step = 1e-5;
+      const double slope = (objective (t + step * dir) - objective (t - step * dir)) / (2.0 * step);
+      const double rounding = static_cast<double> (objective.x.size ()) * 1.1e-16 * j0 / step;
+      EXPECT_LT (std::abs (slope), 1e-10 * std::max (1.0, j0) + rounding);
+    }
+  }
+}
+
+TEST (RobustClassifier, RobustGammaFollowsTheStandardSolution)
+{
+  // METHOD.md 5.2: t_hat = min c_i f_i / s_i over s_i > 0 on the Standard solution,
+  // gamma_eff = min(gamma, 0.9 max(0, t_hat)).
+  Cloud a, b;
+  genericPatches (a, b);
+  for (double scale : {0.5, 2.0, 8.0})
+  {
+    Cloud na = a, nb = b;
+    for (Eigen::Matrix3d& c : na.covariances)
+      c *= scale * scale;
+    for (Eigen::Matrix3d& c : nb.covariances)
+      c *= scale * scale;
+    ClassifierParams p = oracle (TrainingMode::Standard);
+    p.C = 10.0;
+    const ClassifierResult standard = classify (p, na, nb);
+    const LinearObjective o (na, nb, p.C, 0.0);
+    const Eigen::Vector4d t = theta (standard);
+    double t_hat = std::numeric_limits<double>::infinity ();
+    for (std::size_t i = 0; i < o.x.size (); ++i)
+    {
+      const double s = std::sqrt (t.head<3> ().dot (o.sigma[i] * t.head<3> ()));
+      if (s > 0.0)
+        t_hat = std::min (t_hat, o.label[i] * (t.head<3> ().dot (o.x[i]) + t (3)) / s);
+    }
+    p.training = TrainingMode::Robust;
+    const ClassifierResult robust = classify (p, na, nb);
+    const double expected = std::min (normalQuantile (0.9), 0.9 * std::max (0.0, t_hat));
+    std::cout << "[ robust gamma ] noise x" << scale << ": t_hat " << t_hat << ", gamma_eff "
+              << robust.gamma_effective << "\n";
+    EXPECT_NEAR (robust.gamma_effective, expected, 1e-12 * std::max (1.0, expected));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // 11.2 Parallel planes, unequal noise; 11.3 plane against a single point
 // ---------------------------------------------------------------------------------------------
 
@@ -781,6 +910,44 @@ TEST (RobustClassifier, CurvedBowlNeedsTheKernelRung)
   for (int side = 0; side < 2; ++side)
     for (const Eigen::Vector3d& x : side == 0 ? ball.means : cup.means)
       EXPECT_GT ((side == 0 ? 1.0 : -1.0) * ladder.evaluate (r.separator, x), 0.0);
+}
+
+TEST (RobustClassifier, FewFeaturesAndTheLargeRung)
+{
+  // D = 8 is below the preconditioner's 10 directions; the large rung must also run
+  Cloud ball, cup;
+  bowl (100, 0.01, ball, cup);
+  ClassifierParams p;
+  p.kernel = KernelMode::RFF;
+  p.rff_features = 8;
+  p.rff_features_large = 8;
+  const ClassifierResult small = classify (p, ball, cup);
+  EXPECT_EQ (small.rung, Rung::RFF);
+  EXPECT_EQ (small.separator.weights.size (), 8);
+  EXPECT_TRUE (small.converged);
+  EXPECT_GE (minOf (small.probabilities_a), 0.0);
+  EXPECT_LE (maxOf (small.probabilities_b), 1.0);
+  // a ladder whose first kernel rung (D = 8) is too weak escalates to the large one
+  ClassifierParams ladder;
+  ladder.rff_features = 8;
+  ladder.rff_features_large = 256;
+  const ClassifierResult r = classify (ladder, ball, cup);
+  std::cout << "[ ladder 8 -> 256 ] rung " << static_cast<int> (r.rung) << ", tried " << r.rungs_tried
+            << ", misclassified " << r.misclassified << ", P " << r.probability << "\n";
+  EXPECT_GE (r.rungs_tried, 2);
+  EXPECT_EQ (r.misclassified, 0u);
+  EXPECT_LT (r.probability, 0.05);
+}
+
+TEST (RobustClassifier, ParamsEquality)
+{
+  ClassifierParams a, b;
+  EXPECT_TRUE (a == b);
+  b.loss = Loss::Huber;
+  EXPECT_TRUE (a != b);
+  b = a;
+  b.rff_seed = 7;
+  EXPECT_FALSE (a == b);
 }
 
 TEST (RobustClassifier, LadderKeepsThePlaneWhenItIsEnough)

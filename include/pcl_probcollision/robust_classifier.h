@@ -107,10 +107,17 @@ struct ClassifierResult
   bool ok = false;                 ///< false: inputs unusable, see message
   std::string message;
   Rung rung = Rung::None;
-  bool converged = false;          ///< the solver met its gradient tolerance
+  /** \brief Every solve of the kept rung met its tolerance: Newton |grad J| <= 1e-10
+    * max(1, |J|) or an accepted step below 1e-12 (METHOD.md 5.3); L-BFGS |grad J| <= 1e-9
+    * max(1, |J|). False after the iteration cap or a failed line search. */
+  bool converged = false;
   int iterations = 0;              ///< solver iterations summed over the rungs tried
-  double objective = std::numeric_limits<double>::quiet_NaN ();
-  bool degenerate = false;         ///< no separating direction (|grad f| < 1e-8 everywhere)
+  double objective = std::numeric_limits<double>::quiet_NaN ();  ///< final J of the kept rung
+  /** \brief No separating direction: |grad f| < 1e-8 at every point (METHOD.md 6.1); then
+    * every P_i and probability are 0.5. */
+  bool degenerate = false;
+  /** \brief The gamma the kept rung was trained with: 0 for Standard training, and for
+    * Robust training when the Standard fit penetrates (t_hat <= 0) or collapsed. */
   double gamma_effective = std::numeric_limits<double>::quiet_NaN ();
 
   std::vector<double> probabilities_a;  ///< P_i for the points of A (label +1)
@@ -119,10 +126,11 @@ struct ClassifierResult
   double probability = std::numeric_limits<double>::quiet_NaN ();  ///< max over both sides
   int witness_side = 0;            ///< +1: the maximum is a point of A; -1: of B
   std::size_t witness_index = 0;   ///< index of that point within its side
-  /** \brief Unit gradient of f at the witness in the input frame (points toward A's side). */
+  /** \brief Unit gradient of f at the witness in the input frame (points toward A's side);
+    * NaN when the gradient collapsed there. */
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
-  /** \brief Signed distance of the witness to the surface, first order, input units; positive
-    * on its own side. */
+  /** \brief Signed distance of the witness to the surface, first order (c_i f_i / |g_i|),
+    * input units; positive on its own side. NaN when the gradient collapsed there. */
   double witness_distance = std::numeric_limits<double>::quiet_NaN ();
 
   /** \brief Points of the fitted rung on the wrong side by more than ladder_depth_sigmas of
@@ -156,7 +164,15 @@ struct ClassifierResult
   * points. Of the rungs fitted it keeps the non-degenerate one with the fewest misclassified
   * points; ties go to the simpler rung, and when every rung is degenerate the plane is kept.
   *
-  * \note Thread safety: classify() is const and may run concurrently on one instance.
+  * Numbers: L-BFGS stops at |grad J| <= 1e-9 max(1, |J|) and may take 10 * max_iterations
+  * steps (each costs O(n D), against O(n) per Newton step). The RFF loops are compiled for
+  * several x86-64 instruction sets and chosen at load time (detail/kernels.h), so RFF results
+  * may differ between machines at the level of rounding.
+  *
+  * \note Thread safety: classify() is const and may run concurrently on one instance. Each
+  * thread keeps a buffer for the RFF feature matrices (16 n D bytes) between calls; buffers
+  * above 4 MB are released after use.
+  * \note classify() prints nothing: callers report result.message as they see fit.
   */
 class RobustClassifier
 {

@@ -48,16 +48,11 @@ void rffFeatureRows (std::size_t n, std::size_t features, const double* x, const
                      const double* z, const double* ox, const double* oy, const double* oz,
                      const double* beta, double* phi, double* sm);
 
-/** \brief f_i = phi_i . w and, when wx is not null, g_i = (sm_i . wx, sm_i . wy, sm_i . wz)
-  * (with wx = w o Omega_x etc. this is grad f at x_i, since sm_i carries -sqrt(2/D)). */
+/** \brief f_i = phi_i . w and g_i = (sm_i . wx, sm_i . wy, sm_i . wz) for every row (with
+  * wx = w o Omega_x etc. g_i is grad f at x_i, since sm_i carries -sqrt(2/D)). */
 void rffForward (std::size_t n, std::size_t features, const double* phi, const double* sm,
                  const double* w, const double* wx, const double* wy, const double* wz,
                  double* f, double* gx, double* gy, double* gz);
-
-/** \brief g_i = (sm_i . wx, sm_i . wy, sm_i . wz) for the listed rows i only. */
-void rffGradients (std::size_t count, const long* rows, std::size_t features, const double* sm,
-                   const double* wx, const double* wy, const double* wz, double* gx, double* gy,
-                   double* gz);
 
 /** \brief The per-point data of the RFF rung. */
 struct RffRows
@@ -84,12 +79,6 @@ double rffObjective (const RffRows& rows, const double* w, double b, const doubl
                      double eps, const double* s_bound, double displacement, double* s_bound_out,
                      double* v, double* grad, double* grad_b);
 
-/** \brief grad += sum over the listed rows i of r_i phi_i + sm_i o (ox t0_i + oy t1_i + oz t2_i);
-  * the second term only when t0 is not null. */
-void rffBackward (std::size_t count, const long* rows, std::size_t features, const double* phi,
-                  const double* sm, const double* r, const double* t0, const double* t1,
-                  const double* t2, const double* ox, const double* oy, const double* oz,
-                  double* grad);
 /** \brief Number of columns of the preconditioner's projection (rff_separator.h). */
 constexpr std::size_t kProjection = 10;
 

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <new>
 #include <vector>
 
 namespace pcl_probcollision
@@ -35,13 +36,15 @@ namespace detail
   * case and then stalled at |grad J| ~ 1e-6; with H0 = M^-1, where M is the exact Standard
   * Hessian on span(Phi^T Q) + the bias (Q: the 10 monomials of degree <= 2 of the centred
   * coordinates) and the identity (the regulariser's curvature) elsewhere, it converges to
-  * 1e-10 relative in ~20. M is refreshed every iteration from the current active set; that
-  * costs O(n m^2), m = 10. */
+  * 1e-10 relative in ~20. M follows the active set: built in O(n m^2) (m = 10) when a solve
+  * starts, then updated by rank one per point that enters or leaves it.
+  *
+  * Robust evaluations skip g_i, exactly, for points that are certainly inactive (see
+  * valueAndGradient()). */
 class RffSeparatorSolver
 {
 public:
   using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  using Gradients = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
   static constexpr int kMemory = 10;
 
