@@ -1011,7 +1011,8 @@ ClassifierParams::operator== (const ClassifierParams& o) const
          gamma_cap == o.gamma_cap && C == o.C && rbf_gamma == o.rbf_gamma &&
          rff_features == o.rff_features && rff_features_large == o.rff_features_large &&
          rff_seed == o.rff_seed && ladder_depth_sigmas == o.ladder_depth_sigmas &&
-         ladder_fraction == o.ladder_fraction && max_iterations == o.max_iterations && loss == o.loss;
+         ladder_fraction == o.ladder_fraction && max_iterations == o.max_iterations && loss == o.loss &&
+         exact_points_in_maximum == o.exact_points_in_maximum;
 }
 
 RobustClassifier::RobustClassifier (const ClassifierParams& params) : params_ (params)
@@ -1146,8 +1147,23 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   result.misclassified = best.misclassified;
   result.probabilities_a.assign (best.probability.data (), best.probability.data () + na);
   result.probabilities_b.assign (best.probability.data () + na, best.probability.data () + n);
-  Eigen::Index witness = 0;
-  result.probability = best.probability.maxCoeff (&witness);
+  Eigen::Index witness = -1;
+  result.probability = -1.0;
+  if (!params_.exact_points_in_maximum)
+  {
+    // The maximum over the uncertain points (see ClassifierParams::exact_points_in_maximum).
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index> (n); ++i)
+    {
+      const Eigen::Matrix3d& c = i < p.n_a ? a.covariances[i] : b.covariances[i - p.n_a];
+      if (c.trace () > 0.0 && best.probability (i) > result.probability)
+      {
+        result.probability = best.probability (i);
+        witness = i;
+      }
+    }
+  }
+  if (witness < 0)
+    result.probability = best.probability.maxCoeff (&witness);
   if (best.degenerate)
     result.probability = 0.5;
   result.witness_side = witness < p.n_a ? 1 : -1;

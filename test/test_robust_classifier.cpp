@@ -1295,3 +1295,43 @@ TEST (RobustClassifier, ConcurrentClassifyOnOneInstance)
     EXPECT_EQ (r.probabilities_b, reference.probabilities_b);
   }
 }
+
+// Exact points (mesh samples, zero covariance) only say which side of the fitted surface they
+// fall on; by default the maximum runs over the uncertain points (METHOD.md 9).
+TEST (RobustClassifier, ExactPointsStayOutOfTheMaximumByDefault)
+{
+  const double sigma = 0.01;
+  std::vector<Eigen::Vector3d> ma, mb;
+  std::vector<Eigen::Matrix3d> ca, cb;
+  for (int j = 0; j < 11; ++j)
+    for (int i = 0; i < 11; ++i)
+    {
+      // A: an exact grid on z = 0 with one sample raised above B's plane.
+      ma.emplace_back (0.1 * i, 0.1 * j, (i == 5 && j == 5) ? 1.5 * sigma : 0.0);
+      ca.push_back (Eigen::Matrix3d::Zero ());
+      // B: uncertain samples on z = sigma, over the same grid.
+      mb.emplace_back (0.1 * i, 0.1 * j, sigma);
+      cb.push_back (sigma * sigma * Eigen::Matrix3d::Identity ());
+    }
+  ClassifierParams params;
+  params.kernel = KernelMode::Linear;
+  params.C = 1e6;  // the hard-margin limit: the plane lies between the two grids
+  ClassifierResult uncertain_max, all_max;
+  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), uncertain_max));
+  params.exact_points_in_maximum = true;
+  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), all_max));
+  // Same fit, same per-point values; only the maximum differs.
+  EXPECT_EQ (uncertain_max.probabilities_a, all_max.probabilities_a);
+  EXPECT_EQ (uncertain_max.probabilities_b, all_max.probabilities_b);
+  EXPECT_EQ (all_max.probability, 1.0);
+  EXPECT_EQ (all_max.witness_side, 1);
+  EXPECT_EQ (uncertain_max.witness_side, -1);
+  // B's points sit one sigma above A's plane and the separator lies between: P_i >= Phi(-1).
+  EXPECT_GE (uncertain_max.probability, normalCdf (-1.0) - 1e-12);
+  EXPECT_LT (uncertain_max.probability, 0.9);  // nothing says penetration
+  // Every point exact: the maximum falls back to all points.
+  ClassifierResult exact_only;
+  std::vector<Eigen::Matrix3d> zero (cb.size (), Eigen::Matrix3d::Zero ());
+  ASSERT_TRUE (RobustClassifier (ClassifierParams ()).classify (PointSetView (ma, ca), PointSetView (mb, zero), exact_only));
+  EXPECT_EQ (exact_only.probability, 1.0);
+}

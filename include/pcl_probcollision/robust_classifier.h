@@ -70,6 +70,14 @@ struct ClassifierParams
   double ladder_depth_sigmas = 3.0;
   /** \brief Ladder: escalate when the fraction of misclassified points exceeds this, [0, 1). */
   double ladder_fraction = 0.0;
+  /** \brief Whether exact points (zero covariance, e.g. mesh samples, METHOD.md 9) take part
+    * in the maximum. Their P_i is 0, 0.5 or 1 by the side of the fitted surface they fall on
+    * (METHOD.md 6.1): a property of the fit, not a probability, so one exact sample a hair over
+    * a separator fitted to noisy data would make P = 1 for surfaces that merely touch. false
+    * (default, METHOD.md 9: "only the cloud's points contribute graded probabilities"): the
+    * maximum runs over the points with uncertainty, and over all points only when every point
+    * is exact. Per-point values are reported either way. */
+  bool exact_points_in_maximum = false;
   /** \brief Newton iteration cap of the linear rung (>= 1). The RFF rung runs L-BFGS, whose
     * iterations are much cheaper and less effective; it gets 10 * max_iterations. */
   int max_iterations = 100;
