@@ -294,6 +294,11 @@ TEST (ProbabilisticCollision, UnusableInputsFailWithAMessage)
   Eigen::Isometry3d sheared = Eigen::Isometry3d::Identity ();
   sheared.linear () (0, 1) = 0.5;
   EXPECT_FALSE (pc.compute (sheared, r));
+  EXPECT_NE (r.message.find ("pose"), std::string::npos) << r.message;
+  Eigen::Isometry3d nan_pose = Eigen::Isometry3d::Identity ();
+  nan_pose.translation ().x () = std::nan ("");
+  EXPECT_FALSE (pc.compute (nan_pose, r));
+  EXPECT_TRUE (std::isnan (r.probability));
   EXPECT_TRUE (pc.compute (r)) << r.message;
   EXPECT_THROW (pc.setProbabilityThreshold (1.5), pcl::BadArgumentException);
   EXPECT_THROW (pc.setThresholds (0.6, 0.4), pcl::BadArgumentException);

@@ -210,6 +210,13 @@ bool
 ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
 {
   result = CollisionResult ();
+  const Eigen::Matrix3d R = T_target_input.linear ();
+  if (!T_target_input.matrix ().allFinite () || !(R.transpose () * R).isIdentity (1e-6) || R.determinant () < 0.0)
+  {
+    result.message = "pose T_target_input is not a finite rotation plus translation";
+    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
+    return false;
+  }
   if (!this->input_)
   {
     result.message = "no input cloud given (setInputCloud)";
