@@ -1215,12 +1215,6 @@ RobustClassifier::evaluate (const SeparatorModel& model, const Eigen::Vector3d& 
 }
 
 double
-normalCdf (double z)
-{
-  return 0.5 * std::erfc (-z * 0.70710678118654752440);
-}
-
-double
 normalQuantile (double p)
 {
   if (!(p >= 0.0 && p <= 1.0))

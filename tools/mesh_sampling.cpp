@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "mesh_sampling.h"
 
+#include <pcl_probcollision/normal_distribution.h>
+
 #include <pcl/kdtree/kdtree_flann.h>
 
 #include <Eigen/Core>
@@ -15,14 +17,6 @@ namespace pcd_collision
 {
 namespace
 {
-/** \brief Uniform in [0, 1) from the top 53 bits (std::uniform_real_distribution is
-  * implementation-defined; this is not). */
-double
-uniform01 (std::mt19937_64& rng)
-{
-  return static_cast<double> (rng () >> 11) * (1.0 / 9007199254740992.0);
-}
-
 Eigen::Vector3d
 vertex (const TriangleMesh& mesh, int i)
 {
@@ -86,12 +80,12 @@ sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::s
   for (const auto& t : mesh.triangles)
   {
     const double n_expected = triangleArea (mesh, t) / (spacing * spacing);
-    const auto n = static_cast<std::size_t> (std::floor (n_expected + uniform01 (rng)));
+    const auto n = static_cast<std::size_t> (std::floor (n_expected + pcl_probcollision::detail::uniformUnit (rng)));
     const Eigen::Vector3d a = vertex (mesh, t[0]), b = vertex (mesh, t[1]), c = vertex (mesh, t[2]);
     for (std::size_t s = 0; s < n; ++s)
     {
-      const double r1 = std::sqrt (uniform01 (rng));
-      const double r2 = uniform01 (rng);
+      const double r1 = std::sqrt (pcl_probcollision::detail::uniformUnit (rng));
+      const double r2 = pcl_probcollision::detail::uniformUnit (rng);
       const Eigen::Vector3d p = (1.0 - r1) * a + r1 * (1.0 - r2) * b + r1 * r2 * c;
       cloud.push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
     }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/normal_distribution.h>
 #include <pcl_probcollision/uncertain_points.h>
 
 #include <Eigen/Core>
@@ -217,9 +218,4 @@ private:
   Eigen::VectorXd beta_;
 };
 
-/** \brief Standard normal CDF, Phi(z) = erfc(-z / sqrt 2) / 2, accurate in both tails. */
-double normalCdf (double z);
-/** \brief Inverse of normalCdf for p in (0, 1): Acklam's rational approximation refined by one
-  * Halley step on erfc (relative error ~1e-15). Returns -inf at 0, +inf at 1, NaN outside. */
-double normalQuantile (double p);
 } // namespace pcl_probcollision

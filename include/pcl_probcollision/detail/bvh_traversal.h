@@ -3,6 +3,7 @@
 
 #include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/detail/obb.h>
+#include <pcl_probcollision/normal_distribution.h>
 
 #include <pcl/exceptions.h>
 
@@ -131,14 +132,6 @@ struct TraversalResult
   }
   bool operator!= (const TraversalResult& o) const { return !(*this == o); }
 };
-
-/** \brief Uniform double in [0, 1) from the top 53 bits: the same sequence on every platform
-  * (std::uniform_real_distribution is implementation-defined). */
-inline double
-uniformUnit (std::mt19937_64& rng)
-{
-  return static_cast<double> (rng () >> 11) * (1.0 / 9007199254740992.0);
-}
 
 /** \brief Throws pcl::BadArgumentException unless T's linear part is a rotation (1e-6). */
 inline void

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <pcl_probcollision/detail/obb.h>
+#include <pcl_probcollision/normal_distribution.h>
 
 #include <Eigen/Core>
 
@@ -12,13 +13,6 @@ namespace pcl_probcollision
 {
 namespace detail
 {
-/** \brief Standard normal CDF Phi(z) = erfc(-z / sqrt 2) / 2, accurate in both tails. */
-inline double
-standardNormalCdf (double z)
-{
-  return 0.5 * std::erfc (-z * 0.70710678118654752440);
-}
-
 /** \brief |z| beyond which a tail term Phi(-|z|) (< 7.7e-24) is taken as 0 to save an erfc. */
 constexpr double kNegligibleTailZ = 10.0;
 
@@ -37,8 +31,8 @@ slabOutsideProbability (double lo, double hi, double m, double s)
     return (m >= lo && m <= hi) ? 0.0 : 1.0;
   const double z_lo = (lo - m) / s;  // below the lower face: Phi(z_lo)
   const double z_hi = (hi - m) / s;  // above the upper face: Phi(-z_hi)
-  const double below = (z_lo < -kNegligibleTailZ) ? 0.0 : standardNormalCdf (z_lo);
-  const double above = (z_hi > kNegligibleTailZ) ? 0.0 : standardNormalCdf (-z_hi);
+  const double below = (z_lo < -kNegligibleTailZ) ? 0.0 : normalCdf (z_lo);
+  const double above = (z_hi > kNegligibleTailZ) ? 0.0 : normalCdf (-z_hi);
   return std::min (1.0, below + above);
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <pcl_probcollision/detail/kernels.h>
+#include <pcl_probcollision/normal_distribution.h>
 
 #include <Eigen/Core>
 
@@ -30,7 +31,7 @@ drawRandomFourierFeatures (std::uint64_t seed, int features, double rbf_gamma,
                            Eigen::MatrixXd& omega, Eigen::VectorXd& beta)
 {
   std::mt19937_64 engine (seed);
-  const auto uniform = [&engine] () { return static_cast<double> (engine () >> 11) * 0x1.0p-53; };
+  const auto uniform = [&engine] () { return uniformUnit (engine); };
   bool have_spare = false;
   double spare = 0.0;
   const auto normal = [&] () {
