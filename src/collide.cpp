@@ -98,6 +98,14 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
     fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b is not a rotation plus translation");
     return false;
   }
+  // A finite but absurd translation overflows when B's points and boxes are mapped (inf - inf:
+  // NaN boxes never prune, so the traversal fitted every leaf pair for minutes; found by
+  // fuzz/fuzz_collide, fuzz/regressions/). Same bound as ProbabilisticCollision's coordinates.
+  if (!(T_a_b.translation ().cwiseAbs ().maxCoeff () <= 1e15))
+  {
+    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b translation is beyond the supported range of +-1e15");
+    return false;
+  }
 
   // The caller's classifier carries the random-feature draw; without one, draw it here.
   std::optional<RobustClassifier> own;

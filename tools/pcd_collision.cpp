@@ -171,6 +171,9 @@ private:
 };
 
 // ---------------------------------------------------------------------------------------------
+/** \brief Sizes (bounding-box diagonals) differing by more than this get a units warning. */
+constexpr double kScaleWarningRatio = 100.0;
+
 struct Input
 {
   std::string path;
@@ -458,10 +461,57 @@ witnessLine (const pcl_probcollision::CollisionResult& r)
   if (r.witness_side == 0)
     return "  witness: none (no leaf pair tested)";
   char buf[256];
-  std::snprintf (buf, sizeof (buf), "  witness: %s[%d] at (%.4f, %.4f, %.4f), normal (%.3f, %.3f, %.3f)",
-                 r.witness_side > 0 ? "a" : "b", r.witness_index, r.witness_point.x (), r.witness_point.y (),
-                 r.witness_point.z (), r.witness_normal.x (), r.witness_normal.y (), r.witness_normal.z ());
-  return buf;
+  std::snprintf (buf, sizeof (buf), "  witness: %s[%d] at (%.4f, %.4f, %.4f), ", r.witness_side > 0 ? "a" : "b",
+                 r.witness_index, r.witness_point.x (), r.witness_point.y (), r.witness_point.z ());
+  std::string line = buf;
+  // The normal is NaN when the separator's gradient collapsed there (coincident points): never
+  // print NaN.
+  if (r.witness_normal.allFinite ())
+  {
+    std::snprintf (buf, sizeof (buf), "normal (%.3f, %.3f, %.3f)", r.witness_normal.x (), r.witness_normal.y (),
+                   r.witness_normal.z ());
+    line += buf;
+  }
+  else
+    line += "normal undefined (no separating direction)";
+  return line;
+}
+
+/** \brief Bounding-box diagonal of an input as loaded: the finite points of a cloud, the vertices
+  * of a mesh (0 for a single point). */
+double
+inputDiagonal (const Input& in)
+{
+  if (in.kind == InputKind::Mesh)
+    return meshDiagonal (in.mesh);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& p : in.cloud->points)
+    if (std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z))
+    {
+      const Eigen::Vector3d q = p.getVector3fMap ().cast<double> ();
+      lo = lo.cwiseMin (q);
+      hi = hi.cwiseMax (q);
+    }
+  return (hi.array () >= lo.array ()).all () ? (hi - lo).norm () : 0.0;
+}
+
+/** \brief Both inputs must be in the same units (docs/CLI.md). A millimetre scan against a metre
+  * mesh makes sizes differ by 1000x: warn on stderr when they differ by more than 100x. A warning,
+  * not an error: a screw against a room is legitimate. */
+void
+warnIfScalesDiffer (const Input& a, const Input& b)
+{
+  const double da = inputDiagonal (a), db = inputDiagonal (b);
+  if (!(da > 0.0 && db > 0.0 && std::isfinite (da) && std::isfinite (db)))
+    return;
+  const double ratio = std::max (da, db) / std::min (da, db);
+  if (ratio > kScaleWarningRatio)
+    std::fprintf (stderr,
+                  "pcd_collision: warning: the inputs' sizes differ by %.0fx (bounding-box diagonal %.6g in '%s', "
+                  "%.6g in '%s'); both must be in the same units (e.g. metres), so convert one of them if they "
+                  "are not\n",
+                  ratio, da, a.path.c_str (), db, b.path.c_str ());
 }
 
 /** \brief "\r[12/300 poses]" on stderr when it is a terminal, at most every 0.2 s, first after
@@ -546,6 +596,7 @@ run (int argc, char** argv)
   b.kind = inputKindOf (b.path);
   loadInput (a, log);
   loadInput (b, log);
+  warnIfScalesDiffer (a, b);
 
   // MeshSampled mode: spacing from -mesh_density, the other cloud, or the meshes' size.
   for (Input* m : {&a, &b})
@@ -641,6 +692,7 @@ run (int argc, char** argv)
 int
 main (int argc, char** argv)
 {
+  pcd_collision::installInterruptCleanup ();
   try
   {
     return pcd_collision::run (argc, argv);

@@ -6,6 +6,7 @@
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -21,6 +22,60 @@ namespace pcd_collision
 {
 namespace
 {
+// The temporary file of writeResultCloud while it exists, for the signal handler: an interrupted
+// run (SIGINT, SIGTERM, SIGHUP) must leave no partial file behind (docs/RELIABILITY.md).
+char g_temp_path[4096];
+volatile sig_atomic_t g_temp_active = 0;
+
+extern "C" void
+removeTempAndDie (int sig)
+{
+  // Only async-signal-safe calls: unlink, sigaction, raise.
+  if (g_temp_active)
+    ::unlink (g_temp_path);
+  struct sigaction dfl;
+  std::memset (&dfl, 0, sizeof (dfl));
+  dfl.sa_handler = SIG_DFL;
+  ::sigaction (sig, &dfl, nullptr);
+  ::raise (sig);  // die of the same signal, so the parent sees it
+}
+
+/** \brief Blocks the interrupting signals for its lifetime, so that creating the temporary file
+  * and registering it for removal happen as one step. */
+class BlockInterrupts
+{
+public:
+  BlockInterrupts ()
+  {
+    sigset_t set;
+    sigemptyset (&set);
+    sigaddset (&set, SIGINT);
+    sigaddset (&set, SIGTERM);
+    sigaddset (&set, SIGHUP);
+    ::sigprocmask (SIG_BLOCK, &set, &old_);
+  }
+  ~BlockInterrupts () { ::sigprocmask (SIG_SETMASK, &old_, nullptr); }
+  BlockInterrupts (const BlockInterrupts&) = delete;
+  BlockInterrupts& operator= (const BlockInterrupts&) = delete;
+
+private:
+  sigset_t old_;
+};
+
+void
+setTempPath (const char* path)
+{
+  BlockInterrupts block;
+  if (!path)
+  {
+    g_temp_active = 0;
+    return;
+  }
+  std::strncpy (g_temp_path, path, sizeof (g_temp_path) - 1);
+  g_temp_path[sizeof (g_temp_path) - 1] = '\0';
+  g_temp_active = 1;
+}
+
 /** \brief One field value as double, whatever its PCD type. */
 double
 readField (const std::uint8_t* p, std::uint8_t datatype)
@@ -139,6 +194,23 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
   return true;
 }
 
+void
+installInterruptCleanup ()
+{
+  struct sigaction sa;
+  std::memset (&sa, 0, sizeof (sa));
+  sa.sa_handler = removeTempAndDie;
+  sigemptyset (&sa.sa_mask);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP})
+  {
+    struct sigaction old;
+    // Keep "ignored" (e.g. nohup) as it was.
+    if (::sigaction (sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN)
+      continue;
+    ::sigaction (sig, &sa, nullptr);
+  }
+}
+
 std::uint32_t
 verdictColour (float probability, double free_below, double collision_above)
 {
@@ -207,7 +279,19 @@ writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sid
   std::string tmpl = (dir / ("." + target.filename ().string () + ".tmp-XXXXXX")).string ();
   std::vector<char> buf (tmpl.begin (), tmpl.end ());
   buf.push_back ('\0');
-  const int fd = ::mkstemp (buf.data ());
+  if (buf.size () >= sizeof (g_temp_path))
+  {
+    error = "cannot write '" + path + "': path too long";
+    return false;
+  }
+  int fd = -1;
+  {
+    // Create and register together: a signal in between would leave the file behind.
+    BlockInterrupts block;
+    fd = ::mkstemp (buf.data ());
+    if (fd >= 0)
+      setTempPath (buf.data ());
+  }
   if (fd < 0)
   {
     error = "cannot write '" + path + "': " + std::strerror (errno);
@@ -233,13 +317,23 @@ writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sid
   if (rc != 0)
   {
     std::remove (tmp.c_str ());
+    setTempPath (nullptr);
     error = "cannot write '" + path + "' (writing the PCD data failed)";
     return false;
   }
-  if (std::rename (tmp.c_str (), path.c_str ()) != 0)
+  int renamed = -1, e = 0;
   {
-    const int e = errno;
+    // Rename and unregister as one step: afterwards the temporary name must not be removed.
+    BlockInterrupts block;
+    renamed = std::rename (tmp.c_str (), path.c_str ());
+    e = errno;
+    if (renamed == 0)
+      setTempPath (nullptr);
+  }
+  if (renamed != 0)
+  {
     std::remove (tmp.c_str ());
+    setTempPath (nullptr);
     error = "cannot write '" + path + "': " + std::strerror (e);
     return false;
   }

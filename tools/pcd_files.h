@@ -32,6 +32,11 @@ bool writeResultCloud (const std::string& path, const std::vector<LabelledCloud>
                        double collision_above, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
                        std::size_t& points_written, std::string& error);
 
+/** \brief Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary file of a
+  * writeResultCloud in progress and then die of the same signal (exit status 128 + n to a
+  * shell). Signals that were ignored at start stay ignored. */
+void installInterruptCleanup ();
+
 /** \brief The verdict colour of one probability, packed as PCL's rgb (0x00RRGGBB). */
 std::uint32_t verdictColour (float probability, double free_below, double collision_above);
 } // namespace pcd_collision

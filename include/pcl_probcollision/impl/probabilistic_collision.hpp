@@ -103,6 +103,28 @@ ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud,
       return false;
     }
 
+  // Finite but absurd coordinates (beyond 1e15 units) overflow the float arithmetic of the kd-tree:
+  // FLANN's middle split computes (min + max) / 2 = inf for two values above FLT_MAX / 2 and
+  // aborts on an assertion (found by fuzz/fuzz_collide). Refuse them with the point named.
+  {
+    constexpr float kMaxCoordinate = 1e15f;
+    const std::size_t count = indices ? indices->size () : cloud->size ();
+    for (std::size_t j = 0; j < count; ++j)
+    {
+      const int i = indices ? (*indices)[j] : static_cast<int> (j);
+      const PointT& p = (*cloud)[i];
+      if (pcl::isXYZFinite (p) &&
+          !(std::abs (p.x) <= kMaxCoordinate && std::abs (p.y) <= kMaxCoordinate && std::abs (p.z) <= kMaxCoordinate))
+      {
+        err.precision (9);
+        err << which << " point " << i << " at (" << p.x << ", " << p.y << ", " << p.z
+            << ") is beyond the supported coordinate range of +-1e15";
+        message = err.str ();
+        return false;
+      }
+    }
+  }
+
   // Estimate what the caller did not give: covariances and the neighbour radii (area weights).
   pcl::PointCloud<Covariance> estimated;
   std::vector<float> radii;

@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# Reliability checks of issue #7 (docs/RELIABILITY.md), run by .ci/run after scripts/test.sh:
+#   1. clang, AddressSanitizer + UndefinedBehaviorSanitizer (+ LeakSanitizer): build everything
+#      (with the libFuzzer targets) and run the whole ctest suite;
+#   2. libFuzzer: each fuzz target for FUZZ_SECONDS (default 60) from the seed corpus;
+#   3. ThreadSanitizer: the concurrency tests;
+#   4. valgrind memcheck on pcd_collision over data/ (the Release build of scripts/test.sh).
+# Build directories: build-asan, build-tsan (never build/, which step 4 only reads).
+# Usage: bash scripts/ci-reliability.sh [asan|fuzz|tsan|valgrind ...]   (default: all, in order)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+jobs=${JOBS:-2}
+fuzz_seconds=${FUZZ_SECONDS:-60}
+steps=("$@")
+[ ${#steps[@]} -gt 0 ] || steps=(asan fuzz tsan valgrind)
+
+bash scripts/install-ci-extras.sh
+
+declare -a timings=()
+timed () {
+  local name=$1; shift
+  local start=$SECONDS
+  echo "=== ci-reliability: $name"
+  "$@"
+  timings+=("$name $((SECONDS - start)) s")
+  echo "=== ci-reliability: $name done in $((SECONDS - start)) s"
+}
+
+# -O1 keeps the instrumented build and its tests affordable on 2 cores.
+sanitized_configure () {  # dir sanitizers extra-args...
+  local dir=$1 san=$2; shift 2
+  CC=clang CXX=clang++ cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g" \
+    -DPCL_PROBCOLLISION_SANITIZE="$san" -DPCL_PROBCOLLISION_BUILD_BENCHMARKS=OFF "$@"
+}
+
+asan_build () {
+  sanitized_configure build-asan address,undefined -DPCL_PROBCOLLISION_BUILD_FUZZERS=ON
+  cmake --build build-asan -j"$jobs"
+}
+asan_test () {
+  # Left out here (all run in scripts/test.sh):
+  # - downstream_find_package installs the library and links a plain consumer against it: a
+  #   packaging test, meaningless with an instrumented static library;
+  # - two tests whose floating-point tolerances hold with g++ -O2 but not with clang -O1 (no
+  #   sanitizer report; docs/RELIABILITY.md "Not done"): P differs by 1.6e-3 between a reused pose
+  #   and a rebuilt cloud, and one expected-weight reach weight reaches exactly 1.
+  local excluded='^(downstream_find_package|ProbabilisticCollision.PoseReuseEqualsTransformingTheCloudAndRebuilding'
+  excluded+='|BVHTraversal.StochasticRepeatsWithSeedAndMeanBoundsExpectedWeight)$'
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1 \
+  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan --output-on-failure -j"$jobs" -E "$excluded" --timeout 1500
+}
+
+fuzz_one () {  # target corpus-name
+  local target=$1 corpus=$2
+  local work="build-asan/fuzz/run-$corpus"
+  rm -rf "$work"; mkdir -p "$work/corpus" "$work/artifacts"
+  # New inputs go to the first (scratch) directory; the repository's seeds stay as they are.
+  if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      "build-asan/fuzz/$target" -max_total_time="$fuzz_seconds" -timeout=30 -rss_limit_mb=4096 \
+      -print_final_stats=1 -artifact_prefix="$work/artifacts/" \
+      "$work/corpus" "fuzz/corpus/$corpus" > "$work/log.txt" 2>&1; then
+    tail -n 80 "$work/log.txt"
+    echo "ci-reliability: $target found a failure; reproduce with: build-asan/fuzz/$target $work/artifacts/*" >&2
+    ls -l "$work/artifacts" >&2
+    return 1
+  fi
+  grep -E '^stat::number_of_executed_units|^stat::new_units_added|^stat::peak_rss_mb' "$work/log.txt" || true
+}
+fuzz_all () {
+  [ -x build-asan/fuzz/fuzz_collide ] || asan_build
+  fuzz_one fuzz_collide collide
+  fuzz_one fuzz_cli_options cli
+}
+
+tsan_options="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/test/tools/tsan.supp"
+tsan_build () {
+  # gtest_discover_tests runs the instrumented tests at build time: they need the options too.
+  export TSAN_OPTIONS="$tsan_options"
+  sanitized_configure build-tsan thread -DPCL_PROBCOLLISION_BUILD_EXAMPLES=OFF
+  cmake --build build-tsan -j"$jobs" --target test_reliability test_probabilistic_bvh test_robust_classifier \
+    test_probabilistic_collision
+}
+tsan_test () {
+  # The hierarchies of these tests are built before the threads start; the threads run only our
+  # code (collide(), classify(), the traversal). test/tools/tsan.supp holds
+  # the one suppression (libOpenNI2's static initializer).
+  export TSAN_OPTIONS="$tsan_options"
+  build-tsan/test/test_reliability --gtest_filter='*Concurrent*'
+  build-tsan/test/test_probabilistic_bvh --gtest_filter='*Threads*'
+  build-tsan/test/test_robust_classifier --gtest_filter='*Concurrent*'
+  build-tsan/test/test_probabilistic_collision --gtest_filter='*Concurrent*'
+}
+
+valgrind_cli () {
+  local exe=${PCD_COLLISION_EXE:-build/tools/pcd_collision}  # built by scripts/test.sh
+  [ -x "$exe" ] || { cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build -j"$jobs" --target pcd_collision; }
+  local out; out=$(mktemp -d)
+  local vg=(valgrind --tool=memcheck --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite
+            --show-leak-kinds=definite --track-origins=no --suppressions="$root/test/tools/valgrind.supp" -q)
+  "${vg[@]}" "$exe" data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt -json > "$out/batch.json"
+  "${vg[@]}" "$exe" data/gripper.obj data/table_mug.pcd -pose -0.15,0.05,-0.02,0,0,0 -o "$out/result.pcd"
+  "${vg[@]}" "$exe" data/gripper.obj data/table_mug.pcd -sensor kinect -pose 0,0,0.005,0,0,0 > /dev/null
+  # Error paths too: exit 1 or 2, but still no memory error (99).
+  local rc=0
+  "${vg[@]}" "$exe" data/gripper.obj data/missing.pcd 2> /dev/null || rc=$?
+  [ "$rc" -ne 99 ] || { echo "valgrind: memory errors on the error path" >&2; return 1; }
+  rc=0
+  "${vg[@]}" "$exe" data/gripper.obj data/table_mug.pcd -sigma 1O 2> /dev/null || rc=$?
+  [ "$rc" -ne 99 ] || { echo "valgrind: memory errors on the usage-error path" >&2; return 1; }
+  [ "$(wc -l < "$out/batch.json")" -eq 3 ] || { echo "valgrind run: expected 3 JSON lines" >&2; return 1; }
+  rm -rf "$out"
+}
+
+for s in "${steps[@]}"; do
+  case "$s" in
+    asan) timed "asan+ubsan build" asan_build; timed "asan+ubsan ctest" asan_test ;;
+    fuzz) timed "fuzz (${fuzz_seconds} s each)" fuzz_all ;;
+    tsan) timed "tsan build" tsan_build; timed "tsan tests" tsan_test ;;
+    valgrind) timed "valgrind pcd_collision" valgrind_cli ;;
+    *) echo "ci-reliability: unknown step '$s' (asan, fuzz, tsan, valgrind)" >&2; exit 2 ;;
+  esac
+done
+echo "=== ci-reliability: summary"
+printf '  %s\n' "${timings[@]}"
