@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Installs the Debian packages pcl_probcollision needs to build, test and benchmark.
-# Idempotent: does nothing when every package is already installed.
+# Installs the Debian packages pcl_probcollision needs to build, test and benchmark, plus any
+# extra package names given as arguments. Idempotent: does nothing when all are installed.
 set -euo pipefail
 packages=(cmake make g++ pkg-config libpcl-dev libeigen3-dev libflann-dev libboost-dev
-          libgtest-dev libbenchmark-dev)
+          libgtest-dev libbenchmark-dev "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

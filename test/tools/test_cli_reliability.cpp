@@ -3,6 +3,7 @@
 // Every run ends in a documented exit status with valid output or one error line: never a crash,
 // a NaN printed as a probability, or a partial file.
 
+#include "test_files.h"
 #include "mini_json.h"
 
 #include <pcl/io/pcd_io.h>
@@ -41,30 +42,9 @@ const fs::path kGripper = kData / "gripper.obj";
 const fs::path kScene = kData / "table_mug.pcd";
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN ();
 
-std::string
-readFile (const fs::path& p)
-{
-  std::ifstream f (p, std::ios::binary);
-  return std::string (std::istreambuf_iterator<char> (f), std::istreambuf_iterator<char> ());
-}
-
-void
-writeFile (const fs::path& p, const std::string& text)
-{
-  std::ofstream f (p, std::ios::binary);
-  f << text;
-}
-
-std::vector<std::string>
-lines (const std::string& text)
-{
-  std::vector<std::string> out;
-  std::istringstream in (text);
-  std::string l;
-  while (std::getline (in, l))
-    out.push_back (l);
-  return out;
-}
+using test_files::lines;
+using test_files::readFile;
+using test_files::writeFile;
 
 /** \brief "nan" or "inf" outside JSON strings (file names may contain them). */
 bool

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // pcd_collision through the built binary: the contract of docs/CLI.md and every bad input.
 
+#include "test_files.h"
 #include "mini_json.h"
 
 #include <pcl/PCLPointCloud2.h>
@@ -46,30 +47,9 @@ quote (const std::string& s)
   return q + "'";
 }
 
-std::string
-readFile (const fs::path& p)
-{
-  std::ifstream f (p, std::ios::binary);
-  return std::string (std::istreambuf_iterator<char> (f), std::istreambuf_iterator<char> ());
-}
-
-void
-writeFile (const fs::path& p, const std::string& text)
-{
-  std::ofstream f (p, std::ios::binary);
-  f << text;
-}
-
-std::vector<std::string>
-lines (const std::string& text)
-{
-  std::vector<std::string> out;
-  std::istringstream in (text);
-  std::string l;
-  while (std::getline (in, l))
-    out.push_back (l);
-  return out;
-}
+using test_files::lines;
+using test_files::readFile;
+using test_files::writeFile;
 
 std::string
 lowercase (std::string s)
