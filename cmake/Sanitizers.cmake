@@ -35,10 +35,11 @@ if(PCL_PROBCOLLISION_SANITIZE)
   message(STATUS "pcl_probcollision: sanitizers ${_pcl_pc_san}")
 endif()
 
-# Fuzzing (fuzz/): coverage instrumentation for every target; the fuzzers link libFuzzer's main.
+# Fuzzing (fuzz/): the coverage instrumentation goes on the code the fuzzers exercise only (the
+# library, the CLI parser and the fuzzers themselves, fuzz/CMakeLists.txt), not on the test
+# programs built in the same tree: it made them about 1.8x slower under ASan.
 if(PCL_PROBCOLLISION_BUILD_FUZZERS)
   if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "PCL_PROBCOLLISION_BUILD_FUZZERS needs clang (CC=clang CXX=clang++)")
   endif()
-  add_compile_options(-fsanitize=fuzzer-no-link)
 endif()

@@ -3,7 +3,7 @@
 # extra package names given as arguments. Idempotent: does nothing when all are installed.
 set -euo pipefail
 packages=(cmake make g++ pkg-config libpcl-dev libeigen3-dev libflann-dev libboost-dev
-          libgtest-dev libbenchmark-dev "$@")
+          libgtest-dev libbenchmark-dev libfcl-dev liboctomap-dev gnuplot-nox "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -290,3 +290,138 @@ TEST (CovarianceEstimation, RealStereoScanKeepsAlignmentAndGivesFinitePsdCovaria
   EXPECT_EQ (finite, 209280u);  // SCENES.md: finite points of this scan
   EXPECT_EQ (psd, finite);
 }
+
+namespace
+{
+// A square grid in z = 0, spacing h, with Gaussian noise sigma on every axis.
+Cloud::Ptr
+noisyPlane (int n, double h, double sigma, std::uint64_t seed, double offset = 0.0)
+{
+  std::mt19937_64 rng (seed);
+  std::normal_distribution<double> noise (0.0, sigma);
+  Cloud::Ptr c (new Cloud);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      c->push_back (pcl::PointXYZ (static_cast<float> (offset + i * h + noise (rng)),
+                                   static_cast<float> (offset + j * h + noise (rng)),
+                                   static_cast<float> (offset + noise (rng))));
+  return c;
+}
+
+struct Projected
+{
+  pcl::PointCloud<Covariance> covariances;
+  std::vector<Eigen::Vector3d> displacements;
+};
+
+Projected
+project (const Cloud::ConstPtr& cloud, const SensorNoiseModel& noise)
+{
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setInputCloud (cloud);
+  est.setSensorNoise (noise);
+  est.setSurfaceProjection (true);
+  Projected p;
+  est.compute (p.covariances);
+  p.displacements = est.getSurfaceDisplacements ();
+  return p;
+}
+} // namespace
+
+// On a flat noisy patch the projection removes most of each point's error across the surface,
+// and the covariance says so: its spread across the surface shrinks, along it only the sensor's
+// remains (the discretisation spread is dropped there).
+TEST (CovarianceEstimation, SurfaceProjectionDenoisesAFlatPatchAndShrinksItsSpreadAcrossIt)
+{
+  const double sigma = 0.002, h = 0.01;
+  const Cloud::ConstPtr cloud = noisyPlane (30, h, sigma, 7);
+  const Projected p = project (cloud, SensorNoiseModel::isotropic (sigma));
+  const auto measured = estimate (cloud, 10, SensorNoiseModel::isotropic (sigma));
+  ASSERT_EQ (p.displacements.size (), cloud->size ());
+  double before = 0.0, after = 0.0, zz_before = 0.0, zz_after = 0.0, xx_after = 0.0;
+  for (std::size_t i = 0; i < cloud->size (); ++i)
+  {
+    const double z = (*cloud)[i].z;
+    before += z * z;
+    after += (z + p.displacements[i].z ()) * (z + p.displacements[i].z ());
+    zz_before += measured[i].matrix () (2, 2);
+    zz_after += p.covariances[i].matrix () (2, 2);
+    xx_after += p.covariances[i].matrix () (0, 0);
+    EXPECT_TRUE (isPsd (p.covariances[i].matrix (), 1e-15));
+  }
+  const double n = static_cast<double> (cloud->size ());
+  const double rms_before = std::sqrt (before / n), rms_after = std::sqrt (after / n);
+  EXPECT_NEAR (rms_before, sigma, 0.1 * sigma);
+  EXPECT_LT (rms_after, 0.5 * sigma) << "measured " << rms_before;
+  // Measured: discretisation (about 2 sigma^2 across) plus sensor; projected: about a tenth.
+  EXPECT_GT (zz_before / n, 2.0 * sigma * sigma);
+  EXPECT_LT (zz_after / n, 0.5 * sigma * sigma);
+  // Along the surface the sensor's sigma^2 is what is left (the spacing h^2 = 25 sigma^2 is gone).
+  EXPECT_NEAR (xx_after / n, sigma * sigma, 0.3 * sigma * sigma);
+}
+
+// Without a sensor model nothing is projected: the output equals the measured model's.
+TEST (CovarianceEstimation, SurfaceProjectionWithoutSensorNoiseChangesNothing)
+{
+  const Cloud::ConstPtr cloud = noisyPlane (12, 0.01, 0.002, 3);
+  const Projected p = project (cloud, SensorNoiseModel ());
+  const auto measured = estimate (cloud, 10);
+  for (std::size_t i = 0; i < cloud->size (); ++i)
+  {
+    EXPECT_EQ (p.displacements[i], Eigen::Vector3d::Zero ());
+    EXPECT_TRUE (p.covariances[i].matrix ().isApprox (measured[i].matrix (), 1e-12));
+  }
+}
+
+// At a 90 degree edge the neighbours' scatter across any plane is geometry, not noise: edge
+// points stay near where they were measured instead of being pulled into the corner's chord.
+TEST (CovarianceEstimation, SurfaceProjectionLeavesSharpEdgesInPlace)
+{
+  const double h = 0.01, sigma = 0.0005;
+  std::mt19937_64 rng (5);
+  std::normal_distribution<double> noise (0.0, sigma);
+  Cloud::Ptr cloud (new Cloud);
+  std::vector<std::size_t> edge;
+  for (int j = 0; j < 20; ++j)
+    for (int i = -10; i <= 10; ++i)
+    {
+      // z = 0 for x <= 0, then a vertical wall x = 0 going down (an edge along y at x = z = 0).
+      const double x = i <= 0 ? i * h : 0.0, z = i <= 0 ? 0.0 : -i * h;
+      if (i == 0)
+        edge.push_back (cloud->size ());
+      cloud->push_back (pcl::PointXYZ (static_cast<float> (x + noise (rng)), static_cast<float> (j * h + noise (rng)),
+                                       static_cast<float> (z + noise (rng))));
+    }
+  const Projected p = project (cloud, SensorNoiseModel::isotropic (sigma));
+  for (const std::size_t i : edge)
+    EXPECT_LT (p.displacements[i].norm (), 4.0 * sigma) << "edge point " << i;
+}
+
+// Projection works in differences: a map-frame offset of 100 km moves nothing.
+TEST (CovarianceEstimation, SurfaceProjectionIsTranslationInvariant)
+{
+  // Spacing 0.25 and noise in steps of 1/128 keep float coordinates exact at a 1e5 offset.
+  const double sigma = 0.05;
+  auto plane = [&] (double offset) {
+    std::mt19937_64 rng (11);
+    std::normal_distribution<double> noise (0.0, sigma);
+    auto q = [&] () { return std::round (noise (rng) * 128.0) / 128.0; };
+    Cloud::Ptr c (new Cloud);
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 12; ++i)
+        c->push_back (pcl::PointXYZ (static_cast<float> (offset + i * 0.25 + q ()),
+                                     static_cast<float> (offset + j * 0.25 + q ()), static_cast<float> (offset + q ())));
+    return c;
+  };
+  const Projected p0 = project (plane (0.0), SensorNoiseModel::isotropic (sigma));
+  const Projected p1 = project (plane (1e5), SensorNoiseModel::isotropic (sigma));
+  ASSERT_EQ (p0.displacements.size (), p1.displacements.size ());
+  double moved = 0.0;
+  for (std::size_t i = 0; i < p0.displacements.size (); ++i)
+  {
+    EXPECT_LE ((p0.displacements[i] - p1.displacements[i]).norm (), 1e-9) << i;
+    EXPECT_LE ((p0.covariances[i].matrix () - p1.covariances[i].matrix ()).cwiseAbs ().maxCoeff (), 1e-9) << i;
+    moved = std::max (moved, p0.displacements[i].norm ());
+  }
+  EXPECT_GT (moved, 0.5 * sigma);  // the points did move
+}

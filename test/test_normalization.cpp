@@ -18,7 +18,9 @@ randomCloud (std::size_t n, unsigned seed, double spread)
   UncertainCloud c;
   for (std::size_t i = 0; i < n; ++i)
   {
-    c.means.emplace_back (u (rng) + 3.0, u (rng) - 7.0, u (rng) + 100.0);
+    const double x = u (rng);  // one draw per statement: argument order is unspecified
+    const double y = u (rng);
+    c.means.emplace_back (x + 3.0, y - 7.0, u (rng) + 100.0);
     Eigen::Matrix3d a = Eigen::Matrix3d::NullaryExpr ([&] () { return u (rng) * 1e-2; });
     c.covariances.push_back (a * a.transpose ());
   }

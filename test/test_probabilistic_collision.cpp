@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "seeded_draws.h"
+
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -18,6 +20,7 @@
 #include <thread>
 
 using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
@@ -32,9 +35,11 @@ patch (double size, double h, double z, double sigma, unsigned seed)
   const int n = static_cast<int> (std::round (size / h)) + 1;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i)
-      c->push_back (pcl::PointXYZ (static_cast<float> (i * h - size / 2 + (sigma > 0 ? noise (rng) : 0.0)),
-                                   static_cast<float> (j * h - size / 2 + (sigma > 0 ? noise (rng) : 0.0)),
-                                   static_cast<float> (z + (sigma > 0 ? noise (rng) : 0.0))));
+    {
+      const Eigen::Vector3d e = sigma > 0 ? draw3 (noise, rng) : Eigen::Vector3d (0.0, 0.0, 0.0);
+      c->push_back (pcl::PointXYZ (static_cast<float> (i * h - size / 2 + e.x ()), static_cast<float> (j * h - size / 2 + e.y ()),
+                                   static_cast<float> (z + e.z ())));
+    }
   c->width = n;
   c->height = n;
   return c;
@@ -59,9 +64,9 @@ Eigen::Isometry3d
 randomPose (std::mt19937& rng, double translation)
 {
   std::uniform_real_distribution<double> u (-1.0, 1.0);
-  const Eigen::Vector3d axis = Eigen::Vector3d (u (rng), u (rng), u (rng)).normalized ();
-  return Eigen::Translation3d (translation * u (rng), translation * u (rng), translation * u (rng)) *
-         Eigen::AngleAxisd (M_PI * u (rng), axis);
+  const Eigen::Vector3d axis = draw3 (u, rng).normalized ();
+  const Eigen::Vector3d t = translation * draw3 (u, rng);
+  return Eigen::Translation3d (t) * Eigen::AngleAxisd (M_PI * u (rng), axis);
 }
 } // namespace
 
@@ -125,26 +130,38 @@ TEST (ProbabilisticCollision, PoseReuseEqualsTransformingTheCloudAndRebuilding)
   const double sigma = 0.003;
   const auto a = patch (0.15, 0.01, 0.0, 0.001, 5);
   const auto b = patch (0.2, 0.01, 0.0, 0.001, 6);
-  std::mt19937 rng (7);
   ProbabilisticCollision<pcl::PointXYZ> reused;
   reused.setInputCloud (a);
   reused.setTargetCloud (b);
   reused.setInputNoise (SensorNoiseModel::isotropic (sigma));
   reused.setTargetNoise (SensorNoiseModel::isotropic (sigma));
-  CollisionRequest request;
-  request.exhaustive = true;
-  reused.setRequest (request);
-  for (int trial = 0; trial < 6; ++trial)
+  // The two queries differ by the float storage of the moved points and by the frame the
+  // classifier works in (A's own frame with the pose, B's for the rebuilt cloud). A plane is
+  // rotation-equivariant: P agrees to rounding (METHOD.md 11.6, 1e-6 for Linear; measured at most
+  // 3e-7 over 90 poses). Random Fourier features are fixed in the unit-cube frame, which the pose
+  // rotates, so a leaf pair that escalated to RFF gets another, equally valid fit: the same only
+  // in distribution (METHOD.md 4), and METHOD.md 11.6 allows 0.02 there (trial 4 of the Ladder
+  // run below: 1.6e-3).
+  for (const KernelMode kernel : {KernelMode::Linear, KernelMode::Ladder})
   {
-    const Eigen::Isometry3d pose = randomPose (rng, 0.05);
-    CollisionResult with_pose;
-    ASSERT_TRUE (reused.compute (pose, with_pose));
-    Cloud::Ptr moved (new Cloud);
-    pcl::transformPointCloud (*a, *moved, Eigen::Affine3f (pose.matrix ().cast<float> ()));
-    const CollisionResult rebuilt = query (moved, b, sigma, Eigen::Isometry3d::Identity (), request);
-    // Float storage of the moved points is the only difference.
-    EXPECT_NEAR (with_pose.probability, rebuilt.probability, 1e-4) << trial;
-    EXPECT_EQ (with_pose.verdict, rebuilt.verdict) << trial;
+    CollisionRequest request;
+    request.exhaustive = true;
+    request.classifier.kernel = kernel;
+    reused.setRequest (request);
+    std::mt19937 rng (7);
+    for (int trial = 0; trial < 6; ++trial)
+    {
+      const Eigen::Isometry3d pose = randomPose (rng, 0.05);
+      CollisionResult with_pose;
+      ASSERT_TRUE (reused.compute (pose, with_pose));
+      Cloud::Ptr moved (new Cloud);
+      pcl::transformPointCloud (*a, *moved, Eigen::Affine3f (pose.matrix ().cast<float> ()));
+      const CollisionResult rebuilt = query (moved, b, sigma, Eigen::Isometry3d::Identity (), request);
+      const bool rff = with_pose.kernel_leaf_pairs > 0 || rebuilt.kernel_leaf_pairs > 0;
+      EXPECT_TRUE (kernel == KernelMode::Ladder || !rff);
+      EXPECT_NEAR (with_pose.probability, rebuilt.probability, rff ? 0.02 : 1e-6) << trial;
+      EXPECT_EQ (with_pose.verdict, rebuilt.verdict) << trial;
+    }
   }
 }
 
@@ -352,4 +369,41 @@ TEST (ProbabilisticCollision, RealSceneQueriesFromScenesMd)
     ++rows;
   }
   EXPECT_EQ (rows, 24);
+}
+
+// The calibration default (docs/RESULTS.md): two noisy 40 x 40 patches, sigma 2 mm, spacing
+// 1 cm, 4 sigma apart. Measured positions: the maximum over 3,200 noisy points drifts toward 1
+// and the clear gap reads contact or collision. Projected (the default): free, while the same
+// patches 1 sigma into each other still read collision.
+TEST (ProbabilisticCollision, SurfaceProjectionKeepsAClearGapFreeWhereTheMeasuredMaximumDrifts)
+{
+  const double sigma = 0.002, h = 0.01;
+  auto patch = [&] (double z, std::uint64_t seed) {
+    std::mt19937_64 rng (seed);
+    std::normal_distribution<double> noise (0.0, sigma);
+    Cloud::Ptr c (new Cloud);
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i)
+        c->push_back (pcl::PointXYZ (static_cast<float> (i * h + noise (rng)), static_cast<float> (j * h + noise (rng)),
+                                     static_cast<float> (z + noise (rng))));
+    return c;
+  };
+  auto query = [&] (double gap, bool projection) {
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    pc.setInputCloud (patch (0.0, 1));
+    pc.setTargetCloud (patch (-gap, 2));
+    pc.setInputNoise (SensorNoiseModel::isotropic (sigma));
+    pc.setTargetNoise (SensorNoiseModel::isotropic (sigma));
+    pc.setSurfaceProjection (projection);
+    CollisionResult r;
+    EXPECT_TRUE (pc.compute (r)) << r.message;
+    return r;
+  };
+  EXPECT_TRUE (ProbabilisticCollision<pcl::PointXYZ> ().getSurfaceProjection ());
+  const CollisionResult measured = query (4.0 * sigma, false);
+  const CollisionResult projected = query (4.0 * sigma, true);
+  const CollisionResult crossing = query (-1.0 * sigma, true);
+  EXPECT_NE (measured.verdict, Verdict::Free) << "P = " << measured.probability;
+  EXPECT_EQ (projected.verdict, Verdict::Free) << "P = " << projected.probability;
+  EXPECT_EQ (crossing.verdict, Verdict::InCollision) << "P = " << crossing.probability;
 }

@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include "sanitized_build.h"
+#include "seeded_draws.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,26 +25,21 @@
 #include <unistd.h>
 
 using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
-
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define PCL_PC_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define PCL_PC_SANITIZED 1
-#endif
-#endif
 
 namespace
 {
 // Sanitized builds (CI's ASan and TSan steps) run smaller workloads of the same tests: the
 // contracts are the same, instrumented code is 10-50x slower.
 #ifdef PCL_PC_SANITIZED
-constexpr int kConcurrentPoses = 16;
+constexpr int kConcurrentPoses = 8;  // still one per thread
 constexpr std::size_t kBatchPoses = 12000;
+constexpr double kFarPatch = 0.5;  // side of the far-from-the-origin patch, metres
 #else
 constexpr int kConcurrentPoses = 48;
 constexpr std::size_t kBatchPoses = 100000;
+constexpr double kFarPatch = 1.0;
 #endif
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN ();
 constexpr float kInf = std::numeric_limits<float>::infinity ();
@@ -141,7 +139,9 @@ sheet (int n, double size, double z, double sigma, unsigned seed, const Eigen::V
   UncertainCloud c;
   for (int i = 0; i < n; ++i)
   {
-    c.means.push_back (offset + Eigen::Vector3d (u (rng), u (rng), z + dz (rng)));
+    const double x = u (rng);  // one draw per statement: seeded_draws.h
+    const double y = u (rng);
+    c.means.push_back (offset + Eigen::Vector3d (x, y, z + dz (rng)));
     c.covariances.push_back (Eigen::Matrix3d::Identity () * sigma * sigma);
     c.source_indices.push_back (i);
   }
@@ -411,10 +411,10 @@ TEST (Reliability, FarFromTheOriginGivesTheSameAnswerAsAtTheOrigin)
   for (const double gap : {4 * h, 0.0})
   {
     SCOPED_TRACE (gap);
-    const auto a0 = patch (1.0, h, 0.0, 0.0, 10);
-    const auto b0 = patch (0.5, h, gap, 0.0, 11);
-    const auto a1 = patch (1.0, h, 0.0, 0.0, 10, offset);
-    const auto b1 = patch (0.5, h, gap, 0.0, 11, offset);
+    const auto a0 = patch (kFarPatch, h, 0.0, 0.0, 10);
+    const auto b0 = patch (kFarPatch / 2, h, gap, 0.0, 11);
+    const auto a1 = patch (kFarPatch, h, 0.0, 0.0, 10, offset);
+    const auto b1 = patch (kFarPatch / 2, h, gap, 0.0, 11, offset);
     for (std::size_t i = 0; i < a0->size (); ++i)
       ASSERT_EQ ((*a1)[i].x - static_cast<float> (offset.x ()), (*a0)[i].x);
     const Query near = query (a0, b0, 0.01, rq);
@@ -596,8 +596,13 @@ TEST (Reliability, ConcurrentQueriesOnSharedHierarchiesMatchSerialExactly)
     std::uniform_real_distribution<double> u (-1.0, 1.0);
     std::vector<Eigen::Isometry3d> poses;
     for (int i = 0; i < kConcurrentPoses; ++i)
-      poses.push_back (Eigen::Translation3d (0.05 * u (rng), 0.05 * u (rng), 0.01 * u (rng)) *
-                       Eigen::AngleAxisd (0.3 * u (rng), Eigen::Vector3d (u (rng), u (rng), 1.0).normalized ()));
+    {
+      const Eigen::Vector3d t = draw3 (u, rng).cwiseProduct (Eigen::Vector3d (0.05, 0.05, 0.01));
+      const double angle = 0.3 * u (rng);
+      const double ax = u (rng);
+      const Eigen::Vector3d axis (ax, u (rng), 1.0);
+      poses.push_back (Eigen::Translation3d (t) * Eigen::AngleAxisd (angle, axis.normalized ()));
+    }
     std::vector<CollisionResult> serial (poses.size ()), parallel (poses.size ());
     for (std::size_t i = 0; i < poses.size (); ++i)
       ASSERT_TRUE (collide (a, b, poses[i], rq, serial[i], &classifier)) << serial[i].message;

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "seeded_draws.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -28,6 +30,7 @@
 namespace
 {
 using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;
 
 const double kPi = 3.14159265358979323846;
 
@@ -136,11 +139,12 @@ Eigen::Matrix3d
 randomCovariance (std::mt19937_64& rng, double lo, double hi)
 {
   std::uniform_real_distribution<double> u (lo, hi);
-  const Eigen::Vector3d s (u (rng), u (rng), u (rng));
+  const Eigen::Vector3d s = draw3 (u, rng);  // one draw per statement: seeded_draws.h
   std::uniform_real_distribution<double> angle (0.0, 2.0 * kPi);
-  const Eigen::Matrix3d r = (Eigen::AngleAxisd (angle (rng), Eigen::Vector3d::UnitZ ()) *
-                             Eigen::AngleAxisd (angle (rng), Eigen::Vector3d::UnitY ()) *
-                             Eigen::AngleAxisd (angle (rng), Eigen::Vector3d::UnitX ()))
+  const Eigen::Vector3d zyx = draw3 (angle, rng);
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd (zyx (0), Eigen::Vector3d::UnitZ ()) *
+                             Eigen::AngleAxisd (zyx (1), Eigen::Vector3d::UnitY ()) *
+                             Eigen::AngleAxisd (zyx (2), Eigen::Vector3d::UnitX ()))
                                 .toRotationMatrix ();
   return r * s.cwiseAbs2 ().asDiagonal () * r.transpose ();
 }
@@ -157,12 +161,14 @@ genericPatches (Cloud& a, Cloud& b, std::uint64_t seed = 7)
   for (int k = 0; k < 150; ++k)
   {
     const double x = u (rng), y = u (rng);
-    a.add (Eigen::Vector3d (x, y, 0.1 * x - 0.05 * y + 0.01 * u (rng)), randomCovariance (rng, 0.002, 0.02));
+    const double z = 0.1 * x - 0.05 * y + 0.01 * u (rng);
+    a.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
   }
   for (int k = 0; k < 90; ++k)
   {
     const double x = u (rng), y = u (rng);
-    b.add (Eigen::Vector3d (x, y, 0.1 * x - 0.05 * y + 0.06 + 0.01 * u (rng)), randomCovariance (rng, 0.002, 0.02));
+    const double z = 0.1 * x - 0.05 * y + 0.06 + 0.01 * u (rng);
+    b.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
   }
 }
 
@@ -442,7 +448,9 @@ TEST (RobustClassifier, LinearSolutionMinimisesTheObjective)
     EXPECT_NEAR (j0, r.objective, 1e-12 * j0);
     for (int k = 0; k < 100; ++k)
     {
-      const Eigen::Vector4d dir = Eigen::Vector4d (z (rng), z (rng), z (rng), z (rng)).normalized ();
+      const double d0 = z (rng);
+      const Eigen::Vector3d d123 = draw3 (z, rng);
+      const Eigen::Vector4d dir = Eigen::Vector4d (d0, d123 (0), d123 (1), d123 (2)).normalized ();
       const double h = 1e-4 * t.norm ();
       EXPECT_GE (objective (t + h * dir) - j0, -1e-13 * j0);
       // J is piecewise quadratic, so the central difference has no truncation error away from
@@ -629,7 +637,7 @@ TEST (RobustClassifier, CloudInsideTheHullOfTheOtherGivesAtLeastOneHalfWithAPlan
   std::mt19937_64 rng (3);
   std::normal_distribution<double> n (0.0, 0.02);
   for (int k = 0; k < 200; ++k)
-    a.add (Eigen::Vector3d (n (rng), n (rng), n (rng)), iso (0.001));
+    a.add (draw3 (n, rng), iso (0.001));
   for (const Eigen::Vector3d& u : fibonacci (500))
     b.add (0.5 * u, iso (0.001));
   for (TrainingMode mode : {TrainingMode::Standard, TrainingMode::Robust})
@@ -846,8 +854,8 @@ TEST (RobustClassifier, MoreNoisyPointsNearContactRaiseTheMaximum)
         for (int j = 0; j < side; ++j)
         {
           const double x = (i + 0.5) / side, y = (j + 0.5) / side;
-          a.add (Eigen::Vector3d (x + e (rng), y + e (rng), e (rng)), iso (sigma));
-          b.add (Eigen::Vector3d (x + e (rng), y + e (rng), gap + e (rng)), iso (sigma));
+          a.add (Eigen::Vector3d (x, y, 0.0) + draw3 (e, rng), iso (sigma));
+          b.add (Eigen::Vector3d (x, y, gap) + draw3 (e, rng), iso (sigma));
         }
       ClassifierResult r;
       ASSERT_TRUE (classifier.classify (a.view (), b.view (), r));
@@ -989,7 +997,7 @@ TEST (RobustClassifier, MonteCarloLinear)
       int crossed = 0;
       for (int s = 0; s < samples; ++s)
       {
-        const Eigen::Vector3d x = cloud.means[i] + l * Eigen::Vector3d (z (rng), z (rng), z (rng));
+        const Eigen::Vector3d x = cloud.means[i] + l * draw3 (z, rng);
         crossed += c * classifier.evaluate (r.separator, x) < 0.0;
       }
       const double pi = probabilities[i], se = std::sqrt (pi * (1.0 - pi) / samples);
@@ -1044,7 +1052,7 @@ TEST (RobustClassifier, MonteCarloRff)
     const Eigen::Matrix3d l = sigma.llt ().matrixL ();
     int crossed = 0;
     for (int k = 0; k < samples; ++k)
-      crossed += c * classifier.evaluate (r.separator, x0 + l * Eigen::Vector3d (z (rng), z (rng), z (rng))) < 0.0;
+      crossed += c * classifier.evaluate (r.separator, x0 + l * draw3 (z, rng)) < 0.0;
     const double pi = probabilities[i], se = std::sqrt (std::max (pi * (1.0 - pi), 1.0 / samples) / samples);
     const double observed = static_cast<double> (crossed) / samples;
     std::cout << "[ RFF Monte Carlo ] side " << side << " point " << i << ": P_i " << pi
@@ -1063,7 +1071,7 @@ TEST (RobustClassifier, RffJacobianMatchesCentralDifferences)
   std::uniform_real_distribution<double> u (0.0, 1.0);
   for (int trial = 0; trial < 20; ++trial)
   {
-    const Eigen::Vector3d x (u (rng), u (rng), u (rng));
+    const Eigen::Vector3d x = draw3 (u, rng);
     Eigen::VectorXd phi0;
     Eigen::MatrixXd jacobian;
     detail::rffFeatures (omega, beta, features, x, phi0, &jacobian);
@@ -1094,7 +1102,8 @@ TEST (RobustClassifier, RffApproximatesTheRbfKernel)
       const int pairs = 2000;
       for (int k = 0; k < pairs; ++k)
       {
-        const Eigen::Vector3d x (u (rng), u (rng), u (rng)), y (u (rng), u (rng), u (rng));
+        const Eigen::Vector3d x = draw3 (u, rng);
+        const Eigen::Vector3d y = draw3 (u, rng);
         Eigen::VectorXd px, py;
         detail::rffFeatures (omega, beta, features, x, px);
         detail::rffFeatures (omega, beta, features, y, py);

@@ -41,7 +41,7 @@ const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
-                                            "-v"};
+                                            "-measured", "-v"};
 
 ParseResult
 usage (const std::string& message)
@@ -272,6 +272,8 @@ parseCommandLine (const std::vector<std::string>& args)
         deterministic = true;
       else if (a == "-stochastic")
         o.stochastic = true;
+      else if (a == "-measured")
+        o.measured = true;
       else if (a == "-exhaustive")
         o.exhaustive = true;
       else if (a == "-json")
@@ -465,6 +467,8 @@ helpText ()
        "  -thresholds LOW,HIGH   = "
     << fmt (D::free_below) << "," << fmt (D::collision_above)
     << "   P < LOW is free, P > HIGH is collision, else contact\n"
+       "  -measured       points at their measured positions with their full spread (the\n"
+       "                  paper's model); default: projected onto their local surface\n"
        "  -deterministic  (default) expected-weight traversal\n"
        "  -stochastic     stochastic traversal, seeded by -seed\n"
        "  -seed N         = "

@@ -65,6 +65,8 @@ struct Options
   double epsilon = Defaults::epsilon;
   std::string split = Defaults::split;
   bool stochastic = false;
+  /** \brief -measured: surface projection off (ProbabilisticCollision::setSurfaceProjection). */
+  bool measured = false;
   bool exhaustive = false;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */

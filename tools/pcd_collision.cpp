@@ -422,6 +422,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("k").integer (o.k);
   j.key ("thresholds").beginArray ().num (o.free_below).num (o.collision_above).endArray ();
   j.key ("traversal").str (o.stochastic ? "stochastic" : "deterministic");
+  j.key ("positions").str (o.measured ? "measured" : "projected");
   j.key ("seed").count (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
   j.key ("nmax").integer (rq.hierarchy.n_max);
@@ -617,6 +618,7 @@ run (int argc, char** argv)
   pc.setInputCloud (a.cloud);
   pc.setTargetCloud (b.cloud);
   pc.setKSearch (o.k);
+  pc.setSurfaceProjection (!o.measured);
   if (a.kind == InputKind::Mesh)
     pc.setInputCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (a.cloud->width, a.cloud->height));
   else

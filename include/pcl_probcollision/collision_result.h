@@ -48,7 +48,9 @@ struct CollisionResult
   /** \brief Its index in its own input cloud (-1 when none). */
   int witness_index = -1;
   /** \brief Its position and the separator's unit normal there (pointing toward A's side),
-    * both in the target's (B's) frame, where the pose puts A. */
+    * both in the target's (B's) frame, where the pose puts A. The normal can be NaN even with
+    * a witness: the separator's gradient collapsed there (coincident or exact points, a
+    * degenerate classifier; ClassifierResult::witness_normal). */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
 

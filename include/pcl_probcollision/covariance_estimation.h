@@ -77,16 +77,47 @@ public:
     * hierarchy uses r_i^2 as the surface area a point stands for. */
   const std::vector<float>& getNeighbourRadii () const { return radii_; }
 
+  /** \brief Locally denoised positions (default off; needs a sensor noise model).
+    *
+    * A measured point carries its full sensor noise across the surface, and the maximum of
+    * many such points near contact drifts toward 1 (docs/RESULTS.md). With projection on,
+    * each point moves toward the plane fitted to its weighted neighbours (itself excluded):
+    * x'_i = x_i - alpha_i n_i n_i^T (x_i - c_i), with c_i their weighted centroid, n_i the
+    * plane's normal and alpha_i = min(1, 2 s_i^2 / lambda_i), lambda_i the neighbours' scatter
+    * across the plane and s_i^2 the sensor's variance along n_i: 1 on a flat noisy patch
+    * (noise explains the scatter), small at edges and corners, which stay near where they were
+    * measured. The discretisation term is taken about x'_i and kept along n_i only (a sample
+    * sliding along its own surface does not move the surface), and the covariance's extent
+    * along n_i is scaled by (1 - alpha)^2 + alpha^2 / k_eff, the variance of the shrunk
+    * position, k_eff = (sum w)^2 / sum w^2 the neighbours' effective number. Without a sensor
+    * noise model nothing changes. getSurfaceDisplacements() returns x'_i - x_i. */
+  void setSurfaceProjection (bool project) { project_ = project; }
+  bool getSurfaceProjection () const { return project_; }
+  /** \brief After compute() with projection on: x'_i - x_i per output point (zero when
+    * projection is off or moved nothing, NaN for non-finite points); empty otherwise. Kept as
+    * a displacement so that points far from the origin keep their double precision. */
+  const std::vector<Eigen::Vector3d>& getSurfaceDisplacements () const { return displacements_; }
+
 protected:
   bool initCompute () override;
   void computeFeature (PointCloudOut& output) override;
 
 private:
+  /** \brief The surface projection of one point (see setSurfaceProjection), from its
+    * neighbours' weighted mean offset and second moment about it: the displacement, the
+    * discretisation term about the moved point, the local normal and the variance share kept
+    * along it. False (nothing moves) without sensor variance along the normal. */
+  static bool projectOntoSurface (const Eigen::Vector3d& mean_offset, const Eigen::Matrix3d& second_moment,
+                                  double k_eff, const Eigen::Matrix3d& sensor_cov, Eigen::Vector3d& displacement,
+                                  Eigen::Matrix3d& psi, Eigen::Vector3d& normal, double& shrink);
+
   std::optional<double> tau_;
   bool use_discretization_ = true;
   SensorNoiseModel noise_;
   std::optional<SensorPose> sensor_pose_;
   std::vector<float> radii_;
+  bool project_ = false;
+  std::vector<Eigen::Vector3d> displacements_;
 };
 } // namespace pcl_probcollision
 

@@ -52,6 +52,7 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (o.epsilon, 0.02);
   EXPECT_EQ (o.split, "pca");
   EXPECT_FALSE (o.stochastic);
+  EXPECT_FALSE (o.measured);
   EXPECT_FALSE (o.exhaustive);
   EXPECT_FALSE (o.mesh_spacing);
   EXPECT_FALSE (o.output);
@@ -63,7 +64,7 @@ TEST (CliOptions, EveryOption)
   const ParseResult r = parse ({"-pose", "1,2,3,0.1,-0.2,3e-1", "-sigma", "0.01", "-sigma_b", "0.02", "-k", "7",
                                 "-thresholds", "0.2,0.8", "-seed", "18446744073709551615", "-nmax", "5", "-sigma_max",
                                 "0.1", "-epsilon", "0", "-split", "octree", "-stochastic", "-exhaustive",
-                                "-mesh_density", "0.004", "-o", "out.PCD", "-json", "-v"});
+                                "-mesh_density", "0.004", "-o", "out.PCD", "-json", "-measured", "-v"});
   ASSERT_EQ (r.kind, Kind::Run) << r.error;
   const Options& o = r.options;
   ASSERT_TRUE (o.pose);
@@ -81,6 +82,7 @@ TEST (CliOptions, EveryOption)
   EXPECT_EQ (o.epsilon, 0.0);
   EXPECT_EQ (o.split, "octree");
   EXPECT_TRUE (o.stochastic);
+  EXPECT_TRUE (o.measured);
   EXPECT_TRUE (o.exhaustive);
   EXPECT_EQ (*o.mesh_spacing, 0.004);
   EXPECT_EQ (*o.output, "out.PCD");

@@ -580,6 +580,22 @@ TEST_F (PcdCollisionTool, StochasticTraversalIsSeeded)
   EXPECT_EQ (run ({kGripper.string (), kScene.string (), "-stochastic", "-deterministic"}).status, 2);
 }
 
+// -measured switches the surface projection off: the touching pose reads a different P, and the
+// JSON says which model answered.
+TEST_F (PcdCollisionTool, MeasuredPositionsAreAnOption)
+{
+  const std::vector<std::string> base = {kGripper.string (), kScene.string (), "-pose", "-0.15,0.05,-0.01,0,0,0",
+                                         "-exhaustive"};
+  auto measured_args = base;
+  measured_args.push_back ("-measured");
+  const auto projected = runJson (base), measured = runJson (measured_args);
+  ASSERT_EQ (projected.size (), 1u);
+  ASSERT_EQ (measured.size (), 1u);
+  EXPECT_EQ (projected[0]["parameters"]["positions"].text, "projected");
+  EXPECT_EQ (measured[0]["parameters"]["positions"].text, "measured");
+  EXPECT_NE (projected[0]["probability"].text, measured[0]["probability"].text);
+}
+
 TEST_F (PcdCollisionTool, DemoDataIsReproducible)
 {
   // The recipe in data/README.md regenerates the committed files byte for byte.

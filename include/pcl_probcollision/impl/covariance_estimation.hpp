@@ -60,6 +60,7 @@ bool
 CovarianceEstimation<PointInT, PointOutT>::initCompute ()
 {
   radii_.clear ();
+  displacements_.clear ();
   if (this->search_radius_ != 0.0)
   {
     PCL_ERROR ("[pcl_probcollision::%s::initCompute] radius search (%g) is not supported: the "
@@ -81,6 +82,44 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
 }
 
 template <typename PointInT, typename PointOutT>
+bool
+CovarianceEstimation<PointInT, PointOutT>::projectOntoSurface (const Eigen::Vector3d& mean_offset,
+                                                             const Eigen::Matrix3d& second_moment, double k_eff,
+                                                             const Eigen::Matrix3d& sensor_cov,
+                                                             Eigen::Vector3d& displacement, Eigen::Matrix3d& psi,
+                                                             Eigen::Vector3d& normal, double& shrink)
+{
+  // Scatter of the neighbours (the point itself excluded, so that its own error does not pull
+  // the plane) about their weighted centroid; its weakest direction is the local normal.
+  const Eigen::Matrix3d scatter = second_moment - mean_offset * mean_offset.transpose ();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (0.5 * (scatter + scatter.transpose ()));
+  const Eigen::Vector3d n = eig.eigenvectors ().col (0);
+  const double lambda = std::max (eig.eigenvalues ()(0), 0.0);
+  const double s2 = n.dot (sensor_cov * n);
+  if (!(s2 > 0.0) || !(k_eff > 1.0))
+    return false;
+  // The sensor explains the scatter across the plane on a flat patch (alpha = 1; a factor 2
+  // absorbs the sampling spread of lambda over about ten neighbours); at an edge or corner
+  // the scatter is geometry, and the point keeps most of its measured position.
+  constexpr double kTolerance = 2.0;
+  const double alpha = lambda > kTolerance * s2 ? kTolerance * s2 / lambda : 1.0;
+  // x_i sits at the origin of the moments, so the centroid is at mean_offset.
+  displacement = alpha * n * n.dot (mean_offset);
+  // The discretisation term about the new position, sum w (d - delta)(d - delta)^T / sum w,
+  // along the normal only: sliding a sample along its own surface does not move the surface,
+  // and a tangential spread of the sample spacing, seen by a leaf separator that is tilted
+  // against the surface, read as a crossing (docs/RESULTS.md).
+  const Eigen::Matrix3d about_moved = second_moment - mean_offset * displacement.transpose () -
+                                      displacement * mean_offset.transpose () + displacement * displacement.transpose ();
+  psi = n.dot (about_moved * n) * n * n.transpose ();
+  // Variance of the shrunk position along n, as a share of the measured point's: the measured
+  // part weighs (1 - alpha), the plane's offset (error s2 / k_eff, independent of x_i) alpha.
+  shrink = (1.0 - alpha) * (1.0 - alpha) + alpha * alpha / k_eff;
+  normal = n;
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
 void
 CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output)
 {
@@ -96,6 +135,8 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
     finite_surface += pcl::isXYZFinite (p) ? 1 : 0;
 
   radii_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
+  if (project_)
+    displacements_.assign (indices.size (), Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
   pcl::Indices nn_indices;
   std::vector<float> nn_sqr_dists;
   bool dense = true;
@@ -134,6 +175,9 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
     radii_[out] = static_cast<float> (r);
 
     Eigen::Matrix3d psi = Eigen::Matrix3d::Zero ();
+    // Weighted mean offset of the neighbours and their effective number (surface projection).
+    Eigen::Vector3d first = Eigen::Vector3d::Zero ();
+    double k_eff = 0.0, weight_sq_sum = 0.0;
     if (kept > 0 && r > 0.0)
     {
       const double tau_i = tau * r / std::sqrt (static_cast<double> (kept));
@@ -145,10 +189,16 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
         const Eigen::Vector3d d = surface[nn_indices[j]].getVector3fMap ().template cast<double> () - xi;
         const double w = std::exp (-d.squaredNorm () * inv_tau2);
         psi.noalias () += w * d * d.transpose ();
+        first += w * d;
         weight_sum += w;
+        weight_sq_sum += w * w;
       }
       if (weight_sum > 0.0)
+      {
         psi /= weight_sum;
+        first /= weight_sum;
+        k_eff = weight_sum * weight_sum / weight_sq_sum;
+      }
     }
 
     Eigen::Matrix3d total = use_discretization_ ? psi : Eigen::Matrix3d::Zero ();
@@ -160,8 +210,22 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (psi);
         normal = eig.eigenvectors ().col (0);
       }
-      total += noise_.covariance (xi, normal, sensor);
+      const Eigen::Matrix3d sensor_cov = noise_.covariance (xi, normal, sensor);
+      Eigen::Vector3d delta, n;
+      Eigen::Matrix3d psi_moved;
+      double shrink = 1.0;
+      if (project_ && kept >= 2 && projectOntoSurface (first, psi, k_eff, sensor_cov, delta, psi_moved, n, shrink))
+      {
+        displacements_[out] = delta;
+        total = (use_discretization_ ? psi_moved : Eigen::Matrix3d::Zero ()) + sensor_cov;
+        const Eigen::Matrix3d A = Eigen::Matrix3d::Identity () - (1.0 - std::sqrt (shrink)) * n * n.transpose ();
+        total = A * total * A.transpose ();
+      }
+      else
+        total += sensor_cov;
     }
+    if (project_ && !displacements_[out].allFinite ())
+      displacements_[out].setZero ();
     total = 0.5 * (total + total.transpose ());
     output[out] = PointOutT (Covariance (total));
   }

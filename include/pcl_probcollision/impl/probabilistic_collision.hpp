@@ -128,6 +128,7 @@ ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud,
   // Estimate what the caller did not give: covariances and the neighbour radii (area weights).
   pcl::PointCloud<Covariance> estimated;
   std::vector<float> radii;
+  std::vector<Eigen::Vector3d> displacements;
   if (!covariances)
   {
     CovarianceEstimation<PointT> estimation;
@@ -136,8 +137,10 @@ ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud,
       estimation.setIndices (indices);
     estimation.setKSearch (k_);
     estimation.setSensorNoise (noise);
+    estimation.setSurfaceProjection (project_);
     estimation.compute (estimated);
     radii = estimation.getNeighbourRadii ();
+    displacements = estimation.getSurfaceDisplacements ();
   }
 
   UncertainCloud points;
@@ -159,6 +162,8 @@ ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud,
       continue;
     }
     points.means.emplace_back (p.getVector3fMap ().template cast<double> ());
+    if (!displacements.empty ())
+      points.means.back () += displacements[j];
     points.covariances.push_back (c.matrix ());
     points.source_indices.push_back (i);
     if (!radii.empty ())
