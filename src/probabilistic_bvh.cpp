@@ -227,6 +227,21 @@ nodeLeakage (const UncertainCloud& cloud, const std::vector<int>& points, const 
   return std::min (1.0, std::max (0.0, leak));
 }
 
+// A split whose epsilon overlap would store more than this share of the node's points twice is
+// made without overlap instead. epsilon = 0.02 duplicates a few percent, but from epsilon = 0.2
+// the children held nearly all of their parent and the hierarchy grew exponentially (1,000
+// points: a million nodes; found by fuzz/fuzz_collide, docs/RELIABILITY.md).
+// Small nodes may exceed the share by a few points without harm.
+constexpr double kMaxOverlapShare = 0.5;
+constexpr std::size_t kOverlapAllowance = 4;
+
+bool
+tooMuchOverlap (std::size_t stored, std::size_t m)
+{
+  const std::size_t twice = stored - m;
+  return twice > kOverlapAllowance && static_cast<double> (twice) > kMaxOverlapShare * static_cast<double> (m);
+}
+
 // Pca split (METHOD.md 8.1, 8.2). Returns false when no split makes progress.
 bool
 splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
@@ -253,6 +268,8 @@ splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
     }
     if (nl == m || nr == m || nl == 0 || nr == 0)
       continue;
+    if (attempt == 0 && epsilon > 0.0 && tooMuchOverlap (nl + nr, m))
+      continue;  // split without overlap
     children.assign (2, std::vector<int> ());
     children[0].reserve (nl);
     children[1].reserve (nr);
@@ -328,9 +345,13 @@ splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsil
       }
     }
     bool progress = true;
+    std::size_t stored = 0;
     for (const auto& c : cells)
+    {
       progress = progress && c.size () < m;
-    if (!progress)
+      stored += c.size ();
+    }
+    if (!progress || (attempt == 0 && e > 0.0 && tooMuchOverlap (stored, m)))
       continue;
     children.clear ();
     for (auto& c : cells)

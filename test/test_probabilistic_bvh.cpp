@@ -1483,3 +1483,28 @@ TEST (ProbabilisticBVH, TwoClustersOfDuplicatesSplitOnce)
   EXPECT_EQ (bvh.node (1).num_points + bvh.node (2).num_points, 60);
   EXPECT_EQ (bvh.storedPoints (), 60u);
 }
+
+// A large but valid epsilon must not make the hierarchy grow exponentially: splits that would
+// duplicate more than half of a node's points are made without overlap (before the guard,
+// 1,000 points with epsilon 0.2 made about a million nodes, and 48 points with an octree split
+// and epsilon 0.49 exhausted memory).
+TEST (ProbabilisticBVH, LargeEpsilonKeepsTheHierarchyLinearInSize)
+{
+  const UncertainCloud cloud = makeCloud (Shape::Box, 1000, 5);
+  for (const auto style : {BVHParams::SplitStyle::Pca, BVHParams::SplitStyle::Octree})
+  {
+    BVHParams params;
+    params.split_style = style;
+    const ProbabilisticBVH reference (cloud, params);
+    for (const double epsilon : {0.2, 0.49})
+    {
+      params.epsilon = epsilon;
+      const ProbabilisticBVH bvh (cloud, params);
+      EXPECT_LE (bvh.nodes ().size (), 4 * reference.nodes ().size ()) << "epsilon " << epsilon;
+      EXPECT_LE (bvh.storedPoints (), 4 * reference.storedPoints ()) << "epsilon " << epsilon;
+    }
+  }
+  // The default still overlaps siblings (some points stored twice).
+  const ProbabilisticBVH defaults (cloud, BVHParams ());
+  EXPECT_GT (defaults.storedPoints (), cloud.size ());
+}

@@ -38,7 +38,9 @@ struct BVHParams
     * split (dimensionless, >= 0; values >= 1/3 disable the variation rule). */
   double sigma_max = 0.05;
   /** \brief Sibling overlap as a fraction of the parent's extent L along the split axis:
-    * left = {p <= s + epsilon L}, right = {p >= s - epsilon L} (dimensionless, [0, 0.5)). */
+    * left = {p <= s + epsilon L}, right = {p >= s - epsilon L} (dimensionless, [0, 0.5)).
+    * A split whose overlap would store more than half of the node's points twice is made
+    * without overlap (so a large epsilon cannot make the hierarchy grow exponentially). */
   double epsilon = 0.02;
   /** \brief Box inflation in point standard deviations along each box axis (>= 0). */
   double k_sigma = 1.0;
