@@ -18,11 +18,7 @@ namespace
 Cloud::Ptr
 patch (int n, double spacing, double z, double sigma, std::mt19937_64& rng)
 {
-  // Box-Muller on the project's portable uniform draw: the same numbers on every platform.
-  auto normal = [&] () {
-    const double u1 = 1.0 - detail::uniformUnit (rng), u2 = detail::uniformUnit (rng);
-    return std::sqrt (-2.0 * std::log (u1)) * std::cos (6.283185307179586 * u2);
-  };
+  auto normal = [&] () { return detail::standardNormal (rng); };  // portable: same numbers everywhere
   Cloud::Ptr c (new Cloud);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i)

@@ -15,8 +15,6 @@
 
 #include <pcl_probcollision/collision_request.h>
 
-#include <pcl/io/pcd_io.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,7 +23,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
-#include <set>
+#include <tuple>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -64,18 +62,20 @@ progress (const std::string& text)
 }
 
 // ---------------------------------------------------------------------------------------------
-// Collected results.
+// Collected results. A cell is (workload, noise level, method, setting).
+using CellKey = std::tuple<std::string, double, std::string, std::string>;
+
 struct Results
 {
   std::vector<QueryRow> queries;
   std::vector<BuildRow> builds;
-  // flips[(workload, noise, method, setting)] = per pose, per re-sample: is free / score.
+  // flips[cell] = per pose, per re-sample: is free / score.
   struct Flip
   {
     std::vector<std::vector<bool>> is_free;
     std::vector<std::vector<double>> scores;
   };
-  std::map<std::tuple<std::string, double, std::string, std::string>, Flip> flips;
+  std::map<CellKey, Flip> flips;
 };
 
 // Runs one prebuilt method over a pose list, appending rows.
@@ -292,13 +292,12 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
       if (std::abs (w.poses[i].signed_distance) < sigma_eff)
         flip_poses.push_back (i);
     const int resamples = o.quick ? 5 : 20;
-    auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, int r, const Answer& a) {
+    auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
       auto& f = results.flips[{"W1", pct, method, setting}];
       f.is_free.resize (flip_poses.size ());
       f.scores.resize (flip_poses.size ());
       f.is_free[k].push_back (a.verdict == "free");
       f.scores[k].push_back (a.score);
-      (void) r;
     };
     for (int r = 0; r < resamples; ++r)
     {
@@ -310,7 +309,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
         BuildRow unused;
         const PoseQuery q = buildOurs (rob_r, env_r, sigma, s, unused, nullptr);
         for (std::size_t k = 0; k < flip_poses.size (); ++k)
-          record ("ours", s.name, k, r, q (w.poses[flip_poses[k]].T));
+          record ("ours", s.name, k, q (w.poses[flip_poses[k]].T));
       }
       for (const int factor : {1, 2, 4})
       {
@@ -318,7 +317,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
         map.buildEnv (*env_r, factor * sigma);
         map.setRobotMesh (w.rob_mesh);
         for (std::size_t k = 0; k < flip_poses.size (); ++k)
-          record ("octomap_" + std::to_string (factor) + "x", "mesh", k, r,
+          record ("octomap_" + std::to_string (factor) + "x", "mesh", k,
                   yesNo (map.collideMesh (w.poses[flip_poses[k]].T)));
       }
       NearestNeighbourBaseline nn;
@@ -327,7 +326,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
       {
         const double d = nn.minDistance (w.poses[flip_poses[k]].T, 0.05 * w.diagonal);
         for (const int m : {1, 2, 3})
-          record ("nn_" + std::to_string (m) + "sigma", "kdtree", k, r,
+          record ("nn_" + std::to_string (m) + "sigma", "kdtree", k,
                   Answer {std::exp (-d / (m * sigma_eff)), d < m * sigma_eff ? "collision" : "free"});
       }
     }
@@ -445,7 +444,7 @@ writeOutputs (const Options& o, const Results& results)
   writeFile (o.out_dir + "/queries.csv", q.str ());
 
   // Group rows per (workload, noise, method, setting), in first-seen order.
-  using Key = std::tuple<std::string, double, std::string, std::string>;
+  using Key = CellKey;
   std::vector<Key> order;
   std::map<Key, std::vector<const QueryRow*>> groups;
   for (const auto& r : results.queries)

@@ -365,14 +365,6 @@ ExactMeshPair::memoryBytes () const
 }
 
 // ---------------------------------------------------------------------------------------------
-double
-standardNormal (std::mt19937_64& rng)
-{
-  const double u1 = 1.0 - pcl_probcollision::detail::uniformUnit (rng);  // (0, 1]: log is finite
-  const double u2 = pcl_probcollision::detail::uniformUnit (rng);
-  return std::sqrt (-2.0 * std::log (u1)) * std::cos (6.283185307179586476925 * u2);
-}
-
 Eigen::Quaterniond
 uniformRotation (std::mt19937_64& rng)
 {

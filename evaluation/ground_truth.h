@@ -10,6 +10,8 @@
 
 #include "mesh_input.h"
 
+#include <pcl_probcollision/normal_distribution.h>
+
 #include <Eigen/Geometry>
 
 #include <cstddef>
@@ -108,9 +110,8 @@ struct PoseTruth
   bool collision = false;        ///< ExactMeshPair::collide (T)
 };
 
-/** \brief Standard normal draw (Box-Muller on the raw 53-bit uniform of
-  * pcl_probcollision::detail::uniformUnit): the same sequence with every standard library. */
-double standardNormal (std::mt19937_64& rng);
+/** \brief The library's portable standard normal draw (normal_distribution.h). */
+using pcl_probcollision::detail::standardNormal;
 
 /** \brief Uniform random rotation: unit quaternion of four standard normals. */
 Eigen::Quaterniond uniformRotation (std::mt19937_64& rng);

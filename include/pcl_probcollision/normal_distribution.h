@@ -27,5 +27,15 @@ uniformUnit (std::mt19937_64& rng)
 {
   return static_cast<double> (rng () >> 11) * 0x1.0p-53;
 }
+
+/** \brief Standard normal draw by Box-Muller on two uniformUnit draws (the cosine branch):
+  * portable for the same reason. */
+inline double
+standardNormal (std::mt19937_64& rng)
+{
+  const double u1 = 1.0 - uniformUnit (rng);  // (0, 1]: the logarithm is finite
+  const double u2 = uniformUnit (rng);
+  return std::sqrt (-2.0 * std::log (u1)) * std::cos (6.283185307179586476925 * u2);
+}
 } // namespace detail
 } // namespace pcl_probcollision
