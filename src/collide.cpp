@@ -153,9 +153,8 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
       best = contribution;
       const bool on_a = leaf.witness_side > 0;
       const int local = on_a ? span_a[leaf.witness_index] : span_b[leaf.witness_index];
-      const UncertainCloud& cloud = on_a ? a.cloud () : b.cloud ();
       result.witness_side = on_a ? 1 : -1;
-      result.witness_index = cloud.source_indices.empty () ? local : cloud.source_indices[local];
+      result.witness_index = (on_a ? a : b).sourceIndex (local);
       result.witness_point = on_a ? means_a[leaf.witness_index] : means_b[leaf.witness_index];
       result.witness_normal = leaf.witness_normal;
     }

@@ -380,7 +380,15 @@ TEST_P (BVHInvariants, Hold)
   // Root holds every point; the stored cloud is the input.
   EXPECT_EQ (bvh.size (), n);
   EXPECT_EQ (nodes[0].num_points, static_cast<std::int32_t> (n));
-  EXPECT_EQ (bvh.cloud ().means, cloud.means);
+  EXPECT_EQ (bvh.means (), cloud.means);
+  ASSERT_EQ (bvh.covariances ().size (), n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Eigen::Matrix3d sym = 0.5 * (cloud.covariances[i] + cloud.covariances[i].transpose ());
+    EXPECT_EQ ((bvh.covariances ()[i].matrix () - sym).cwiseAbs ().maxCoeff (), 0.0) << i;
+    const Eigen::Vector3d a = Eigen::Vector3d (0.3, -0.5, 0.8).normalized ();
+    EXPECT_NEAR (bvh.covariances ()[i].quadratic (a), a.dot (sym * a), 1e-12 * sym.norm ()) << i;
+  }
 
   std::vector<int> covered (n, 0);
   std::size_t leaves = 0, stored = 0;
@@ -527,7 +535,8 @@ TEST_P (BVHInvariants, Hold)
   EXPECT_EQ (bvh.depth (), max_depth + 1);
   EXPECT_EQ (nodes[0].begin, 0);
   EXPECT_EQ (static_cast<std::size_t> (nodes[0].end), stored);
-  const std::size_t floor_bytes = n * (sizeof (Eigen::Vector3d) + sizeof (Eigen::Matrix3d) + sizeof (double) + sizeof (int)) +
+  // Means, packed covariances (48 bytes) and source indices; the area weights are not kept.
+  const std::size_t floor_bytes = n * (sizeof (Eigen::Vector3d) + sizeof (PackedCovariance) + sizeof (int)) +
                                   nodes.size () * sizeof (Node) + stored * sizeof (int);
   EXPECT_GE (bvh.bytes (), floor_bytes);
   EXPECT_LE (bvh.bytes (), floor_bytes + sizeof (ProbabilisticBVH));
@@ -1356,7 +1365,7 @@ TEST (ProbabilisticBVH, MoveBuildAndUnionBound)
   EXPECT_EQ (c.size (), 800u);
   ASSERT_TRUE (by_move.build (std::move (c)));
   EXPECT_EQ (by_move.pointIndices (), by_copy.pointIndices ());
-  EXPECT_EQ (by_move.cloud ().means, copy.means);
+  EXPECT_EQ (by_move.means (), copy.means);
   EXPECT_GE (by_move.buildMilliseconds (), 0.0);
   // The union bound is an upper bound of the min-slab leakage, node by node.
   BVHParams ub;

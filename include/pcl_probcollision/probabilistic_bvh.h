@@ -180,7 +180,7 @@ public:
   bool empty () const { return nodes_.empty (); }
 
   /** \brief Number of distinct points (the size of the stored cloud). */
-  std::size_t size () const { return cloud_.size (); }
+  std::size_t size () const { return means_.size (); }
 
   /** \brief All nodes; the root is nodes()[0] when not empty. */
   const std::vector<Node>& nodes () const { return nodes_; }
@@ -207,7 +207,7 @@ public:
   /** \brief Number of levels: 0 when empty, 1 for a single leaf. */
   int depth () const { return depth_; }
 
-  /** \brief Memory held by this object in bytes: the stored cloud (means, covariances, weights,
+  /** \brief Memory held by this object in bytes: the stored points (means, packed covariances,
     * source indices), the nodes and the index array, by capacity. */
   std::size_t bytes () const;
 
@@ -215,8 +215,17 @@ public:
     * input validation and the copy of a const cloud excluded). */
   double buildMilliseconds () const { return build_milliseconds_; }
 
-  /** \brief The stored copy of the cloud, in its own frame. */
-  const UncertainCloud& cloud () const { return cloud_; }
+  /** \brief The stored point means, in the cloud's own frame (index = point index of the
+    * hierarchy). */
+  const std::vector<Eigen::Vector3d>& means () const { return means_; }
+  /** \brief The stored covariances, symmetrised and packed (area weights are not kept: they
+    * only weight the leakage at build time). */
+  const std::vector<PackedCovariance>& covariances () const { return covariances_; }
+  /** \brief The source index of every point (the built cloud's source_indices), or empty when
+    * the built cloud had none. */
+  const std::vector<int>& sourceIndices () const { return source_indices_; }
+  /** \brief The caller's index of point i: sourceIndices()[i], or i when there are none. */
+  int sourceIndex (int i) const { return source_indices_.empty () ? i : source_indices_[static_cast<std::size_t> (i)]; }
 
   /** \brief The parameters of the last successful build(). */
   const BVHParams& params () const { return params_; }
@@ -247,7 +256,10 @@ public:
 private:
   bool buildValidated (UncertainCloud&& cloud, const BVHParams& params);
 
-  UncertainCloud cloud_;
+  // The points, in the cloud's own frame: 76 bytes a point.
+  std::vector<Eigen::Vector3d> means_;
+  std::vector<PackedCovariance> covariances_;
+  std::vector<int> source_indices_;
   BVHParams params_;
   std::vector<Node> nodes_;
   std::vector<int> indices_;

@@ -29,6 +29,34 @@ struct UncertainCloud
   bool empty () const { return means.empty (); }
 };
 
+/** \brief A symmetric 3 x 3 covariance stored by its six distinct entries: 48 bytes instead of
+  * the 72 of an Eigen::Matrix3d, for the copies a hierarchy keeps of every point. */
+struct PackedCovariance
+{
+  double xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+
+  PackedCovariance () = default;
+  /** \brief The symmetric part (S + S^T) / 2 of s. */
+  explicit PackedCovariance (const Eigen::Matrix3d& s)
+    : xx (s (0, 0)), xy (0.5 * (s (0, 1) + s (1, 0))), xz (0.5 * (s (0, 2) + s (2, 0))), yy (s (1, 1)),
+      yz (0.5 * (s (1, 2) + s (2, 1))), zz (s (2, 2)) {}
+  /** \brief The full matrix. */
+  Eigen::Matrix3d
+  matrix () const
+  {
+    Eigen::Matrix3d m;
+    m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return m;
+  }
+  /** \brief a^T Sigma a: the variance along a (for a unit a). */
+  double
+  quadratic (const Eigen::Vector3d& a) const
+  {
+    return a.x () * a.x () * xx + a.y () * a.y () * yy + a.z () * a.z () * zz +
+           2.0 * (a.x () * a.y () * xy + a.x () * a.z () * xz + a.y () * a.z () * yz);
+  }
+};
+
 /** \brief A non-owning view of n points with covariances, as the classifier consumes them. */
 struct PointSetView
 {

@@ -285,14 +285,14 @@ ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input
   // Per-point values: from hierarchy order to the caller's clouds.
   if (request_.per_point)
   {
-    auto scatter = [] (const std::vector<float>& in, const UncertainCloud& cloud, std::size_t size) {
+    auto scatter = [] (const std::vector<float>& in, const ProbabilisticBVH& bvh, std::size_t size) {
       std::vector<float> out (size, std::numeric_limits<float>::quiet_NaN ());
       for (std::size_t j = 0; j < in.size (); ++j)
-        out[cloud.source_indices[j]] = in[j];
+        out[bvh.sourceIndex (static_cast<int> (j))] = in[j];
       return out;
     };
-    result.probabilities_a = scatter (result.probabilities_a, input_bvh_->cloud (), this->input_->size ());
-    result.probabilities_b = scatter (result.probabilities_b, target_bvh_->cloud (), target_->size ());
+    result.probabilities_a = scatter (result.probabilities_a, *input_bvh_, this->input_->size ());
+    result.probabilities_b = scatter (result.probabilities_b, *target_bvh_, target_->size ());
   }
   return true;
 }
