@@ -9,3 +9,15 @@ target_compile_options(evaluate_collision PRIVATE -Wall -Wextra)
 add_executable(calibration_drift calibration_drift.cpp)
 target_link_libraries(calibration_drift PRIVATE pcl_probcollision)
 target_compile_options(calibration_drift PRIVATE -Wall -Wextra)
+
+# Issue #8's figures (docs/PERFORMANCE.md): build, query and batch times beside the octomap and
+# exact-mesh references on the same poses. Prints counters; asserts nothing.
+find_package(benchmark QUIET)
+if(benchmark_FOUND)
+  add_executable(bench_performance bench_performance.cpp)
+  target_link_libraries(bench_performance PRIVATE eval_ground_truth eval_metrics pcd_collision_mesh
+    pcl_probcollision benchmark::benchmark)
+  target_compile_options(bench_performance PRIVATE -Wall -Wextra)
+  target_compile_definitions(bench_performance PRIVATE
+    PCL_PROBCOLLISION_SHARED_DATA="${PCL_PROBCOLLISION_SHARED_DATA}")
+endif()

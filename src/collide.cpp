@@ -50,6 +50,10 @@ traversalParams (const CollisionRequest& request)
   p.exhaustive = request.exhaustive;
   // In decision mode a contribution above collision_above makes InCollision final (METHOD.md 7).
   p.stop_probability = request.collision_above;
+  // A pair whose reach weight is at most the maximum so far cannot raise it (its contribution
+  // is rho * P_leaf <= rho): same probability and witness, fewer classifier fits. Per-point
+  // values need every reachable leaf pair, so they keep the full traversal.
+  p.skip_dominated = !request.per_point;
   return p;
 }
 } // namespace

@@ -450,6 +450,36 @@ TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
   }
 }
 
+// Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
+// so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
+TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
+{
+  const ProbabilisticBVH a (sheet (600, 0.2, 0.0, 0.002, 31));
+  std::size_t fewer = 0;
+  for (const double gap : {0.03, 0.008, 0.004, 0.0})
+  {
+    SCOPED_TRACE (gap);
+    const ProbabilisticBVH b (sheet (600, 0.2, gap, 0.002, 32));
+    for (const double tilt : {0.0, 0.2})
+    {
+      const Eigen::Isometry3d T (Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ()));
+      CollisionRequest full, lean;
+      full.per_point = true;  // every reachable leaf pair
+      lean.per_point = false;
+      CollisionResult rf, rl;
+      ASSERT_TRUE (collide (a, b, T, full, rf)) << rf.message;
+      ASSERT_TRUE (collide (a, b, T, lean, rl)) << rl.message;
+      EXPECT_EQ (rf.probability, rl.probability);
+      EXPECT_EQ (rf.verdict, rl.verdict);
+      EXPECT_EQ (rf.witness_side, rl.witness_side);
+      EXPECT_EQ (rf.witness_index, rl.witness_index);
+      EXPECT_LE (rl.leaf_pairs_tested, rf.leaf_pairs_tested);
+      fewer += rl.leaf_pairs_tested < rf.leaf_pairs_tested;
+    }
+  }
+  EXPECT_GT (fewer, 0u) << "no query was cheaper without per-point values";
+}
+
 TEST (Reliability, ReorderingThePointsKeepsTheProbability)
 {
   CollisionRequest rq;

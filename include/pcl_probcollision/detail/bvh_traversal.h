@@ -215,9 +215,15 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
   {
     const Entry e = stack.back ();
     stack.pop_back ();
+    double rho = e.rho;
+    // The weight only shrinks below this pair: dominated already, no box test needed.
+    if (params.skip_dominated && rho <= best)
+    {
+      ++result.pruned_pairs;
+      continue;
+    }
     const Node& na = nodes_a[static_cast<std::size_t> (e.a)];
     const Node& nb = nodes_b[static_cast<std::size_t> (e.b)];
-    double rho = e.rho;
 
     ++result.node_pairs_tested;
     const Eigen::Vector3d extra_a = margin + grow_a * na.max_sigma.cast<double> ();

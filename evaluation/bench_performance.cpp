@@ -1,0 +1,329 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Issue #8's figures (docs/PERFORMANCE.md), side by side with the references in one run.
+//
+// Workload: FCL's piano and room meshes (../shared/data/meshes, millimetres), each sampled to
+// 10,000 points (uniform by area plus every vertex), Gaussian noise of 0.5 % of the piano's
+// bounding-box diagonal on every coordinate of both, declared as isotropic sensor noise;
+// 2,000 uniform random piano poses and 700 near-contact poses (exact |signed distance| under
+// 2 % of the piano's diagonal), labelled by FCL on the meshes (evaluation/ground_truth.h).
+// References on the same poses in the same loop: FCL colliding the piano mesh with an octomap
+// of the noisy room cloud at 2 sigma resolution (what MoveIt does), and FCL on the exact meshes.
+//
+// Benchmarks (one iteration each; the figures are counters, nothing is asserted):
+//   BM_Build/N          covariance estimation + hierarchy of the room sampled to N points
+//   BM_Query/uniform    per-pose times (median, p99) of ours, the octomap and exact FCL,
+//   BM_Query/near       with our accuracy on the same poses (easy right, ROC AUC, Brier)
+//   BM_Batch/threads:T  computeBatch() over all 2,700 poses on T threads: poses per second,
+//                       and whether every answer equals the one-thread answer bit for bit
+//
+// PCL_PROBCOLLISION_SHARED_DATA (environment) overrides the compiled-in data directory.
+#include "baselines.h"
+#include "ground_truth.h"
+#include "mesh_sampling.h"
+#include "metrics.h"
+
+#include <pcl_probcollision/probabilistic_collision.h>
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace pcl_probcollision;
+using namespace pcl_probcollision_eval;
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double
+microsecondsSince (Clock::time_point start)
+{
+  return std::chrono::duration<double, std::micro> (Clock::now () - start).count ();
+}
+
+std::string
+dataDir ()
+{
+  const char* env = std::getenv ("PCL_PROBCOLLISION_SHARED_DATA");
+  return env && *env ? env : PCL_PROBCOLLISION_SHARED_DATA;
+}
+
+/** \brief The mesh sampled to about target points, with N(0, sigma^2) on every coordinate. */
+CloudXYZ::Ptr
+noisySamples (const TriangleMesh& mesh, std::size_t target, double sigma, std::uint64_t seed)
+{
+  // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
+  const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
+  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
+  CloudXYZ::Ptr cloud (new CloudXYZ (pcd_collision::sampleMesh (mesh, spacing, seed)));
+  std::mt19937_64 rng (seed + 7);
+  for (auto& p : cloud->points)
+  {
+    // one draw per statement: the order is the same with every compiler
+    const double dx = sigma * standardNormal (rng);
+    const double dy = sigma * standardNormal (rng);
+    const double dz = sigma * standardNormal (rng);
+    p.x += static_cast<float> (dx);
+    p.y += static_cast<float> (dy);
+    p.z += static_cast<float> (dz);
+  }
+  return cloud;
+}
+
+/** \brief The two meshes and the noise level (all a build benchmark needs). */
+struct Meshes
+{
+  TriangleMesh rob_mesh, env_mesh;
+  std::unique_ptr<ExactMeshPair> exact;
+  double diagonal = 0.0, sigma = 0.0;
+};
+
+const Meshes&
+meshes ()
+{
+  static const Meshes m = [] {
+    Meshes m;
+    const std::string dir = dataDir () + "/meshes/";
+    std::string error;
+    if (!pcd_collision::loadTriangleMesh (dir + "piano_room_rob.obj", m.rob_mesh, error) ||
+        !pcd_collision::loadTriangleMesh (dir + "piano_room_env.obj", m.env_mesh, error))
+      throw std::runtime_error (error);
+    m.exact.reset (new ExactMeshPair (m.rob_mesh, m.env_mesh));
+    m.diagonal = m.exact->robotDiagonal ();
+    m.sigma = 0.005 * m.diagonal;
+    return m;
+  }();
+  return m;
+}
+
+/** \brief The clouds, the labelled poses and every method prebuilt. */
+/** \brief The query settings: library defaults, or one change named by the environment
+  * variable BENCH_PERFORMANCE_SETTING (for the speed-versus-accuracy comparison):
+  * "rff256" (the ladder stops at D = 256), "linear" (plane only), "stochastic" traversal. */
+CollisionRequest
+settingRequest ()
+{
+  CollisionRequest request;
+  const char* env = std::getenv ("BENCH_PERFORMANCE_SETTING");
+  const std::string setting = env ? env : "";
+  if (setting == "rff256")
+    request.classifier.rff_features_large = request.classifier.rff_features;
+  else if (setting == "linear")
+    request.classifier.kernel = KernelMode::Linear;
+  else if (setting == "stochastic")
+    request.traversal = TraversalMode::Stochastic;
+  else if (!setting.empty () && setting != "default")
+    throw std::invalid_argument ("BENCH_PERFORMANCE_SETTING: unknown setting '" + setting + "'");
+  return request;
+}
+
+struct Workload
+{
+  const Meshes* m = nullptr;
+  double sigma = 0.0;
+  CloudXYZ::Ptr piano, room;
+  std::vector<PoseTruth> uniform, near;
+  std::unique_ptr<ProbabilisticCollision<pcl::PointXYZ>> ours;  // hierarchies prebuilt
+  std::unique_ptr<OctomapBaseline> octomap;                     // 2 sigma, vs the piano mesh
+  double setup_s = 0.0;
+};
+
+Workload&
+workload ()
+{
+  static Workload w = [] {
+    Workload w;
+    const auto start = Clock::now ();
+    w.m = &meshes ();
+    w.sigma = w.m->sigma;
+    w.piano = noisySamples (w.m->rob_mesh, 10000, w.sigma, 801);
+    w.room = noisySamples (w.m->env_mesh, 10000, w.sigma, 802);
+    w.uniform = uniformPoseTruths (*w.m->exact, 2000, 803, 2);
+    NearContactOptions nc;
+    nc.band = 0.02 * w.m->diagonal;
+    nc.threads = 2;
+    w.near = nearContactPoses (*w.m->exact, 700, 804, nc);
+
+    w.ours.reset (new ProbabilisticCollision<pcl::PointXYZ>);
+    w.ours->setRequest (settingRequest ());
+    w.ours->setInputCloud (w.piano);
+    w.ours->setTargetCloud (w.room);
+    w.ours->setInputNoise (SensorNoiseModel::isotropic (w.sigma));
+    w.ours->setTargetNoise (SensorNoiseModel::isotropic (w.sigma));
+    CollisionResult r;
+    if (!w.ours->compute (r))
+      throw std::runtime_error ("building the hierarchies failed: " + r.message);
+
+    w.octomap.reset (new OctomapBaseline);
+    w.octomap->buildEnv (*w.room, 2.0 * w.sigma);
+    w.octomap->setRobotMesh (w.m->rob_mesh);
+    w.setup_s = microsecondsSince (start) / 1e6;
+    return w;
+  }();
+  return w;
+}
+
+// ---------------------------------------------------------------------------------------------
+void
+BM_Build (benchmark::State& state)
+{
+  const Meshes& w = meshes ();
+  const std::size_t target = static_cast<std::size_t> (state.range (0));
+  const CloudXYZ::Ptr room = noisySamples (w.env_mesh, target, w.sigma, 805);
+  // A one-point object B: its build is negligible, build_ms is the room's.
+  CloudXYZ::Ptr dot (new CloudXYZ);
+  dot->push_back (pcl::PointXYZ (0.f, 0.f, 0.f));
+  double ms = 0.0;
+  double hierarchy_ms = 0.0;
+  std::size_t bytes = 0, stored = 0, nodes = 0;
+  for (auto _ : state)
+  {
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    pc.setInputCloud (room);
+    pc.setTargetCloud (dot);
+    pc.setInputNoise (SensorNoiseModel::isotropic (w.sigma));
+    pc.setTargetNoise (SensorNoiseModel::isotropic (w.sigma));
+    CollisionRequest request;
+    request.enable_timings = true;
+    pc.setRequest (request);
+    CollisionResult r;
+    if (!pc.compute (Eigen::Isometry3d (Eigen::Translation3d (1e5, 0.0, 0.0)), r))
+    {
+      state.SkipWithError (r.message.c_str ());
+      return;
+    }
+    ms = r.build_ms;
+    hierarchy_ms = pc.getInputHierarchy ()->buildMilliseconds ();
+    bytes = pc.getInputHierarchy ()->bytes ();
+    stored = pc.getInputHierarchy ()->storedPoints ();
+    nodes = pc.getInputHierarchy ()->nodes ().size ();
+  }
+  const double n = static_cast<double> (room->size ());
+  state.counters["points"] = n;
+  state.counters["build_ms"] = ms;
+  state.counters["ms_per_10k_points"] = ms / n * 1e4;
+  state.counters["hierarchy_ms"] = hierarchy_ms;
+  state.counters["bytes_per_point"] = static_cast<double> (bytes) / n;
+  state.counters["stored_per_point"] = static_cast<double> (stored) / n;
+  state.counters["nodes"] = static_cast<double> (nodes);
+}
+BENCHMARK (BM_Build)->Arg (10000)->Arg (100000)->Arg (1000000)->Unit (benchmark::kMillisecond)->Iterations (1);
+
+/** \brief The hierarchy alone (the points with covariances given), CPU time per build. */
+void
+BM_Hierarchy (benchmark::State& state)
+{
+  const Meshes& w = meshes ();
+  const CloudXYZ::Ptr room = noisySamples (w.env_mesh, static_cast<std::size_t> (state.range (0)), w.sigma, 805);
+  CloudXYZ::Ptr dot (new CloudXYZ);
+  dot->push_back (pcl::PointXYZ (0.f, 0.f, 0.f));
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (room);
+  pc.setTargetCloud (dot);
+  pc.setInputNoise (SensorNoiseModel::isotropic (w.sigma));
+  CollisionResult r;
+  if (!pc.compute (Eigen::Isometry3d (Eigen::Translation3d (1e5, 0.0, 0.0)), r))
+  {
+    state.SkipWithError (r.message.c_str ());
+    return;
+  }
+  const ProbabilisticBVH& built = *pc.getInputHierarchy ();
+  UncertainCloud points;
+  points.means = built.means ();
+  for (const PackedCovariance& c : built.covariances ())
+    points.covariances.push_back (c.matrix ());
+  for (auto _ : state)
+  {
+    ProbabilisticBVH bvh (points);
+    benchmark::DoNotOptimize (bvh.nodes ().data ());
+  }
+  state.counters["points"] = static_cast<double> (points.size ());
+}
+BENCHMARK (BM_Hierarchy)->Arg (10000)->Arg (100000)->Unit (benchmark::kMillisecond);
+
+// ---------------------------------------------------------------------------------------------
+void
+queryCounters (benchmark::State& state, const std::vector<PoseTruth>& poses)
+{
+  Workload& w = workload ();
+  std::vector<double> ours_us, octo_us, fcl_us, score;
+  std::vector<bool> truth;
+  std::size_t easy = 0, easy_right = 0, leaf_pairs = 0, octo_right = 0, kernel_pairs = 0, iterations = 0;
+  const double sigma_eff = std::sqrt (2.0) * w.sigma;
+  for (auto _ : state)
+  {
+    ours_us.clear ();
+    octo_us.clear ();
+    fcl_us.clear ();
+    score.clear ();
+    truth.clear ();
+    easy = easy_right = leaf_pairs = octo_right = kernel_pairs = iterations = 0;
+    for (const PoseTruth& pose : poses)
+    {
+      CollisionResult r;
+      auto t0 = Clock::now ();
+      const bool ok = w.ours->compute (pose.T, r);
+      ours_us.push_back (microsecondsSince (t0));
+      t0 = Clock::now ();
+      const bool octo = w.octomap->collideMesh (pose.T);
+      octo_us.push_back (microsecondsSince (t0));
+      t0 = Clock::now ();
+      const bool exact = w.m->exact->collide (pose.T);
+      fcl_us.push_back (microsecondsSince (t0));
+      benchmark::DoNotOptimize (exact);
+      if (!ok)
+      {
+        state.SkipWithError (r.message.c_str ());
+        return;
+      }
+      score.push_back (r.probability);
+      truth.push_back (pose.collision);
+      leaf_pairs += r.leaf_pairs_tested;
+      kernel_pairs += r.kernel_leaf_pairs;
+      iterations += r.classifier_iterations;
+      octo_right += octo == pose.collision;
+      if (std::abs (pose.signed_distance) > 3.0 * sigma_eff)
+      {
+        ++easy;
+        easy_right += pose.collision ? r.verdict == Verdict::InCollision : r.verdict == Verdict::Free;
+      }
+    }
+  }
+  const TimeSummary ours = summarizeTimes (ours_us), octo = summarizeTimes (octo_us), fcl = summarizeTimes (fcl_us);
+  state.counters["poses"] = static_cast<double> (poses.size ());
+  state.counters["ours_median_us"] = ours.median;
+  state.counters["ours_p99_us"] = ours.p99;
+  state.counters["ours_max_us"] = ours.max;
+  state.counters["octomap2s_median_us"] = octo.median;
+  state.counters["octomap2s_p99_us"] = octo.p99;
+  state.counters["fcl_mesh_median_us"] = fcl.median;
+  state.counters["median_ratio_to_octomap"] = ours.median / octo.median;
+  state.counters["leaf_pairs_mean"] = static_cast<double> (leaf_pairs) / poses.size ();
+  state.counters["kernel_pairs_mean"] = static_cast<double> (kernel_pairs) / poses.size ();
+  state.counters["iterations_per_leaf_pair"] = static_cast<double> (iterations) / std::max<std::size_t> (1, leaf_pairs);
+  state.counters["easy"] = static_cast<double> (easy);
+  state.counters["easy_right"] = static_cast<double> (easy_right);
+  state.counters["auc"] = rocAuc (score, truth);
+  state.counters["brier"] = brierScore (score, truth);
+  state.counters["octomap2s_right"] = static_cast<double> (octo_right);
+}
+
+void
+BM_Query (benchmark::State& state)
+{
+  const Workload& w = workload ();
+  queryCounters (state, state.range (0) == 0 ? w.uniform : w.near);
+  state.counters["setup_s"] = w.setup_s;
+}
+BENCHMARK (BM_Query)->ArgName ("near")->Arg (0)->Arg (1)->Unit (benchmark::kMillisecond)->Iterations (1);
+} // namespace
+
+BENCHMARK_MAIN ();
