@@ -49,6 +49,58 @@ BVHParams::validate () const
 
 namespace
 {
+// The table of detail::normalTailTabulated: Phi(-z_i) and the step times its derivative at
+// z_i = i / 128 on [0, kNegligibleTailZ]; built at load time, so the lookup needs no guard.
+constexpr int kTailSteps = 128 * static_cast<int> (detail::kNegligibleTailZ);
+constexpr double kTailStep = detail::kNegligibleTailZ / kTailSteps;
+struct TailTable
+{
+  double f[kTailSteps + 1];
+  double df[kTailSteps + 1];
+  TailTable ()
+  {
+    for (int i = 0; i <= kTailSteps; ++i)
+    {
+      const double zi = i * kTailStep;
+      f[i] = normalCdf (-zi);
+      df[i] = -kTailStep * 0.39894228040143267794 * std::exp (-0.5 * zi * zi);
+    }
+  }
+};
+const TailTable kTailTable;
+
+/** \brief normalTailTabulated for z in [0, kNegligibleTailZ) (cubic Hermite on the table). */
+inline double
+tailInRange (double z)
+{
+  const double x = z * (1.0 / kTailStep);
+  const int i = static_cast<int> (x);
+  const double t = x - i, t2 = t * t, t3 = t2 * t;
+  return (2.0 * t3 - 3.0 * t2 + 1.0) * kTailTable.f[i] + (t3 - 2.0 * t2 + t) * kTailTable.df[i] +
+         (3.0 * t2 - 2.0 * t3) * kTailTable.f[i + 1] + (t3 - t2) * kTailTable.df[i + 1];
+}
+
+/** \brief normalTailTabulated for z >= 0 (NaN not expected). */
+inline double
+tail (double z)
+{
+  return z < detail::kNegligibleTailZ ? tailInRange (z) : 0.0;
+}
+} // namespace
+
+namespace detail
+{
+double
+normalTailTabulated (double z)
+{
+  if (!(z >= 0.0))
+    return z < 0.0 ? 1.0 - normalTailTabulated (-z) : z;  // NaN stays NaN
+  return tail (z);
+}
+} // namespace detail
+
+namespace
+{
 // Largest accepted cloud: stored indices (with duplication) and node ranges are int32.
 constexpr std::size_t kMaxPoints = std::size_t (1) << 28;
 
@@ -205,28 +257,37 @@ computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, do
   }
 }
 
-/** \brief P_x = max_k (1 - P_slab(a_k)) (MinSlab) of point i, skipping the erfc of axes that
+/** \brief P_x = max_k (1 - P_slab(a_k)) (MinSlab) of point i, skipping the tails of axes that
   * cannot attain the maximum. With d_k the distance of the point to the nearer face of axis k
   * in its own standard deviations (d_k >= 0: the point is inside its box), axis k's outside
   * probability lies in [Phi(-d_k), 2 Phi(-d_k)], and Phi(-d - 1) < Phi(-d) / 2 for d >= 0: an
-  * axis with d_k >= min_j d_j + 1 is strictly below the maximum. Same value as the plain
-  * maximum, about a third of the erfc calls (most points sit deep inside along two axes). */
+  * axis with d_k >= min_j d_j + 1 is strictly below the maximum (most points sit deep inside
+  * along two axes). */
 double
 outsideMinSlab (const NodeGeometry& g, std::size_t i)
 {
-  double d[3];
+  // Distances to the lower and upper face in standard deviations (>= 0 up to rounding: the
+  // box holds the point); s = 0 gives infinity, i.e. outside probability 0.
+  double z_lo[3], z_hi[3], d[3];
   double d_min = std::numeric_limits<double>::infinity ();
   for (int k = 0; k < 3; ++k)
   {
     const double s = g.s[k][i];
-    const double gap = std::min (g.q[k][i] - g.lo (k), g.hi (k) - g.q[k][i]);
-    d[k] = s > 0.0 ? gap / s : std::numeric_limits<double>::infinity ();
+    if (s > 0.0)
+    {
+      const double inv = 1.0 / s;
+      z_lo[k] = std::max (0.0, g.q[k][i] - g.lo (k)) * inv;
+      z_hi[k] = std::max (0.0, g.hi (k) - g.q[k][i]) * inv;
+    }
+    else
+      z_lo[k] = z_hi[k] = std::numeric_limits<double>::infinity ();
+    d[k] = std::min (z_lo[k], z_hi[k]);
     d_min = std::min (d_min, d[k]);
   }
   double out = 0.0;
   for (int k = 0; k < 3; ++k)
-    if (!(d[k] >= d_min + 1.0))  // s = 0 (d = inf): inside its own box, outside probability 0
-      out = std::max (out, detail::slabOutsideProbability (g.lo (k), g.hi (k), g.q[k][i], g.s[k][i]));
+    if (!(d[k] >= d_min + 1.0))  // slabOutsideProbability with the tabulated tail
+      out = std::max (out, std::min (1.0, tail (z_lo[k]) + tail (z_hi[k])));
   return out;
 }
 

@@ -671,6 +671,28 @@ TEST (Leakage, PointOracles)
   EXPECT_EQ (detail::pointOutsideProbability (box, Eigen::Vector3d (0, 0, 0.06), flat), 1.0);
 }
 
+// The build's tabulated tail against erfc: absolute error below 1e-11 everywhere.
+TEST (Leakage, TabulatedTailMatchesErfc)
+{
+  double worst = 0.0;
+  for (int i = -20000; i <= 24000; ++i)
+  {
+    const double z = i * 5.123e-4;  // not on the table's grid
+    const double exact = normalCdf (-z);
+    const double tab = detail::normalTailTabulated (z);
+    worst = std::max (worst, std::abs (tab - exact));
+    ASSERT_GE (tab, -1e-11) << z;
+    ASSERT_LE (tab, 1.0 + 1e-11) << z;
+  }
+  EXPECT_LT (worst, 1e-11);
+  EXPECT_GT (worst, 0.0);  // it is an approximation: the test would notice erfc in its place
+  EXPECT_EQ (detail::normalTailTabulated (0.0), 0.5);
+  EXPECT_EQ (detail::normalTailTabulated (10.0), 0.0);
+  EXPECT_EQ (detail::normalTailTabulated (1e300), 0.0);
+  EXPECT_EQ (detail::normalTailTabulated (-1e300), 1.0);
+  EXPECT_TRUE (std::isnan (detail::normalTailTabulated (std::numeric_limits<double>::quiet_NaN ())));
+}
+
 TEST (Leakage, SinglePointNodeOracle)
 {
   // One point, isotropic sigma, box inflated by k_sigma = 1: the point sits at the centre of a
