@@ -8,6 +8,8 @@
 
 #include <Eigen/Geometry>
 
+#include <vector>
+
 namespace pcl_probcollision
 {
 /** \brief The core query: probability that the objects behind two prebuilt hierarchies
@@ -32,6 +34,32 @@ namespace pcl_probcollision
 bool collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
               const CollisionRequest& request, CollisionResult& result,
               const RobustClassifier* classifier = nullptr);
+
+/** \brief collide() for many poses of B, spread over several threads (issue #8).
+  *
+  * Each pose is an independent query on the shared hierarchies and classifier; results are
+  * stored by pose index, so they do not depend on the thread count or on scheduling.
+  *
+  * \param[in] a hierarchy of object A (its frame is the query frame)
+  * \param[in] b hierarchy of object B
+  * \param[in] T_a_b rigid transforms mapping B-frame points into A's frame, one per query
+  * \param[in] request what to compute (invalid: every pose fails as in collide())
+  * \param[out] results resized to T_a_b.size(); results[i] is what
+  *             collide (a, b, T_a_b[i], request, results[i], classifier) gives (timings aside)
+  * \param[in] threads worker threads: 0 = std::thread::hardware_concurrency() (at least 1),
+  *            never more than poses; negative throws pcl::BadArgumentException
+  * \param[in] classifier as for collide(); without one, a single classifier with
+  *            request.classifier's parameters is drawn and shared by all poses
+  * \return true when every pose succeeded; a failing pose has its own status and message and
+  *         the others are still answered.
+  * \throws pcl::BadArgumentException for threads < 0. An exception escaping collide() in a
+  *         worker (std::bad_alloc) stops the batch and is rethrown here after every worker
+  *         has stopped (the earliest pose's); results are then incomplete.
+  */
+bool collideBatch (const ProbabilisticBVH& a, const ProbabilisticBVH& b,
+                   const std::vector<Eigen::Isometry3d>& T_a_b, const CollisionRequest& request,
+                   std::vector<CollisionResult>& results, int threads = 0,
+                   const RobustClassifier* classifier = nullptr);
 
 /** \brief The verdict of a probability under a request's thresholds (Unknown for NaN). */
 Verdict verdictFor (double probability, const CollisionRequest& request);

@@ -35,8 +35,9 @@ namespace pcl_probcollision
   *
   * \note Non-finite points are skipped (and counted in the result). The two clouds must be in
   * the same units: covariances, thresholds of the hierarchy and noise sigmas are in those units.
-  * \note Not thread-safe (a PCL filter object). For many concurrent queries build the
-  * hierarchies once and call collide() from each thread.
+  * \note Not thread-safe (a PCL filter object). computeBatch() spreads many poses over
+  * threads; for concurrent queries from the caller's own threads build the hierarchies once
+  * and call collide() from each thread.
   */
 template <typename PointT>
 class ProbabilisticCollision : public pcl::FilterIndices<PointT>
@@ -104,6 +105,21 @@ public:
     * \return false, with result.status and message set and a PCL_ERROR, when the inputs are
     * unusable (no cloud, no finite point, a non-rigid or non-finite pose). */
   bool compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result);
+  /** \brief compute() for many poses, spread over threads (collideBatch()).
+    *
+    * results[i] is what compute (T_target_input[i], results[i]) gives (timings aside),
+    * whatever the thread count, except that a failed pose's message starts with "pose <i>: ". A bad pose fails
+    * alone; the others are still answered. Hierarchies are (re)built once, before the threads
+    * start; with request.enable_timings every result's build_ms is the time this call spent on
+    * them (0 when they were reused), so do not sum it over the results.
+    * \param[in] T_target_input rigid poses of A in B's frame, as for compute()
+    * \param[out] results resized to T_target_input.size()
+    * \param[in] threads worker threads: 0 = std::thread::hardware_concurrency(), never more
+    *            than poses; negative throws pcl::BadArgumentException
+    * \return true when every pose succeeded (true for no pose); a PCL_ERROR names the first
+    *         failure otherwise. */
+  bool computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input, std::vector<CollisionResult>& results,
+                     int threads = 0);
 
   /** \brief The hierarchies of the last successful compute (null before). */
   std::shared_ptr<const ProbabilisticBVH> getInputHierarchy () const { return input_bvh_; }
@@ -119,8 +135,17 @@ protected:
   using pcl::FilterIndices<PointT>::applyFilter;
 
 private:
-  /** \brief (Re)builds whatever hierarchy is out of date; false with a message on bad input. */
+  /** \brief Checks the inputs and (re)builds whatever hierarchy is out of date; false with
+    * result's status and message on bad input. */
   bool prepare (CollisionResult& result);
+  /** \brief prepare() once the inputs are initialised (initCompute). */
+  bool buildHierarchies (CollisionResult& result);
+  /** \brief Whether T_target_input is a finite rotation plus translation; result says why not. */
+  static bool checkPose (const Eigen::Isometry3d& T_target_input, CollisionResult& result);
+  /** \brief Turns collide()'s answer (A's frame, hierarchy order) into compute()'s: the
+    * witness in the target's frame, per-point values on the callers' clouds, skipped points
+    * and, with timings, build_ms. */
+  void finishResult (const Eigen::Isometry3d& T_target_input, double build_ms, CollisionResult& result) const;
 
   PointCloudConstPtr target_;
   pcl::IndicesConstPtr target_indices_;

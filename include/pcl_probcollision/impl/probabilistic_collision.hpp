@@ -10,7 +10,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -185,6 +188,25 @@ template <typename PointT>
 bool
 ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
 {
+  if (!this->input_)
+    result.message = "no input cloud given (setInputCloud)";
+  else if (!pcl::PCLBase<PointT>::initCompute ())
+    result.message = "input cloud or indices unusable";
+  else
+  {
+    const bool built = buildHierarchies (result);
+    this->deinitCompute ();
+    if (built)
+      return true;
+  }
+  result.status = CollisionResult::Status::InvalidInput;
+  return false;
+}
+
+template <typename PointT>
+bool
+ProbabilisticCollision<PointT>::buildHierarchies (CollisionResult& result)
+{
   const auto start = std::chrono::steady_clock::now ();
   std::string message;
   Source input_now {this->input_.get (), this->indices_.get (), input_covariances_.get (), k_, request_.hierarchy};
@@ -234,45 +256,20 @@ ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
 
 template <typename PointT>
 bool
-ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
+ProbabilisticCollision<PointT>::checkPose (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
 {
-  result = CollisionResult ();
   const Eigen::Matrix3d R = T_target_input.linear ();
-  if (!T_target_input.matrix ().allFinite () || !(R.transpose () * R).isIdentity (1e-6) || R.determinant () < 0.0)
-  {
-    result.message = "pose T_target_input is not a finite rotation plus translation";
-    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-    return false;
-  }
-  if (!this->input_)
-  {
-    result.message = "no input cloud given (setInputCloud)";
-    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-    return false;
-  }
-  if (!pcl::PCLBase<PointT>::initCompute ())
-  {
-    result.message = "input cloud or indices unusable";
-    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-    return false;
-  }
-  const bool prepared = prepare (result);
-  this->deinitCompute ();
-  if (!prepared)
-  {
-    result.status = CollisionResult::Status::InvalidInput;
-    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-    return false;
-  }
-  const double build_ms = result.build_ms;
+  if (T_target_input.matrix ().allFinite () && (R.transpose () * R).isIdentity (1e-6) && R.determinant () >= 0.0)
+    return true;
+  result.message = "pose T_target_input is not a finite rotation plus translation";
+  return false;
+}
 
-  // collide() works in A's frame: B is mapped there by the inverse pose.
-  const Eigen::Isometry3d T_input_target = T_target_input.inverse ();
-  if (!collide (*input_bvh_, *target_bvh_, T_input_target, request_, result, &classifier_))
-  {
-    PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-    return false;
-  }
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::finishResult (const Eigen::Isometry3d& T_target_input, double build_ms,
+                                              CollisionResult& result) const
+{
   result.points_skipped_nonfinite = input_skipped_ + target_skipped_;
   if (request_.enable_timings)
     result.build_ms = build_ms;
@@ -294,7 +291,80 @@ ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input
     result.probabilities_a = scatter (result.probabilities_a, *input_bvh_, this->input_->size ());
     result.probabilities_b = scatter (result.probabilities_b, *target_bvh_, target_->size ());
   }
-  return true;
+}
+
+template <typename PointT>
+bool
+ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
+{
+  result = CollisionResult ();
+  if (checkPose (T_target_input, result) && prepare (result))
+  {
+    const double build_ms = result.build_ms;
+    // collide() works in A's frame: B is mapped there by the inverse pose.
+    if (collide (*input_bvh_, *target_bvh_, T_target_input.inverse (), request_, result, &classifier_))
+    {
+      finishResult (T_target_input, build_ms, result);
+      return true;
+    }
+  }
+  PCL_ERROR ("[pcl_probcollision::%s::compute] %s\n", this->getClassName ().c_str (), result.message.c_str ());
+  return false;
+}
+
+template <typename PointT>
+bool
+ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input,
+                                              std::vector<CollisionResult>& results, int threads)
+{
+  if (threads < 0)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticCollision::computeBatch] threads = "
+                             << threads << " must be >= 0 (0: one per hardware thread)");
+  const std::size_t count = T_target_input.size ();
+  results.assign (count, CollisionResult ());
+  // Poses compute() would refuse fail here; the others become queries in A's frame.
+  std::vector<std::size_t> posed;
+  std::vector<Eigen::Isometry3d> T_input_target;
+  for (std::size_t i = 0; i < count; ++i)
+    if (checkPose (T_target_input[i], results[i]))
+    {
+      posed.push_back (i);
+      T_input_target.push_back (T_target_input[i].inverse ());
+    }
+  // Like compute(), build only when some pose gets that far; every such pose shares the outcome.
+  CollisionResult prepared;
+  if (!posed.empty ())
+  {
+    if (prepare (prepared))
+    {
+      std::vector<CollisionResult> answers;
+      collideBatch (*input_bvh_, *target_bvh_, T_input_target, request_, answers, threads, &classifier_);
+      for (std::size_t k = 0; k < posed.size (); ++k)
+        results[posed[k]] = std::move (answers[k]);
+    }
+    else
+      for (const std::size_t i : posed)
+        results[i] = prepared;
+  }
+
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    CollisionResult& result = results[i];
+    if (result.ok ())
+    {
+      finishResult (T_target_input[i], prepared.build_ms, result);
+      continue;
+    }
+    result.message = "pose " + std::to_string (i) + ": " + result.message;
+    if (failed++ == 0)
+      PCL_ERROR ("[pcl_probcollision::%s::computeBatch] %s\n", this->getClassName ().c_str (), result.message.c_str ());
+  }
+  if (failed > 1)
+    PCL_ERROR ("[pcl_probcollision::%s::computeBatch] %zu of %zu poses failed\n", this->getClassName ().c_str (),
+               failed, count);
+  return failed == 0;
 }
 
 template <typename PointT>
