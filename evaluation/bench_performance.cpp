@@ -13,8 +13,8 @@
 //   BM_Build/N          covariance estimation + hierarchy of the room sampled to N points
 //   BM_Query/uniform    per-pose times (median, p99) of ours, the octomap and exact FCL,
 //   BM_Query/near       with our accuracy on the same poses (easy right, ROC AUC, Brier)
-//   BM_Batch/threads:T  computeBatch() over all 2,700 poses on T threads: poses per second,
-//                       and whether every answer equals the one-thread answer bit for bit
+//   BM_Batch/T          computeBatch() over all 2,700 poses on T threads: poses per second,
+//                       and how many answers equal the one-thread answer bit for bit
 //
 // PCL_PROBCOLLISION_SHARED_DATA (environment) overrides the compiled-in data directory.
 #include "baselines.h"
@@ -107,7 +107,8 @@ meshes ()
 /** \brief The clouds, the labelled poses and every method prebuilt. */
 /** \brief The query settings: library defaults, or one change named by the environment
   * variable BENCH_PERFORMANCE_SETTING (for the speed-versus-accuracy comparison):
-  * "rff256" (the ladder stops at D = 256), "linear" (plane only), "stochastic" traversal. */
+  * "rff256" (the ladder stops at D = 256), "linear" (plane only), "stochastic" traversal,
+  * "deferkernel" (CollisionRequest::defer_kernel_fits). */
 CollisionRequest
 settingRequest ()
 {
@@ -120,6 +121,8 @@ settingRequest ()
     request.classifier.kernel = KernelMode::Linear;
   else if (setting == "stochastic")
     request.traversal = TraversalMode::Stochastic;
+  else if (setting == "deferkernel")
+    request.defer_kernel_fits = true;
   else if (!setting.empty () && setting != "default")
     throw std::invalid_argument ("BENCH_PERFORMANCE_SETTING: unknown setting '" + setting + "'");
   return request;
@@ -324,6 +327,43 @@ BM_Query (benchmark::State& state)
   state.counters["setup_s"] = w.setup_s;
 }
 BENCHMARK (BM_Query)->ArgName ("near")->Arg (0)->Arg (1)->Unit (benchmark::kMillisecond)->Iterations (1);
+
+// ---------------------------------------------------------------------------------------------
+/** \brief computeBatch() over all 2,700 poses on state.range (0) threads; compares every answer
+  * with the one-thread batch (computed once, untimed). */
+void
+BM_Batch (benchmark::State& state)
+{
+  Workload& w = workload ();
+  std::vector<Eigen::Isometry3d> poses;
+  for (const auto* set : {&w.uniform, &w.near})
+    for (const PoseTruth& p : *set)
+      poses.push_back (p.T);
+  static std::vector<CollisionResult> reference;
+  if (reference.empty () && !w.ours->computeBatch (poses, reference, 1))
+  {
+    state.SkipWithError ("the one-thread batch failed");
+    return;
+  }
+  const int threads = static_cast<int> (state.range (0));
+  std::vector<CollisionResult> results;
+  double seconds = 0.0;
+  for (auto _ : state)
+  {
+    const auto t0 = Clock::now ();
+    w.ours->computeBatch (poses, results, threads);
+    seconds = microsecondsSince (t0) / 1e6;
+  }
+  std::size_t same = 0;
+  for (std::size_t i = 0; i < poses.size (); ++i)
+    same += results[i].ok () && results[i].probability == reference[i].probability &&
+            results[i].verdict == reference[i].verdict && results[i].witness_index == reference[i].witness_index;
+  state.counters["threads"] = threads;
+  state.counters["poses"] = static_cast<double> (poses.size ());
+  state.counters["poses_per_s"] = static_cast<double> (poses.size ()) / seconds;
+  state.counters["identical_to_1_thread"] = static_cast<double> (same);
+}
+BENCHMARK (BM_Batch)->Arg (1)->Arg (2)->Unit (benchmark::kMillisecond)->Iterations (1)->UseRealTime ();
 } // namespace
 
 BENCHMARK_MAIN ();

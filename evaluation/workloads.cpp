@@ -42,6 +42,8 @@ oursSettings (bool full)
   add ("rff", [] (OursSetting& o) { o.request.classifier.kernel = KernelMode::RFF; });
   add ("stochastic", [] (OursSetting& o) { o.request.traversal = TraversalMode::Stochastic; });
   add ("expandedbv", [] (OursSetting& o) { o.request.traversal = TraversalMode::ExpandedBV; });
+  add ("deferkernel", [] (OursSetting& o) { o.request.defer_kernel_fits = true; });
+  add ("rff256", [] (OursSetting& o) { o.request.classifier.rff_features_large = o.request.classifier.rff_features; });
   return s;
 }
 

@@ -4,6 +4,7 @@
 
 #include <pcl/exceptions.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -129,15 +130,21 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
   ClassifierResult leaf;
   double best = -1.0;
   std::string failure;
-  auto leaf_test = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
+  std::size_t failures = 0;
+  // Fits one leaf pair with the given kernel mode; false (failure noted) when it has no usable
+  // separator.
+  auto fit = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel) {
     const PointSetView view_a = a.gatherPoints (leaf_a, means_a, covs_a);
     const PointSetView view_b = b.gatherPoints (leaf_b, T_a_b, means_b, covs_b);
-    if (!classifier->classify (view_a, view_b, leaf))
-    {
-      if (failure.empty ())
-        failure = leaf.message;
-      return std::numeric_limits<double>::quiet_NaN ();
-    }
+    if (classifier->classify (view_a, view_b, leaf, kernel))
+      return true;
+    if (failure.empty ())
+      failure = leaf.message;
+    ++failures;
+    return false;
+  };
+  // Takes the fit in `leaf` into the result: counters, per-point values, maximum and witness.
+  auto record = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
     ++result.leaf_pairs_tested;
     result.classifier_iterations += static_cast<std::size_t> (leaf.iterations);
     result.kernel_leaf_pairs += leaf.rung == Rung::RFF || leaf.rung == Rung::RFFLarge ? 1 : 0;
@@ -162,30 +169,80 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
       result.witness_point = on_a ? means_a[leaf.witness_index] : means_b[leaf.witness_index];
       result.witness_normal = leaf.witness_normal;
     }
+    return contribution;
+  };
+
+  // request.defer_kernel_fits: the Ladder's kernel rungs cost a hundred planes. The traversal
+  // fits the plane of every leaf pair it reaches; a pair whose plane asks for a kernel rung
+  // (RobustClassifier::needsKernel) is set aside, contributing nothing yet, and fitted in full
+  // afterwards, largest reach weight first, unless the maximum by then makes it irrelevant.
+  // Every pair fitted ends with the fit of a direct Ladder classify(), so without an early stop
+  // the maximum is the same; with one (P > collision_above, a lower bound either way) the
+  // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
+  // below the default's.
+  struct Deferred
+  {
+    const ProbabilisticBVH::Node* a;
+    const ProbabilisticBVH::Node* b;
+    double rho;
+  };
+  // Per-point values need every pair's final fit in traversal order: no deferral there.
+  const bool lazy_kernel = request.defer_kernel_fits && !request.per_point &&
+                           classifier->getParams ().kernel == KernelMode::Ladder;
+  std::vector<Deferred> deferred;
+  auto leaf_test = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
+    if (!fit (leaf_a, leaf_b, lazy_kernel ? KernelMode::Linear : classifier->getParams ().kernel))
+      return std::numeric_limits<double>::quiet_NaN ();
+    if (lazy_kernel && classifier->needsKernel (leaf))
+    {
+      deferred.push_back ({&leaf_a, &leaf_b, rho});
+      return 0.0;
+    }
+    record (leaf_a, leaf_b, rho);
     return leaf.probability;
   };
 
+  const detail::TraversalParams params = traversalParams (request);
   detail::TraversalResult traversal;
   try
   {
-    traversal = detail::traverseHierarchies (a, b, T_a_b, traversalParams (request), leaf_test);
+    traversal = detail::traverseHierarchies (a, b, T_a_b, params, leaf_test);
   }
   catch (const pcl::PCLException& e)
   {
     fail (result, CollisionResult::Status::InvalidInput, e.what ());
     return false;
   }
+  bool stopped = traversal.lower_bound;
+  if (!stopped && !deferred.empty ())
+  {
+    std::stable_sort (deferred.begin (), deferred.end (),
+                      [] (const Deferred& x, const Deferred& y) { return x.rho > y.rho; });
+    for (const Deferred& d : deferred)
+    {
+      if (params.skip_dominated && d.rho <= best)
+        break;  // sorted: every later pair is dominated too
+      if (!fit (*d.a, *d.b, KernelMode::Ladder))
+        continue;
+      if (record (*d.a, *d.b, d.rho) > params.stop_probability && !params.exhaustive)
+      {
+        stopped = true;
+        break;
+      }
+    }
+  }
   result.bv_tests = traversal.node_pairs_tested;
-  if (traversal.invalid_leaf_results > 0)
+  if (failures > 0)
   {
     // A leaf pair without a usable separator would make the maximum a guess: report it.
     fail (result, CollisionResult::Status::NumericalFailure,
-          "classifier failed on " + std::to_string (traversal.invalid_leaf_results) + " leaf pair(s): " + failure);
+          "classifier failed on " + std::to_string (failures) + " leaf pair(s): " + failure);
     return false;
   }
   result.status = CollisionResult::Status::Ok;
-  result.probability = traversal.probability;
-  result.lower_bound = traversal.lower_bound;
+  // The traversal's maximum counted set-aside pairs as 0; best holds every recorded pair.
+  result.probability = std::max (traversal.probability, best);
+  result.lower_bound = stopped;
   result.no_leaf_tested = traversal.no_leaf_tested;
   if (result.no_leaf_tested)
   {

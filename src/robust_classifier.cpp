@@ -1025,6 +1025,21 @@ RobustClassifier::RobustClassifier (const ClassifierParams& params) : params_ (p
 bool
 RobustClassifier::classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result) const
 {
+  return classify (a, b, result, params_.kernel);
+}
+
+bool
+RobustClassifier::needsKernel (const ClassifierResult& plane) const
+{
+  const std::size_t n = plane.probabilities_a.size () + plane.probabilities_b.size ();
+  return plane.degenerate ||
+         static_cast<double> (plane.misclassified) > params_.ladder_fraction * static_cast<double> (n);
+}
+
+bool
+RobustClassifier::classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result,
+                            KernelMode kernel) const
+{
   result = ClassifierResult ();
   if (a.size == 0 || b.size == 0 || !a.means || !a.covariances || !b.means || !b.covariances)
   {
@@ -1099,7 +1114,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   // The ladder (see the class documentation)
   RungFit best;
   int iterations = 0;
-  if (params_.kernel == KernelMode::RFF)
+  if (kernel == KernelMode::RFF)
   {
     best = fitRff (p, params_, loss, gamma, omega_, beta_, params_.rff_features, Rung::RFF);
     iterations = best.iterations;
@@ -1110,7 +1125,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
     best = fitLinear (p, params_, loss, gamma);
     iterations = best.iterations;
     result.rungs_tried = 1;
-    if (params_.kernel == KernelMode::Ladder)
+    if (kernel == KernelMode::Ladder)
     {
       const int sizes[2] = {params_.rff_features, params_.rff_features_large};
       const Rung rungs[2] = {Rung::RFF, Rung::RFFLarge};

@@ -480,6 +480,55 @@ TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
   EXPECT_GT (fewer, 0u) << "no query was cheaper without per-point values";
 }
 
+// CollisionRequest::defer_kernel_fits: the same P whenever the query does not stop early, the
+// same verdict always, fewer kernel fits; ignored with per-point values.
+TEST (Reliability, DeferredKernelFitsKeepTheAnswer)
+{
+  const ProbabilisticBVH a (sheet (600, 0.2, 0.0, 0.002, 41));
+  std::size_t kernel_default = 0, kernel_deferred = 0;
+  for (const double tilt : {0.0, 0.15, 0.4})
+    for (const double lift : {0.004, 0.0, -0.01})
+    {
+      SCOPED_TRACE (::testing::Message () << "tilt " << tilt << " lift " << lift);
+      const ProbabilisticBVH b (sheet (600, 0.2, 0.0, 0.002, 42));
+      const Eigen::Isometry3d T = Eigen::Translation3d (0.0, 0.0, lift) * Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ());
+      for (const bool exhaustive : {true, false})
+      {
+        CollisionRequest plain, deferring;
+        plain.exhaustive = deferring.exhaustive = exhaustive;
+        deferring.defer_kernel_fits = true;
+        CollisionResult rp, rd;
+        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
+        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
+        EXPECT_EQ (rp.verdict, rd.verdict);
+        if (!rp.lower_bound && !rd.lower_bound)
+        {
+          EXPECT_EQ (rp.probability, rd.probability);
+          EXPECT_EQ (rp.witness_index, rd.witness_index);
+        }
+        else
+          EXPECT_GT (rd.probability, plain.collision_above);
+        if (exhaustive)
+        {
+          kernel_default += rp.kernel_leaf_pairs;
+          kernel_deferred += rd.kernel_leaf_pairs;
+        }
+        // Per-point values need every pair's final fit: the option is ignored.
+        plain.per_point = deferring.per_point = true;
+        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
+        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
+        EXPECT_EQ (rp.probability, rd.probability);
+        ASSERT_EQ (rp.probabilities_a.size (), rd.probabilities_a.size ());
+        for (std::size_t i = 0; i < rp.probabilities_a.size (); ++i)
+          if (!(std::isnan (rp.probabilities_a[i]) && std::isnan (rd.probabilities_a[i])))
+            EXPECT_EQ (rp.probabilities_a[i], rd.probabilities_a[i]) << i;
+        EXPECT_EQ (rp.kernel_leaf_pairs, rd.kernel_leaf_pairs);
+      }
+    }
+  EXPECT_GT (kernel_default, 0u) << "no scene needed a kernel rung: the test would prove nothing";
+  EXPECT_LE (kernel_deferred, kernel_default);
+}
+
 TEST (Reliability, ReorderingThePointsKeepsTheProbability)
 {
   CollisionRequest rq;

@@ -61,6 +61,13 @@ struct CollisionRequest
   std::uint64_t seed = 1;
   /** \brief ExpandedBV: box growth in point standard deviations, >= 0. Default 3. */
   double expanded_k_sigma = 3.0;
+  /** \brief Ladder classifier: fit every reached leaf pair's plane first and the kernel rungs
+    * afterwards, largest reach weight first, only for pairs that can still raise P (ignored
+    * with per_point). Same P when the query does not stop early; a query that does (P >
+    * collision_above) may stop at a shallower pair before any kernel fit, so its P (a lower
+    * bound either way) is lower. Faster on colliding poses; off by default because the lower
+    * P of those poses costs ranking accuracy (docs/PERFORMANCE.md). */
+  bool defer_kernel_fits = false;
 
   /** \brief The separator fitted at each leaf pair: ClassifierParams' defaults (Ladder,
     * Robust, kappa = 0.9) except C = 1000. A leaf pair's points span far more than the gap

@@ -199,6 +199,18 @@ public:
     * \return result.ok */
   bool classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result) const;
 
+  /** \brief As classify(), with another kernel mode than the parameters' for this call (the
+    * random features stay this instance's). collide() fits the plane of every leaf pair
+    * first and the kernel rungs only for the pairs that needsKernel() names and that can
+    * still raise the maximum. */
+  bool classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result,
+                 KernelMode kernel) const;
+
+  /** \brief Whether the Ladder goes on to a kernel rung after this plane fit (a Linear
+    * classify() result): the fit is degenerate or misclassifies more than ladder_fraction of
+    * the points (the ladder rule of the class documentation). */
+  bool needsKernel (const ClassifierResult& plane) const;
+
   /** \brief Evaluates a fitted separator at an input-frame point.
     * \param[in] model result.separator of a classify() call on this instance (RFF models use
     *            this instance's random features)
