@@ -7,11 +7,13 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -424,4 +426,108 @@ TEST (CovarianceEstimation, SurfaceProjectionIsTranslationInvariant)
     moved = std::max (moved, p0.displacements[i].norm ());
   }
   EXPECT_GT (moved, 0.5 * sigma);  // the points did move
+}
+
+namespace
+{
+// A noisy plane with a few NaN points, stored in a scrambled order (as mesh samples are).
+Cloud::Ptr
+scrambledPlaneWithNaN ()
+{
+  Cloud::Ptr cloud = noisyPlane (40, 0.01, 0.002, 13);
+  std::mt19937_64 rng (17);
+  std::shuffle (cloud->begin (), cloud->end (), rng);
+  const float nan = std::numeric_limits<float>::quiet_NaN ();
+  for (std::size_t i = 0; i < cloud->size (); i += 97)
+    (*cloud)[i].x = (*cloud)[i].y = (*cloud)[i].z = nan;
+  cloud->is_dense = false;
+  return cloud;
+}
+} // namespace
+
+// The default search (PCL's FLANN k-d tree, queried in batches and in a spatial order) must give
+// what an explicitly set pcl::search::KdTree gives, which pcl::Feature queries point by point.
+TEST (CovarianceEstimation, DefaultSearchMatchesAnExplicitPclKdTree)
+{
+  const Cloud::Ptr cloud = scrambledPlaneWithNaN ();
+  Cloud::Ptr half (new Cloud);
+  for (std::size_t i = 0; i < cloud->size (); i += 2)
+    half->push_back ((*cloud)[i]);
+  pcl::IndicesPtr some (new pcl::Indices);
+  for (std::size_t i = 0; i < cloud->size (); i += 3)
+    some->push_back (static_cast<int> ((i * 7) % cloud->size ()));
+  const SensorNoiseModel noises[] = {SensorNoiseModel (), SensorNoiseModel::isotropic (0.002),
+                                     SensorNoiseModel::kinect ()};
+  for (const SensorNoiseModel& noise : noises)
+    for (int variant = 0; variant < 3; ++variant)
+    {
+      auto run = [&] (bool explicit_tree, std::vector<float>& radii, std::vector<Eigen::Vector3d>& moved) {
+        CovarianceEstimation<pcl::PointXYZ> est;
+        est.setInputCloud (cloud);
+        est.setSensorNoise (noise);
+        est.setSurfaceProjection (noise.type () != SensorNoiseModel::Type::None);
+        if (variant == 1)
+          est.setIndices (some);
+        if (variant == 2)
+          est.setSearchSurface (half);
+        if (explicit_tree)
+          est.setSearchMethod (pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>> (false));
+        pcl::PointCloud<Covariance> out;
+        est.compute (out);
+        radii = est.getNeighbourRadii ();
+        moved = est.getSurfaceDisplacements ();
+        return out;
+      };
+      std::vector<float> radii, radii_pcl;
+      std::vector<Eigen::Vector3d> moved, moved_pcl;
+      const auto out = run (false, radii, moved);
+      const auto out_pcl = run (true, radii_pcl, moved_pcl);
+      ASSERT_EQ (out.size (), out_pcl.size ());
+      ASSERT_EQ (moved.size (), moved_pcl.size ());
+      for (std::size_t i = 0; i < out.size (); ++i)
+      {
+        ASSERT_EQ (out[i].isFinite (), out_pcl[i].isFinite ()) << variant << " " << i;
+        if (!out[i].isFinite ())
+          continue;
+        EXPECT_EQ (radii[i], radii_pcl[i]) << variant << " " << i;
+        EXPECT_TRUE (out[i].matrix () == out_pcl[i].matrix ()) << variant << " " << i;
+        if (!moved.empty ())
+        {
+          EXPECT_TRUE (moved[i] == moved_pcl[i]) << variant << " " << i;
+        }
+      }
+    }
+}
+
+// compute() leaves its default search in getSearchMethod(); it must answer as pcl::search::KdTree.
+TEST (CovarianceEstimation, DefaultSearchAnswersSingleQueriesLikePclKdTree)
+{
+  const Cloud::Ptr cloud = scrambledPlaneWithNaN ();
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setInputCloud (cloud);
+  pcl::PointCloud<Covariance> out;
+  est.compute (out);
+  const auto search = est.getSearchMethod ();
+  ASSERT_TRUE (search);
+  pcl::search::KdTree<pcl::PointXYZ> reference;
+  reference.setInputCloud (cloud);
+  pcl::Indices got, expected;
+  std::vector<float> got_d, expected_d;
+  for (std::size_t i = 1; i < cloud->size (); i += 37)
+  {
+    if (!pcl::isFinite ((*cloud)[i]))
+      continue;
+    EXPECT_EQ (search->nearestKSearch ((*cloud)[i], 12, got, got_d),
+               reference.nearestKSearch ((*cloud)[i], 12, expected, expected_d));
+    EXPECT_EQ (got, expected) << i;
+    EXPECT_EQ (got_d, expected_d) << i;
+    for (unsigned int max_nn : {0u, 5u})
+    {
+      EXPECT_EQ (search->radiusSearch ((*cloud)[i], 0.025, got, got_d, max_nn),
+                 reference.radiusSearch ((*cloud)[i], 0.025, expected, expected_d, max_nn));
+      std::sort (got.begin (), got.end ());
+      std::sort (expected.begin (), expected.end ());
+      EXPECT_EQ (got, expected) << i;
+    }
+  }
 }

@@ -20,8 +20,10 @@ namespace pcl_probcollision
   * Psi_i + Sigma_i, with Sigma_i from the SensorNoiseModel (none by default).
   *
   * Defaults: k = 10, tau = 2 sqrt(k) (so tau_i = 2 r_i, the authors' reference code), the
-  * discretisation term on, no sensor noise, Euclidean k-d tree search
-  * (pcl::search::KdTree) unless setSearchMethod() gives another.
+  * discretisation term on, no sensor noise, Euclidean k-d tree search unless setSearchMethod()
+  * gives another. The default search is the k-d tree of pcl::search::KdTree (FLANN, exact, the
+  * same neighbours), queried for many points at once; a search set by setSearchMethod() is
+  * asked one point at a time, as pcl::Feature does.
   *
   * \note Output is index-aligned with the input (or its indices); an organized input keeps its
   * width and height. A non-finite input point gets an all-NaN covariance and the output is then
