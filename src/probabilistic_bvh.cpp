@@ -50,13 +50,14 @@ BVHParams::validate () const
 namespace
 {
 // The table of detail::normalTailTabulated: Phi(-z_i) and the step times its derivative at
-// z_i = i / 128 on [0, kNegligibleTailZ]; built at load time, so the lookup needs no guard.
+// z_i = i / 128 on [0, kNegligibleTailZ], one zero entry past the end; built at load time, so
+// the lookup needs no guard.
 constexpr int kTailSteps = 128 * static_cast<int> (detail::kNegligibleTailZ);
 constexpr double kTailStep = detail::kNegligibleTailZ / kTailSteps;
 struct TailTable
 {
-  double f[kTailSteps + 1];
-  double df[kTailSteps + 1];
+  double f[kTailSteps + 2];
+  double df[kTailSteps + 2];
   TailTable ()
   {
     for (int i = 0; i <= kTailSteps; ++i)
@@ -65,26 +66,22 @@ struct TailTable
       f[i] = normalCdf (-zi);
       df[i] = -kTailStep * 0.39894228040143267794 * std::exp (-0.5 * zi * zi);
     }
+    f[kTailSteps + 1] = df[kTailSteps + 1] = 0.0;
   }
 };
 const TailTable kTailTable;
 
-/** \brief normalTailTabulated for z in [0, kNegligibleTailZ) (cubic Hermite on the table). */
+/** \brief normalTailTabulated for z >= 0 (not NaN): cubic Hermite on the table, without a
+  * branch (z beyond the table reads its last node, Phi(-10) = 7.6e-24; a data-dependent branch
+  * here was a tenth of the build). */
 inline double
-tailInRange (double z)
+tail (double z)
 {
-  const double x = z * (1.0 / kTailStep);
+  const double x = std::min (z * (1.0 / kTailStep), static_cast<double> (kTailSteps));
   const int i = static_cast<int> (x);
   const double t = x - i, t2 = t * t, t3 = t2 * t;
   return (2.0 * t3 - 3.0 * t2 + 1.0) * kTailTable.f[i] + (t3 - 2.0 * t2 + t) * kTailTable.df[i] +
          (3.0 * t2 - 2.0 * t3) * kTailTable.f[i + 1] + (t3 - t2) * kTailTable.df[i + 1];
-}
-
-/** \brief normalTailTabulated for z >= 0 (NaN not expected). */
-inline double
-tail (double z)
-{
-  return z < detail::kNegligibleTailZ ? tailInRange (z) : 0.0;
 }
 } // namespace
 
@@ -95,7 +92,7 @@ normalTailTabulated (double z)
 {
   if (!(z >= 0.0))
     return z < 0.0 ? 1.0 - normalTailTabulated (-z) : z;  // NaN stays NaN
-  return tail (z);
+  return z < kNegligibleTailZ ? tail (z) : 0.0;
 }
 } // namespace detail
 
@@ -190,6 +187,7 @@ struct NodeGeometry
   std::vector<double> q[3];       // projections a_k^T (x - mean)
   std::vector<double> s[3];       // standard deviations sqrt(a_k^T Sigma a_k)
   Eigen::Vector3d lo, hi;         // inflated extents in box coordinates about mean
+  Eigen::Vector3d s_max;          // the largest s per axis
 };
 
 void
@@ -234,6 +232,7 @@ computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, do
   }
   g.lo.setConstant (std::numeric_limits<double>::infinity ());
   g.hi.setConstant (-std::numeric_limits<double>::infinity ());
+  g.s_max.setZero ();
   const Eigen::Matrix3d At = g.axes.transpose ();
   for (std::size_t i = 0; i < m; ++i)
   {
@@ -253,6 +252,7 @@ computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, do
       g.s[k][i] = sd;
       g.lo (k) = std::min (g.lo (k), q (k) - k_sigma * sd);
       g.hi (k) = std::max (g.hi (k), q (k) + k_sigma * sd);
+      g.s_max (k) = std::max (g.s_max (k), sd);
     }
   }
 }
@@ -367,16 +367,23 @@ splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
       continue;
     if (attempt == 0 && epsilon > 0.0 && tooMuchOverlap (nl + nr, m))
       continue;  // split without overlap
-    children.assign (2, std::vector<int> ());
-    children[0].reserve (nl);
-    children[1].reserve (nr);
+    // Every point is written to both children and kept where it belongs by advancing the
+    // write position or not (no data-dependent branch); one spare slot takes the last writes.
+    children.resize (2);
+    children[0].resize (nl + 1);
+    children[1].resize (nr + 1);
+    int* left = children[0].data ();
+    int* right = children[1].data ();
+    std::size_t il = 0, ir = 0;
     for (std::size_t i = 0; i < m; ++i)
     {
-      if (p[i] <= left_hi)
-        children[0].push_back (points[i]);
-      if (p[i] >= right_lo)
-        children[1].push_back (points[i]);
+      left[il] = points[i];
+      il += p[i] <= left_hi;
+      right[ir] = points[i];
+      ir += p[i] >= right_lo;
     }
+    children[0].resize (nl);
+    children[1].resize (nr);
     return true;
   }
   return false;
@@ -519,7 +526,7 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
       node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
       node.box.half_extents = 0.5 * (g.hi - g.lo);
       for (int k = 0; k < 3; ++k)
-        node.max_sigma (k) = static_cast<float> (*std::max_element (g.s[k].begin (), g.s[k].end ()));
+        node.max_sigma (k) = static_cast<float> (g.s_max (k));
       node.leakage = nodeLeakage (copy, pts, g, params.leakage_bound);
       node.variation = static_cast<float> (g.variation);
       node.num_points = static_cast<std::int32_t> (m);
