@@ -12,6 +12,7 @@
 // Benchmarks (one iteration each; the figures are counters, nothing is asserted):
 //   BM_Build/N          covariance estimation + hierarchy of the room sampled to N points (mean
 //                       over the iterations; bytes per point of the built hierarchy)
+//   BM_Covariances/N, BM_Hierarchy/N   the two parts alone
 //   BM_Query/uniform    per-pose times (median, p99) of ours, the octomap and exact FCL,
 //   BM_Query/near       with our accuracy on the same poses (easy right, ROC AUC, Brier)
 //   BM_Batch/T          computeBatch() over all 2,700 poses on T threads: poses per second,
@@ -23,6 +24,7 @@
 #include "mesh_sampling.h"
 #include "metrics.h"
 
+#include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
 #include <benchmark/benchmark.h>
@@ -225,6 +227,28 @@ BM_Build (benchmark::State& state)
 BENCHMARK (BM_Build)->Arg (10000)->Unit (benchmark::kMillisecond)->Iterations (20);
 BENCHMARK (BM_Build)->Arg (100000)->Unit (benchmark::kMillisecond)->Iterations (3);
 BENCHMARK (BM_Build)->Arg (1000000)->Unit (benchmark::kMillisecond)->Iterations (1);
+
+/** \brief The covariance estimation alone, as ProbabilisticCollision runs it (k = 10, the
+  * isotropic sensor noise, surface projection on). */
+void
+BM_Covariances (benchmark::State& state)
+{
+  const Meshes& w = meshes ();
+  const CloudXYZ::Ptr room = noisySamples (w.env_mesh, static_cast<std::size_t> (state.range (0)), w.sigma, 805);
+  pcl::PointCloud<Covariance> out;
+  for (auto _ : state)
+  {
+    CovarianceEstimation<pcl::PointXYZ> estimation;
+    estimation.setInputCloud (room);
+    estimation.setKSearch (10);
+    estimation.setSensorNoise (SensorNoiseModel::isotropic (w.sigma));
+    estimation.setSurfaceProjection (true);
+    estimation.compute (out);
+    benchmark::DoNotOptimize (out.data ());
+  }
+  state.counters["points"] = static_cast<double> (room->size ());
+}
+BENCHMARK (BM_Covariances)->Arg (10000)->Arg (100000)->Unit (benchmark::kMillisecond);
 
 /** \brief The hierarchy alone (the points with covariances given), CPU time per build. */
 void

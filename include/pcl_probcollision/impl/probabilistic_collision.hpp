@@ -13,6 +13,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pcl_probcollision
@@ -179,7 +180,7 @@ ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud,
     return false;
   }
   auto built = std::make_shared<ProbabilisticBVH> ();
-  built->build (points, request_.hierarchy);
+  built->build (std::move (points), request_.hierarchy);  // no copy of the cloud
   bvh = built;
   return true;
 }
