@@ -24,7 +24,7 @@ namespace pcl_probcollision
   * \param[in] T_a_b rigid transform mapping B-frame points into A's frame
   * \param[in] request what to compute (validated)
   * \param[out] result verdict, probability, witness in A's frame, counters; per-point
-  *             probabilities (request.per_point) index-aligned with a.cloud() and b.cloud()
+  *             probabilities (request.per_point) index-aligned with a.means() and b.means()
   * \param[in] classifier a prebuilt classifier with request.classifier's parameters to reuse
   *            its random-feature draw across queries (optional)
   * \return result.ok(); false with status and message for an empty hierarchy, a non-finite or

@@ -132,7 +132,7 @@ public:
     double coverage () const { return 1.0 - leakage; }
   };
 
-  /** \brief A read-only range of point indices (into cloud()). */
+  /** \brief A read-only range of point indices (into means() and covariances()). */
   struct IndexSpan
   {
     /** \brief First index (into pointIndices()). */
@@ -158,7 +158,8 @@ public:
 
   /** \brief Builds the hierarchy over a copy of cloud, replacing any previous one.
     * \param[in] cloud points with covariances in one frame (metres, square metres); its
-    *            area_weights (empty = equal weights) weight the leakage; it is copied.
+    *            area_weights (empty = equal weights) weight the leakage; it is copied
+    *            (means, packed covariances and source indices are kept, see means())
     * \param[in] params construction parameters
     * \return true when a hierarchy was built; false for an empty cloud, which leaves an empty
     *         hierarchy (empty() == true, no nodes).
@@ -191,7 +192,7 @@ public:
   /** \brief Id of the root node. */
   static constexpr std::int32_t rootId () { return 0; }
 
-  /** \brief The flat index array: leaves' point indices (into cloud()), leaves in depth-first
+  /** \brief The flat index array: leaves' point indices (into means()), leaves in depth-first
     * order, ascending within a leaf. Its length is storedPoints(). */
   const std::vector<int>& pointIndices () const { return indices_; }
 
