@@ -9,20 +9,21 @@
 // References on the same poses in the same loop: FCL colliding the piano mesh with an octomap
 // of the noisy room cloud at 2 sigma resolution (what MoveIt does), and FCL on the exact meshes.
 //
-// Benchmarks (one iteration each; the figures are counters, nothing is asserted):
+// Benchmarks (the figures are counters; nothing is asserted):
 //   BM_Build/N          covariance estimation + hierarchy of the room sampled to N points (mean
 //                       over the iterations; bytes per point of the built hierarchy)
 //   BM_Covariances/N, BM_Hierarchy/N   the two parts alone
-//   BM_Query/uniform    per-pose times (median, p99) of ours, the octomap and exact FCL,
-//   BM_Query/near       with our accuracy on the same poses (easy right, ROC AUC, Brier)
+//   BM_Query/near:0     per-pose times (median, p99) of ours, the octomap and exact FCL on the
+//   BM_Query/near:1     uniform (0) or near-contact (1) poses, with our accuracy on the same poses
 //   BM_Batch/T          computeBatch() over all 2,700 poses on T threads: poses per second,
 //                       and how many answers equal the one-thread answer bit for bit
 //
-// PCL_PROBCOLLISION_SHARED_DATA (environment) overrides the compiled-in data directory.
+// Environment: PCL_PROBCOLLISION_SHARED_DATA overrides the compiled-in data directory;
+// BENCH_PERFORMANCE_SETTING names a setting of the evaluation's sweep for our method.
 #include "baselines.h"
 #include "ground_truth.h"
-#include "mesh_sampling.h"
 #include "metrics.h"
+#include "workloads.h"
 
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/probabilistic_collision.h>
@@ -34,7 +35,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -59,26 +59,12 @@ dataDir ()
   return env && *env ? env : PCL_PROBCOLLISION_SHARED_DATA;
 }
 
-/** \brief The mesh sampled to about target points, with N(0, sigma^2) on every coordinate. */
+/** \brief The mesh sampled to about target points as the evaluation samples it, with
+  * N(0, sigma^2) on every coordinate. */
 CloudXYZ::Ptr
 noisySamples (const TriangleMesh& mesh, std::size_t target, double sigma, std::uint64_t seed)
 {
-  // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
-  const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
-  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
-  CloudXYZ::Ptr cloud (new CloudXYZ (pcd_collision::sampleMesh (mesh, spacing, seed)));
-  std::mt19937_64 rng (seed + 7);
-  for (auto& p : cloud->points)
-  {
-    // one draw per statement: the order is the same with every compiler
-    const double dx = sigma * standardNormal (rng);
-    const double dy = sigma * standardNormal (rng);
-    const double dz = sigma * standardNormal (rng);
-    p.x += static_cast<float> (dx);
-    p.y += static_cast<float> (dy);
-    p.z += static_cast<float> (dz);
-  }
-  return cloud;
+  return addNoise (*sampleCount (mesh, target, seed), sigma, seed + 7);
 }
 
 /** \brief The two meshes and the noise level (all a build benchmark needs). */
@@ -107,30 +93,21 @@ meshes ()
   return m;
 }
 
-/** \brief The clouds, the labelled poses and every method prebuilt. */
-/** \brief The query settings: library defaults, or one change named by the environment
-  * variable BENCH_PERFORMANCE_SETTING (for the speed-versus-accuracy comparison):
-  * "rff256" (the ladder stops at D = 256), "linear" (plane only), "stochastic" traversal,
-  * "deferkernel" (CollisionRequest::defer_kernel_fits). */
-CollisionRequest
-settingRequest ()
+/** \brief The query settings: the library defaults, or a setting of the evaluation's sweep
+  * (evaluation/workloads.h) named by the environment variable BENCH_PERFORMANCE_SETTING, for
+  * the speed-versus-accuracy comparison (e.g. deferkernel, linear, stochastic, rff256). */
+OursSetting
+benchSetting ()
 {
-  CollisionRequest request;
   const char* env = std::getenv ("BENCH_PERFORMANCE_SETTING");
-  const std::string setting = env ? env : "";
-  if (setting == "rff256")
-    request.classifier.rff_features_large = request.classifier.rff_features;
-  else if (setting == "linear")
-    request.classifier.kernel = KernelMode::Linear;
-  else if (setting == "stochastic")
-    request.traversal = TraversalMode::Stochastic;
-  else if (setting == "deferkernel")
-    request.defer_kernel_fits = true;
-  else if (!setting.empty () && setting != "default")
-    throw std::invalid_argument ("BENCH_PERFORMANCE_SETTING: unknown setting '" + setting + "'");
-  return request;
+  const std::string name = env && *env ? env : "default";
+  for (const OursSetting& s : oursSettings (true))
+    if (s.name == name)
+      return s;
+  throw std::invalid_argument ("BENCH_PERFORMANCE_SETTING: unknown setting '" + name + "'");
 }
 
+/** \brief The clouds, the labelled poses and every method prebuilt. */
 struct Workload
 {
   const Meshes* m = nullptr;
@@ -159,7 +136,10 @@ workload ()
     w.near = nearContactPoses (*w.m->exact, 700, 804, nc);
 
     w.ours.reset (new ProbabilisticCollision<pcl::PointXYZ>);
-    w.ours->setRequest (settingRequest ());
+    const OursSetting setting = benchSetting ();
+    w.ours->setRequest (setting.request);
+    w.ours->setSurfaceProjection (setting.projection);
+    w.ours->setKSearch (setting.k);
     w.ours->setInputCloud (w.piano);
     w.ours->setTargetCloud (w.room);
     w.ours->setInputNoise (SensorNoiseModel::isotropic (w.sigma));

@@ -14,7 +14,7 @@ target_compile_options(calibration_drift PRIVATE -Wall -Wextra)
 # exact-mesh references on the same poses. Prints counters; asserts nothing.
 find_package(benchmark QUIET)
 if(benchmark_FOUND)
-  add_executable(bench_performance bench_performance.cpp)
+  add_executable(bench_performance bench_performance.cpp workloads.cpp)
   target_link_libraries(bench_performance PRIVATE eval_ground_truth eval_metrics pcd_collision_mesh
     pcl_probcollision benchmark::benchmark)
   target_compile_options(bench_performance PRIVATE -Wall -Wextra)

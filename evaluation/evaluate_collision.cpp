@@ -119,15 +119,6 @@ struct PianoRoom
   std::vector<bool> near;
 };
 
-CloudXYZ::Ptr
-sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed)
-{
-  // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
-  const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
-  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
-  return CloudXYZ::Ptr (new CloudXYZ (pcd_collision::sampleMesh (mesh, spacing, seed)));
-}
-
 PianoRoom
 loadPianoRoom (const Options& o)
 {

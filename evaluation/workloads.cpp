@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "workloads.h"
+#include "mesh_sampling.h"
 
 #include <pcl_probcollision/normal_distribution.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -89,6 +91,15 @@ buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, doubl
     }
     return answer;
   };
+}
+
+CloudXYZ::Ptr
+sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed)
+{
+  // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
+  const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
+  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
+  return CloudXYZ::Ptr (new CloudXYZ (pcd_collision::sampleMesh (mesh, spacing, seed)));
 }
 
 CloudXYZ::Ptr

@@ -73,6 +73,10 @@ PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& 
   * not free; lifted: free) out of total. */
 void evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& right, int& total);
 
+/** \brief The mesh sampled uniformly by area plus every vertex, aiming at `target` points in all
+  * (pcd_collision::sampleMesh; deterministic for a seed). */
+CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed);
+
 /** \brief Gaussian noise of standard deviation sigma on every coordinate (deterministic). */
 CloudXYZ::Ptr addNoise (const CloudXYZ& clean, double sigma, std::uint64_t seed);
 } // namespace pcl_probcollision_eval

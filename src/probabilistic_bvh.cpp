@@ -190,9 +190,17 @@ struct NodeGeometry
   Eigen::Vector3d s_max;          // the largest s per axis
 };
 
+/** \brief The points the build reads: means, the packed covariances the hierarchy keeps, and
+  * the area weights (empty: equal) that only the leakage uses. */
+struct BuildPoints
+{
+  const std::vector<Eigen::Vector3d>& means;
+  const std::vector<PackedCovariance>& covariances;
+  const std::vector<double>& area_weights;
+};
+
 void
-computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, double k_sigma,
-                 NodeGeometry& g)
+computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, double k_sigma, NodeGeometry& g)
 {
   const std::size_t m = points.size ();
   Eigen::Vector3d mean = Eigen::Vector3d::Zero ();
@@ -238,15 +246,11 @@ computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, do
   {
     const int j = points[i];
     const Eigen::Vector3d q = At * (cloud.means[j] - mean);
-    const Eigen::Matrix3d& S = cloud.covariances[j];
     for (int k = 0; k < 3; ++k)
     {
-      // a^T Sigma a from the six distinct entries: the variance along box axis a (written out:
-      // a generic 3 x 3 product per point and node was a tenth of the build).
-      const double ax = g.axes (0, k), ay = g.axes (1, k), az = g.axes (2, k);
-      const double var = ax * ax * S (0, 0) + ay * ay * S (1, 1) + az * az * S (2, 2) +
-                         ax * ay * (S (0, 1) + S (1, 0)) + ax * az * (S (0, 2) + S (2, 0)) +
-                         ay * az * (S (1, 2) + S (2, 1));
+      // The variance along box axis a from the six distinct entries (a generic 3 x 3 product
+      // per point and node was a tenth of the build).
+      const double var = cloud.covariances[j].quadratic (g.axes.col (k));
       const double sd = std::sqrt (std::max (0.0, var));
       g.q[k][i] = q (k);
       g.s[k][i] = sd;
@@ -257,17 +261,17 @@ computeGeometry (const UncertainCloud& cloud, const std::vector<int>& points, do
   }
 }
 
-/** \brief P_x = max_k (1 - P_slab(a_k)) (MinSlab) of point i, skipping the tails of axes that
-  * cannot attain the maximum. With d_k the distance of the point to the nearer face of axis k
-  * in its own standard deviations (d_k >= 0: the point is inside its box), axis k's outside
-  * probability lies in [Phi(-d_k), 2 Phi(-d_k)], and Phi(-d - 1) < Phi(-d) / 2 for d >= 0: an
-  * axis with d_k >= min_j d_j + 1 is strictly below the maximum (most points sit deep inside
-  * along two axes). */
+/** \brief P_x of point i (METHOD.md 8.4) with the tabulated tail: per box axis the outside
+  * probability 1 - P_slab = Phi(-z_lo) + Phi(-z_hi), z the distances to the two faces in the
+  * point's standard deviations, combined by `bound`. MinSlab (the maximum) skips the axes that
+  * cannot attain it: with d_k = min(z_lo, z_hi) >= 0 (the point is inside its box), axis k's
+  * outside probability lies in [Phi(-d_k), 2 Phi(-d_k)], and Phi(-d - 1) < Phi(-d) / 2 for
+  * d >= 0, so an axis with d_k >= min_j d_j + 1 is strictly below the maximum (most points sit
+  * deep inside along two axes). */
 double
-outsideMinSlab (const NodeGeometry& g, std::size_t i)
+pointOutside (const NodeGeometry& g, std::size_t i, detail::LeakageBound bound)
 {
-  // Distances to the lower and upper face in standard deviations (>= 0 up to rounding: the
-  // box holds the point); s = 0 gives infinity, i.e. outside probability 0.
+  // s = 0 gives infinite distances, i.e. outside probability 0 on that axis.
   double z_lo[3], z_hi[3], d[3];
   double d_min = std::numeric_limits<double>::infinity ();
   for (int k = 0; k < 3; ++k)
@@ -284,33 +288,24 @@ outsideMinSlab (const NodeGeometry& g, std::size_t i)
     d[k] = std::min (z_lo[k], z_hi[k]);
     d_min = std::min (d_min, d[k]);
   }
-  double out = 0.0;
+  double out[3] = {0.0, 0.0, 0.0};
+  const bool min_slab = bound == detail::LeakageBound::MinSlab;
   for (int k = 0; k < 3; ++k)
-    if (!(d[k] >= d_min + 1.0))  // slabOutsideProbability with the tabulated tail
-      out = std::max (out, std::min (1.0, tail (z_lo[k]) + tail (z_hi[k])));
-  return out;
+    if (!(d[k] >= d_min + 1.0) || (!min_slab && std::isfinite (d[k])))
+      out[k] = std::min (1.0, tail (z_lo[k]) + tail (z_hi[k]));
+  return detail::combineSlabs (out[0], out[1], out[2], bound);
 }
 
 double
-nodeLeakage (const UncertainCloud& cloud, const std::vector<int>& points, const NodeGeometry& g,
+nodeLeakage (const BuildPoints& cloud, const std::vector<int>& points, const NodeGeometry& g,
              detail::LeakageBound bound)
 {
   const std::size_t m = points.size ();
   const bool weighted = !cloud.area_weights.empty ();
   double sum_w = 0.0, sum_wp = 0.0, sum_p = 0.0;
-  const bool min_slab = bound == detail::LeakageBound::MinSlab;
   for (std::size_t i = 0; i < m; ++i)
   {
-    double p;
-    if (min_slab)
-      p = outsideMinSlab (g, i);
-    else
-    {
-      const double out0 = detail::slabOutsideProbability (g.lo (0), g.hi (0), g.q[0][i], g.s[0][i]);
-      const double out1 = detail::slabOutsideProbability (g.lo (1), g.hi (1), g.q[1][i], g.s[1][i]);
-      const double out2 = detail::slabOutsideProbability (g.lo (2), g.hi (2), g.q[2][i], g.s[2][i]);
-      p = detail::combineSlabs (out0, out1, out2, bound);
-    }
+    const double p = pointOutside (g, i, bound);
     sum_p += p;
     if (weighted)
     {
@@ -490,9 +485,14 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
   const auto t0 = std::chrono::steady_clock::now ();
   UncertainCloud copy = std::move (cloud);
   copy.means.shrink_to_fit ();
-  copy.covariances.shrink_to_fit ();
-  copy.area_weights.shrink_to_fit ();
   copy.source_indices.shrink_to_fit ();
+  // Packed once: the build reads the covariances the hierarchy keeps.
+  std::vector<PackedCovariance> covariances;
+  covariances.reserve (copy.size ());
+  for (const Eigen::Matrix3d& c : copy.covariances)
+    covariances.emplace_back (c);
+  copy.covariances = std::vector<Eigen::Matrix3d> ();
+  const BuildPoints points {copy.means, covariances, copy.area_weights};
   std::vector<Node> nodes;
   std::vector<int> indices;
   std::size_t leaf_count = 0;
@@ -519,7 +519,7 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
       stack.pop_back ();
       const std::vector<int>& pts = task.points;
       const std::size_t m = pts.size ();
-      computeGeometry (copy, pts, params.k_sigma, g);
+      computeGeometry (points, pts, params.k_sigma, g);
 
       Node& node = nodes[task.node];
       node.box.axes = g.axes;
@@ -527,7 +527,7 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
       node.box.half_extents = 0.5 * (g.hi - g.lo);
       for (int k = 0; k < 3; ++k)
         node.max_sigma (k) = static_cast<float> (g.s_max (k));
-      node.leakage = nodeLeakage (copy, pts, g, params.leakage_bound);
+      node.leakage = nodeLeakage (points, pts, g, params.leakage_bound);
       node.variation = static_cast<float> (g.variation);
       node.num_points = static_cast<std::int32_t> (m);
       node.depth = task.depth;
@@ -587,12 +587,9 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
     indices.shrink_to_fit ();
   }
 
-  // Keep what queries read, packed; the area weights only served the leakage above.
+  // Keep what queries read; the area weights only served the leakage above.
   means_ = std::move (copy.means);
-  covariances_.clear ();
-  covariances_.reserve (n);
-  for (const Eigen::Matrix3d& c : copy.covariances)
-    covariances_.emplace_back (c);
+  covariances_ = std::move (covariances);
   source_indices_ = std::move (copy.source_indices);
   params_ = params;
   nodes_ = std::move (nodes);

@@ -225,12 +225,12 @@ fitRff (const detail::SeparatorProblem& p, const ClassifierParams& params,
   return fit;
 }
 
-/** \brief Whether the ladder must try the next rung after this fit. */
+/** \brief The ladder rule: whether a fit of n points, degenerate or with that many
+  * misclassified points, sends the ladder to the next rung. */
 bool
-needsEscalation (const RungFit& fit, double ladder_fraction, Eigen::Index n)
+needsEscalation (bool degenerate, std::size_t misclassified, double ladder_fraction, std::size_t n)
 {
-  return fit.degenerate ||
-         static_cast<double> (fit.misclassified) > ladder_fraction * static_cast<double> (n);
+  return degenerate || static_cast<double> (misclassified) > ladder_fraction * static_cast<double> (n);
 }
 
 /** \brief Whether a fit of a more complex rung replaces the best fit so far. */
@@ -1031,9 +1031,8 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
 bool
 RobustClassifier::needsKernel (const ClassifierResult& plane) const
 {
-  const std::size_t n = plane.probabilities_a.size () + plane.probabilities_b.size ();
-  return plane.degenerate ||
-         static_cast<double> (plane.misclassified) > params_.ladder_fraction * static_cast<double> (n);
+  return needsEscalation (plane.degenerate, plane.misclassified, params_.ladder_fraction,
+                          plane.probabilities_a.size () + plane.probabilities_b.size ());
 }
 
 bool
@@ -1129,7 +1128,8 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
     {
       const int sizes[2] = {params_.rff_features, params_.rff_features_large};
       const Rung rungs[2] = {Rung::RFF, Rung::RFFLarge};
-      bool escalate = needsEscalation (best, params_.ladder_fraction, p.n);
+      const std::size_t n_points = static_cast<std::size_t> (p.n);
+      bool escalate = needsEscalation (best.degenerate, best.misclassified, params_.ladder_fraction, n_points);
       for (int k = 0; k < 2 && escalate; ++k)
       {
         if (k == 1 && sizes[1] == sizes[0])
@@ -1137,7 +1137,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
         RungFit fit = fitRff (p, params_, loss, gamma, omega_, beta_, sizes[k], rungs[k]);
         iterations += fit.iterations;
         ++result.rungs_tried;
-        escalate = needsEscalation (fit, params_.ladder_fraction, p.n);
+        escalate = needsEscalation (fit.degenerate, fit.misclassified, params_.ladder_fraction, n_points);
         if (replaces (fit, best))
           best = std::move (fit);
       }

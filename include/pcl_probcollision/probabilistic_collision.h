@@ -108,8 +108,8 @@ public:
   /** \brief compute() for many poses, spread over threads (collideBatch()).
     *
     * results[i] is what compute (T_target_input[i], results[i]) gives (timings aside),
-    * whatever the thread count, except that a failed pose's message starts with "pose <i>: ". A bad pose fails
-    * alone; the others are still answered. Hierarchies are (re)built once, before the threads
+    * whatever the thread count, except that a failed pose's message starts with "pose <i>: ".
+    * A bad pose fails alone; the others are still answered. Hierarchies are (re)built once, before the threads
     * start; with request.enable_timings every result's build_ms is the time this call spent on
     * them (0 when they were reused), so do not sum it over the results.
     * \param[in] T_target_input rigid poses of A in B's frame, as for compute()

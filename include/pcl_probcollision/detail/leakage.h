@@ -17,10 +17,10 @@ namespace detail
 constexpr double kNegligibleTailZ = 10.0;
 
 /** \brief Phi(-z), the upper normal tail, by cubic Hermite interpolation of a table of
-  * Phi(-z) and its derivative -phi(z) on [0, kNegligibleTailZ] with step 1/128 (20 KB, filled
-  * on first use); 0 beyond kNegligibleTailZ and 1 - Phi(z) below 0. Absolute error below
+  * Phi(-z) and its derivative -phi(z) on [0, kNegligibleTailZ] with step 1/128 (20 KB, built
+  * when the library loads); 0 beyond kNegligibleTailZ and 1 - Phi(z) below 0. Absolute error below
   * 1e-11 (the Hermite bound h^4 / 384 max |d^4 Phi / dz^4| = 5e-12), a fraction of the time
-  * of erfc: the hierarchy build evaluates it for points of every node (METHOD.md 8.4). For
+  * of erfc: the hierarchy build evaluates it for the points of every node (METHOD.md 8.4). For
   * relative accuracy in the far tail use normalCdf. */
 double normalTailTabulated (double z);
 
