@@ -111,10 +111,10 @@ BM_TraversalNearContact (benchmark::State& state)
 {
   const TraversalFixture& f = fixture ();
   detail::TraversalParams params;
-  params.mode = static_cast<detail::TraversalMode> (
-      state.range (0) == 0 ? int (detail::TraversalMode::ExpectedWeight)
-                           : state.range (0) == 1 ? int (detail::TraversalMode::Stochastic)
-                                                  : int (detail::TraversalMode::ExpandedBV));
+  params.mode = static_cast<TraversalMode> (
+      state.range (0) == 0 ? int (TraversalMode::ExpectedWeight)
+                           : state.range (0) == 1 ? int (TraversalMode::Stochastic)
+                                                  : int (TraversalMode::ExpandedBV));
   const bool gather = state.range (1) != 0;
   std::vector<double> times_us;
   double node_pairs = 0.0, leaf_pairs = 0.0, disjoint = 0.0;

@@ -137,16 +137,14 @@ workload ()
 
     w.ours.reset (new ProbabilisticCollision<pcl::PointXYZ>);
     const OursSetting setting = benchSetting ();
+    CloudModelParams params = setting.model;
+    params.noise = SensorNoiseModel::isotropic (w.sigma);
     w.ours->setRequest (setting.request);
-    w.ours->setSurfaceProjection (setting.projection);
-    w.ours->setKSearch (setting.k);
-    w.ours->setInputCloud (w.piano);
-    w.ours->setTargetCloud (w.room);
-    w.ours->setInputNoise (SensorNoiseModel::isotropic (w.sigma));
-    w.ours->setTargetNoise (SensorNoiseModel::isotropic (w.sigma));
-    CollisionResult r;
-    if (!w.ours->compute (r))
-      throw std::runtime_error ("building the hierarchies failed: " + r.message);
+    w.ours->setInputModelParams (params);
+    w.ours->setTargetModelParams (params);
+    // The models are built once here, as a planner would, and handed over prebuilt.
+    w.ours->setInputModel (buildCloudModel (*w.piano, params, nullptr, nullptr, "piano"));
+    w.ours->setTargetModel (buildCloudModel (*w.room, params, nullptr, nullptr, "room"));
 
     w.octomap.reset (new OctomapBaseline);
     w.octomap->buildEnv (*w.room, 2.0 * w.sigma);
@@ -164,33 +162,19 @@ BM_Build (benchmark::State& state)
   const Meshes& w = meshes ();
   const std::size_t target = static_cast<std::size_t> (state.range (0));
   const CloudXYZ::Ptr room = noisySamples (w.env_mesh, target, w.sigma, 805);
-  // A one-point object B: its build is negligible, build_ms is the room's.
-  CloudXYZ::Ptr dot (new CloudXYZ);
-  dot->push_back (pcl::PointXYZ (0.f, 0.f, 0.f));
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (w.sigma);
   double ms = 0.0;  // summed over the iterations
   double hierarchy_ms = 0.0;
   std::size_t bytes = 0, stored = 0, nodes = 0;
   for (auto _ : state)
   {
-    ProbabilisticCollision<pcl::PointXYZ> pc;
-    pc.setInputCloud (room);
-    pc.setTargetCloud (dot);
-    pc.setInputNoise (SensorNoiseModel::isotropic (w.sigma));
-    pc.setTargetNoise (SensorNoiseModel::isotropic (w.sigma));
-    CollisionRequest request;
-    request.enable_timings = true;
-    pc.setRequest (request);
-    CollisionResult r;
-    if (!pc.compute (Eigen::Isometry3d (Eigen::Translation3d (1e5, 0.0, 0.0)), r))
-    {
-      state.SkipWithError (r.message.c_str ());
-      return;
-    }
-    ms += r.build_ms;
-    hierarchy_ms += pc.getInputHierarchy ()->buildMilliseconds ();
-    bytes = pc.getInputHierarchy ()->bytes ();
-    stored = pc.getInputHierarchy ()->storedPoints ();
-    nodes = pc.getInputHierarchy ()->nodes ().size ();
+    const CloudModel::ConstPtr model = buildCloudModel (*room, params);
+    ms += model->buildMilliseconds ();
+    hierarchy_ms += model->hierarchy ().buildMilliseconds ();
+    bytes = model->bytes ();
+    stored = model->hierarchy ().storedPoints ();
+    nodes = model->hierarchy ().nodes ().size ();
   }
   const double n = static_cast<double> (room->size ());
   const double runs = static_cast<double> (state.iterations ());
@@ -236,19 +220,10 @@ BM_Hierarchy (benchmark::State& state)
 {
   const Meshes& w = meshes ();
   const CloudXYZ::Ptr room = noisySamples (w.env_mesh, static_cast<std::size_t> (state.range (0)), w.sigma, 805);
-  CloudXYZ::Ptr dot (new CloudXYZ);
-  dot->push_back (pcl::PointXYZ (0.f, 0.f, 0.f));
-  ProbabilisticCollision<pcl::PointXYZ> pc;
-  pc.setInputCloud (room);
-  pc.setTargetCloud (dot);
-  pc.setInputNoise (SensorNoiseModel::isotropic (w.sigma));
-  CollisionResult r;
-  if (!pc.compute (Eigen::Isometry3d (Eigen::Translation3d (1e5, 0.0, 0.0)), r))
-  {
-    state.SkipWithError (r.message.c_str ());
-    return;
-  }
-  const ProbabilisticBVH& built = *pc.getInputHierarchy ();
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (w.sigma);
+  const CloudModel::ConstPtr model = buildCloudModel (*room, params);
+  const ProbabilisticBVH& built = model->hierarchy ();
   UncertainCloud points;
   points.means = built.means ();
   for (const PackedCovariance& c : built.covariances ())

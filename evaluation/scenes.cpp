@@ -43,14 +43,16 @@ evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& r
     for (const OursSetting& s : oursSettings (false))
     {
       ProbabilisticCollision<pcl::PointXYZ> pc;
+      CloudModelParams params = s.model;
+      params.noise = noise;
       pc.setInputCloud (a);
       pc.setTargetCloud (b);
-      pc.setInputNoise (noise);
-      pc.setTargetNoise (noise);
-      pc.setSurfaceProjection (s.projection);
+      pc.setInputModelParams (params);
+      pc.setTargetModelParams (params);
       pc.setRequest (s.request);
       CollisionResult r;
-      pc.compute (Eigen::Isometry3d::Identity () * Eigen::Translation3d (1e6, 0, 0), r);  // build
+      pc.setInputModel (buildCloudModel (*a, params, nullptr, nullptr, f[2]));
+      pc.setTargetModel (buildCloudModel (*b, params, nullptr, nullptr, f[3]));
       const auto start = std::chrono::steady_clock::now ();
       if (!pc.compute (pose, r))
         throw std::runtime_error (f[0] + ": " + r.message);

@@ -3,7 +3,8 @@
 #include "mesh_sampling.h"
 
 #include <pcl_probcollision/normal_distribution.h>
-#include <pcl_probcollision/probabilistic_collision.h>
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/collision.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,26 +21,31 @@ std::vector<OursSetting>
 oursSettings (bool full)
 {
   std::vector<OursSetting> s;
-  const CollisionRequest defaults;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
-  const bool projection = ProbabilisticCollision<pcl::PointXYZ> ().getSurfaceProjection ();
-  s.push_back ({"default", defaults, projection});
-  s.push_back ({projection ? "max" : "projected", defaults, !projection});
+  const OursSetting defaults;
+  const bool projection = defaults.model.surface_projection;
+  OursSetting other = defaults;
+  other.name = projection ? "max" : "projected";
+  other.model.surface_projection = !projection;
+  s.push_back (defaults);
+  s.push_back (other);
   if (!full)
     return s;
   auto add = [&] (const std::string& name, auto change) {
-    OursSetting o {name, defaults, true};
+    OursSetting o = defaults;
+    o.name = name;
+    o.model.surface_projection = true;
     change (o);
     s.push_back (o);
   };
-  add ("k20", [] (OursSetting& o) { o.k = 20; });
+  add ("k20", [] (OursSetting& o) { o.model.k = 20; });
   add ("C10", [] (OursSetting& o) { o.request.classifier.C = 10.0; });
   add ("C100", [] (OursSetting& o) { o.request.classifier.C = 100.0; });
-  add ("nmax10", [] (OursSetting& o) { o.request.hierarchy.n_max = 10; o.request.hierarchy.n_min = 5; });
-  add ("nmax40", [] (OursSetting& o) { o.request.hierarchy.n_max = 40; });
-  add ("sigmamax0.02", [] (OursSetting& o) { o.request.hierarchy.sigma_max = 0.02; });
-  add ("eps0", [] (OursSetting& o) { o.request.hierarchy.epsilon = 0.0; });
-  add ("octree", [] (OursSetting& o) { o.request.hierarchy.split_style = BVHParams::SplitStyle::Octree; });
+  add ("nmax10", [] (OursSetting& o) { o.model.hierarchy.n_max = 10; o.model.hierarchy.n_min = 5; });
+  add ("nmax40", [] (OursSetting& o) { o.model.hierarchy.n_max = 40; });
+  add ("sigmamax0.02", [] (OursSetting& o) { o.model.hierarchy.sigma_max = 0.02; });
+  add ("eps0", [] (OursSetting& o) { o.model.hierarchy.epsilon = 0.0; });
+  add ("octree", [] (OursSetting& o) { o.model.hierarchy.split_style = BVHParams::SplitStyle::Octree; });
   add ("linear", [] (OursSetting& o) { o.request.classifier.kernel = KernelMode::Linear; });
   add ("rff", [] (OursSetting& o) { o.request.classifier.kernel = KernelMode::RFF; });
   add ("stochastic", [] (OursSetting& o) { o.request.traversal = TraversalMode::Stochastic; });
@@ -53,32 +59,22 @@ PoseQuery
 buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma, const OursSetting& setting,
            BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query)
 {
-  auto pc = std::make_shared<ProbabilisticCollision<pcl::PointXYZ>> ();
-  pc->setInputCloud (robot);
-  pc->setTargetCloud (env);
-  pc->setInputNoise (SensorNoiseModel::isotropic (sigma));
-  pc->setTargetNoise (SensorNoiseModel::isotropic (sigma));
-  pc->setSurfaceProjection (setting.projection);
-  pc->setKSearch (setting.k);
-  CollisionRequest request = setting.request;
-  request.enable_timings = true;
-  pc->setRequest (request);
-  // The first query builds both hierarchies: a pose far away costs no leaf pair.
-  Eigen::Isometry3d far = Eigen::Isometry3d::Identity ();
-  far.translation () = Eigen::Vector3d::Constant (1e9);
-  CollisionResult r;
-  if (!pc->compute (far, r))
-    throw std::runtime_error ("our method failed to build: " + r.message);
-  build.build_ms = r.build_ms;
-  const auto a = pc->getInputHierarchy ();
-  const auto b = pc->getTargetHierarchy ();
+  CloudModelParams params = setting.model;
+  params.noise = SensorNoiseModel::isotropic (sigma);
+  const auto start = std::chrono::steady_clock::now ();
+  const CloudModel::ConstPtr a = buildCloudModel (*robot, params, nullptr, nullptr, "robot");
+  const CloudModel::ConstPtr b = buildCloudModel (*env, params, nullptr, nullptr, "environment");
+  build.build_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   build.memory_bytes = static_cast<double> (a->bytes () + b->bytes ());
-  build.nodes = static_cast<double> (a->nodes ().size () + b->nodes ().size ());
+  build.nodes = static_cast<double> (a->hierarchy ().nodes ().size () + b->hierarchy ().nodes ().size ());
+  auto classifier = std::make_shared<const RobustClassifier> (setting.request.classifier);
   const int features = setting.request.classifier.rff_features;
-  return [pc, on_query, features] (const Eigen::Isometry3d& T) {
+  const CollisionRequest request = setting.request;
+  return [a, b, classifier, request, on_query, features] (const Eigen::Isometry3d& T) {
     CollisionResult result;
     Answer answer;
-    if (!pc->compute (T, result))
+    // T places the robot (A) in the environment's (B's) frame; collide() maps B into A's.
+    if (!collide (*a, *b, T.inverse (), request, result, classifier.get ()))
       throw std::runtime_error ("our query failed: " + result.message);
     answer.score = result.probability;
     answer.verdict = verdictName (result.verdict);

@@ -4,6 +4,7 @@
 
 #include "baselines.h"
 
+#include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision_request.h>
 
 #include <cstdint>
@@ -43,10 +44,10 @@ struct BuildRow
 /** \brief One configuration of our method in the sweep. */
 struct OursSetting
 {
-  std::string name;
+  std::string name = "default";
   pcl_probcollision::CollisionRequest request;
-  bool projection = true;
-  int k = 10;  ///< neighbours of the covariance estimation
+  /** \brief How each cloud is modelled (the noise is set per workload). */
+  pcl_probcollision::CloudModelParams model;
 };
 
 /** \brief The sweep: the library defaults first ("default"), the paper's measured-position

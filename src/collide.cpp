@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/detail/bvh_traversal.h>
+#include <pcl_probcollision/detail/input_checks.h>
 
 #include <pcl/exceptions.h>
 
@@ -35,83 +37,19 @@ keepMax (float& slot, double value)
     slot = v;
 }
 
-detail::TraversalParams
-traversalParams (const CollisionRequest& request)
-{
-  detail::TraversalParams p;
-  switch (request.traversal)
-  {
-    case TraversalMode::ExpectedWeight: p.mode = detail::TraversalMode::ExpectedWeight; break;
-    case TraversalMode::Stochastic: p.mode = detail::TraversalMode::Stochastic; break;
-    case TraversalMode::ExpandedBV: p.mode = detail::TraversalMode::ExpandedBV; break;
-  }
-  p.rho_min = request.rho_min;
-  p.seed = request.seed;
-  p.expanded_k_sigma = request.expanded_k_sigma;
-  p.exhaustive = request.exhaustive;
-  // In decision mode a contribution above collision_above makes InCollision final (METHOD.md 7).
-  p.stop_probability = request.collision_above;
-  // A pair whose reach weight is at most the maximum so far cannot raise it (its contribution
-  // is rho * P_leaf <= rho): same probability and witness, fewer classifier fits. Per-point
-  // values need every reachable leaf pair, so they keep the full traversal.
-  p.skip_dominated = !request.per_point;
-  return p;
-}
-} // namespace
-
-Verdict
-verdictFor (double probability, const CollisionRequest& request)
-{
-  if (std::isnan (probability))
-    return Verdict::Unknown;
-  if (probability < request.free_below)
-    return Verdict::Free;
-  if (probability > request.collision_above)
-    return Verdict::InCollision;
-  return Verdict::InContact;
-}
-
+/** \brief collide() on the two hierarchies, B mapped into A's local frame by T_a_b; the
+  * request is valid and the pose rigid. Witness in A's local frame, per-point values in
+  * hierarchy order. */
 bool
-collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
-         const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
+collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
+              const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
 {
-  const auto start = std::chrono::steady_clock::now ();
-  result = CollisionResult ();
-  try
-  {
-    request.validate ();
-  }
-  catch (const pcl::PCLException& e)
-  {
-    fail (result, CollisionResult::Status::InvalidInput, e.what ());
-    return false;
-  }
   if (a.empty () || b.empty ())
   {
     fail (result, CollisionResult::Status::InvalidInput,
           a.empty () ? "hierarchy A is empty (no finite point)" : "hierarchy B is empty (no finite point)");
     return false;
   }
-  if (!T_a_b.matrix ().allFinite ())
-  {
-    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b is not finite");
-    return false;
-  }
-  const Eigen::Matrix3d R = T_a_b.linear ();
-  if (!(R.transpose () * R).isIdentity (1e-6) || R.determinant () < 0.0)
-  {
-    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b is not a rotation plus translation");
-    return false;
-  }
-  // A finite but absurd translation overflows when B's points and boxes are mapped (inf - inf:
-  // NaN boxes never prune, so the traversal fitted every leaf pair for minutes; found by
-  // fuzz/fuzz_collide, fuzz/regressions/). Same bound as ProbabilisticCollision's coordinates.
-  if (!(T_a_b.translation ().cwiseAbs ().maxCoeff () <= 1e15))
-  {
-    fail (result, CollisionResult::Status::InvalidInput, "pose T_a_b translation is beyond the supported range of +-1e15");
-    return false;
-  }
-
   // The caller's classifier carries the random-feature draw; without one, draw it here.
   std::optional<RobustClassifier> own;
   if (!classifier)
@@ -202,7 +140,11 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
     return leaf.probability;
   };
 
-  const detail::TraversalParams params = traversalParams (request);
+  detail::TraversalParams params (request);
+  // A pair whose reach weight is at most the maximum so far cannot raise it (its contribution
+  // is rho * P_leaf <= rho): same probability and witness, fewer classifier fits. Per-point
+  // values need every reachable leaf pair, so they keep the full traversal.
+  params.skip_dominated = !request.per_point;
   detail::TraversalResult traversal;
   try
   {
@@ -210,7 +152,7 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
   }
   catch (const pcl::PCLException& e)
   {
-    fail (result, CollisionResult::Status::InvalidInput, e.what ());
+    fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
     return false;
   }
   bool stopped = traversal.lower_bound;
@@ -250,8 +192,75 @@ collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isom
     result.witness_index = -1;
   }
   result.verdict = verdictFor (result.probability, request);
+  return true;
+}
+} // namespace
+
+Verdict
+verdictFor (double probability, const CollisionRequest& request)
+{
+  if (std::isnan (probability))
+    return Verdict::Unknown;
+  if (probability < request.free_below)
+    return Verdict::Free;
+  if (probability > request.collision_above)
+    return Verdict::InCollision;
+  return Verdict::InContact;
+}
+
+
+bool
+collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+         CollisionResult& result, const RobustClassifier* classifier)
+{
+  const auto start = std::chrono::steady_clock::now ();
+  result = CollisionResult ();
+  try
+  {
+    request.validate ();
+  }
+  catch (const pcl::PCLException& e)
+  {
+    fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
+    return false;
+  }
+  const std::string pose_error = detail::poseError (T_a_b, "T_a_b");
+  if (!pose_error.empty ())
+  {
+    fail (result, CollisionResult::Status::InvalidInput, pose_error);
+    return false;
+  }
+  // The hierarchies live in the models' local frames (x = local + origin): B's local points go
+  // to A's local frame by T_local = Translate (-o_a) T_a_b Translate (o_b), composed in double.
+  Eigen::Isometry3d T_local = T_a_b;
+  T_local.translation () = (T_a_b.linear () * b.origin () + T_a_b.translation ()) - a.origin ();
+  if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
+    return false;
+
+  // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
+  if (result.witness_side != 0)
+    result.witness_point += a.origin ();
+  if (request.per_point)
+  {
+    auto scatter = [] (std::vector<float>& values, const CloudModel& model) {
+      std::vector<float> out (model.sourceSize (), kNotReached);
+      const ProbabilisticBVH& bvh = model.hierarchy ();
+      for (std::size_t j = 0; j < values.size (); ++j)
+        out[static_cast<std::size_t> (bvh.sourceIndex (static_cast<int> (j)))] = values[j];
+      values.swap (out);
+    };
+    scatter (result.probabilities_a, a);
+    scatter (result.probabilities_b, b);
+  }
+  result.points_skipped_nonfinite = a.skippedPoints () + b.skippedPoints ();
+  for (const CloudModel* m : {&a, &b})
+    if (!m->warning ().empty ())
+      result.message += (result.message.empty () ? "" : "; ") + m->warning ();
   if (request.enable_timings)
+  {
+    result.build_ms = 0.0;  // the models were built before
     result.query_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+  }
   return true;
 }
 } // namespace pcl_probcollision

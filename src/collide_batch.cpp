@@ -27,10 +27,8 @@ workerCount (int threads, std::size_t poses)
 
 /** \brief Whether collide() would get as far as classifying, i.e. need a classifier. */
 bool
-needsClassifier (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const CollisionRequest& request)
+needsClassifier (const CollisionRequest& request)
 {
-  if (a.empty () || b.empty ())
-    return false;
   try
   {
     request.validate ();
@@ -44,7 +42,7 @@ needsClassifier (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Col
 } // namespace
 
 bool
-collideBatch (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
               const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
               const RobustClassifier* classifier)
 {
@@ -60,7 +58,7 @@ collideBatch (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const std::v
   // Drawing the random features is costly: one classifier for every pose. collide() would draw
   // the same one (its parameters and seed are the request's), so results do not change.
   std::optional<RobustClassifier> shared;
-  if (!classifier && needsClassifier (a, b, request))
+  if (!classifier && needsClassifier (request))
     classifier = &shared.emplace (request.classifier);
 
   // Poses are independent and their results stored by index: which thread answers a pose, and

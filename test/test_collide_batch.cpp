@@ -147,8 +147,8 @@ patchWithHole (int side, double h, const Eigen::Vector3d& centre, unsigned seed)
 
 TEST (CollideBatch, ConcurrentBatchEqualsSingleQueriesForEveryModeAndThreadCount)
 {
-  const ProbabilisticBVH a (grid (20, 0.005, 0.001, 1));
-  const ProbabilisticBVH b (grid (24, 0.005, 0.001, 2));
+  const CloudModel a (grid (20, 0.005, 0.001, 1));
+  const CloudModel b (grid (24, 0.005, 0.001, 2));
   const std::vector<Eigen::Isometry3d> poses = sweep (kPoses, 3);
   for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
   {
@@ -182,8 +182,8 @@ TEST (CollideBatch, ConcurrentBatchEqualsSingleQueriesForEveryModeAndThreadCount
 
 TEST (CollideBatch, ConcurrentBatchWithBadPosesFailsThemAndAnswersTheOthers)
 {
-  const ProbabilisticBVH a (grid (16, 0.005, 0.001, 4));
-  const ProbabilisticBVH b (grid (16, 0.005, 0.001, 5));
+  const CloudModel a (grid (16, 0.005, 0.001, 4));
+  const CloudModel b (grid (16, 0.005, 0.001, 5));
   std::vector<Eigen::Isometry3d> poses = sweep (8, 6);
   poses[2].translation ().y () = std::numeric_limits<double>::quiet_NaN ();
   poses[5].linear () *= 1.5;
@@ -215,7 +215,7 @@ TEST (CollideBatch, ConcurrentBatchWithBadPosesFailsThemAndAnswersTheOthers)
 
 TEST (CollideBatch, NegativeThreadCountThrowsNamingIt)
 {
-  const ProbabilisticBVH a (grid (4, 0.01, 0.001, 7));
+  const CloudModel a (grid (4, 0.01, 0.001, 7));
   const std::vector<Eigen::Isometry3d> poses (2, Eigen::Isometry3d::Identity ());
   std::vector<CollisionResult> results;
   try
@@ -246,7 +246,7 @@ TEST (CollideBatch, NegativeThreadCountThrowsNamingIt)
 
 TEST (CollideBatch, EmptyPoseListGivesNoResults)
 {
-  const ProbabilisticBVH a (grid (4, 0.01, 0.001, 10));
+  const CloudModel a (grid (4, 0.01, 0.001, 10));
   std::vector<CollisionResult> results (5);
   EXPECT_TRUE (collideBatch (a, a, {}, CollisionRequest (), results));
   EXPECT_TRUE (results.empty ());
@@ -256,17 +256,19 @@ TEST (CollideBatch, EmptyPoseListGivesNoResults)
   EXPECT_TRUE (results.empty ());
 }
 
-TEST (CollideBatch, InvalidRequestOrEmptyHierarchyFailsEveryPoseLikeCollide)
+TEST (CollideBatch, InvalidRequestOrPoseFailsEveryPoseLikeCollide)
 {
-  const ProbabilisticBVH a (grid (6, 0.01, 0.001, 11));
-  const ProbabilisticBVH empty;
-  const std::vector<Eigen::Isometry3d> poses = sweep (4, 12);
+  const CloudModel a (grid (6, 0.01, 0.001, 11));
+  std::vector<Eigen::Isometry3d> poses = sweep (4, 12);
   CollisionRequest bad;
   bad.rho_min = 2.0;
-  for (const bool empty_b : {false, true})
+  for (const bool bad_pose : {false, true})
   {
-    const CollisionRequest& request = empty_b ? CollisionRequest () : bad;
-    const ProbabilisticBVH& b = empty_b ? empty : a;
+    const CollisionRequest& request = bad_pose ? CollisionRequest () : bad;
+    if (bad_pose)
+      for (Eigen::Isometry3d& T : poses)
+        T.linear () *= 2.0;  // a scale, not a rotation
+    const CloudModel& b = a;
     std::vector<CollisionResult> batch;
     EXPECT_FALSE (collideBatch (a, b, poses, request, batch, 2));
     ASSERT_EQ (batch.size (), poses.size ());
@@ -341,6 +343,6 @@ TEST (CollideBatch, ConcurrentComputeBatchEqualsComputePoseByPose)
       }
     }
     EXPECT_NE (batch[4].message.find ("pose 4: "), std::string::npos) << batch[4].message;
-    EXPECT_TRUE (batched.getInputHierarchy () && batched.getTargetHierarchy ());
+    EXPECT_TRUE (batched.getInputModel () && batched.getTargetModel ());
   }
 }

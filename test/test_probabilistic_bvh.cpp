@@ -29,7 +29,6 @@
 
 using namespace pcl_probcollision;
 using detail::OrientedBox;
-using detail::TraversalMode;
 using detail::TraversalParams;
 using detail::TraversalResult;
 using Node = ProbabilisticBVH::Node;
@@ -1139,6 +1138,7 @@ TEST (BVHTraversal, EarlyStopGivesLowerBound)
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
   auto always = [] (const Node&, const Node&, double) { return 0.9; };
   TraversalParams tp;
+  tp.stop_probability = 0.5;
   const TraversalResult stopped = detail::traverseHierarchies (a, b, I, tp, always);
   EXPECT_TRUE (stopped.lower_bound);
   EXPECT_EQ (stopped.leaf_pairs_tested, 1u);

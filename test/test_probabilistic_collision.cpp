@@ -203,8 +203,8 @@ TEST (ProbabilisticCollision, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
   pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
   CollisionResult warmup;
   ASSERT_TRUE (pc.compute (warmup));
-  const auto a = pc.getInputHierarchy ();
-  const auto b = pc.getTargetHierarchy ();
+  const auto a = pc.getInputModel ();
+  const auto b = pc.getTargetModel ();
   CollisionRequest request;
   request.exhaustive = true;
   const RobustClassifier classifier (request.classifier);

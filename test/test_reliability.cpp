@@ -113,9 +113,10 @@ struct Query
 
 Query
 query (const Cloud::Ptr& a, const Cloud::Ptr& b, double sigma, CollisionRequest rq = CollisionRequest (),
-       const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity ())
+       const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity (), const BVHParams& hierarchy = BVHParams ())
 {
   ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setHierarchyParams (hierarchy);
   pc.setInputCloud (a);
   pc.setTargetCloud (b);
   if (sigma > 0)
@@ -436,10 +437,10 @@ TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
   for (const double gap : {0.02, 0.003, 0.0})
   {
     SCOPED_TRACE (gap);
-    const ProbabilisticBVH a0 (sheet (400, 0.2, 0.0, 0.002, 12));
-    const ProbabilisticBVH b0 (sheet (400, 0.2, gap, 0.002, 13));
-    const ProbabilisticBVH a1 (sheet (400, 0.2, 0.0, 0.002, 12, offset));
-    const ProbabilisticBVH b1 (sheet (400, 0.2, gap, 0.002, 13, offset));
+    const CloudModel a0 (sheet (400, 0.2, 0.0, 0.002, 12));
+    const CloudModel b0 (sheet (400, 0.2, gap, 0.002, 13));
+    const CloudModel a1 (sheet (400, 0.2, 0.0, 0.002, 12, offset));
+    const CloudModel b1 (sheet (400, 0.2, gap, 0.002, 13, offset));
     CollisionResult r0, r1;
     ASSERT_TRUE (collide (a0, b0, Eigen::Isometry3d::Identity (), rq, r0)) << r0.message;
     ASSERT_TRUE (collide (a1, b1, Eigen::Isometry3d::Identity (), rq, r1)) << r1.message;
@@ -454,12 +455,12 @@ TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
 // so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
 TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
 {
-  const ProbabilisticBVH a (sheet (600, 0.2, 0.0, 0.002, 31));
+  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 31));
   std::size_t fewer = 0;
   for (const double gap : {0.03, 0.008, 0.004, 0.0})
   {
     SCOPED_TRACE (gap);
-    const ProbabilisticBVH b (sheet (600, 0.2, gap, 0.002, 32));
+    const CloudModel b (sheet (600, 0.2, gap, 0.002, 32));
     for (const double tilt : {0.0, 0.2})
     {
       const Eigen::Isometry3d T (Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ()));
@@ -484,8 +485,8 @@ TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
 // same verdict always, fewer kernel fits; ignored with per-point values.
 TEST (Reliability, DeferredKernelFitsKeepTheAnswer)
 {
-  const ProbabilisticBVH a (sheet (600, 0.2, 0.0, 0.002, 41));
-  const ProbabilisticBVH b (sheet (600, 0.2, 0.0, 0.002, 42));
+  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 41));
+  const CloudModel b (sheet (600, 0.2, 0.0, 0.002, 42));
   std::size_t kernel_default = 0, kernel_deferred = 0;
   for (const double tilt : {0.0, 0.15, 0.4})
     for (const double lift : {0.004, 0.0, -0.01})
@@ -563,10 +564,10 @@ TEST (Reliability, TinyObjectsGetTheirVerdicts)
   rq.exhaustive = true;
   BVHParams hierarchy;
   hierarchy.sigma_max = 0.05 * s;  // the hierarchy thresholds are in data units too
-  rq.hierarchy = hierarchy;
   const auto a = patch (s, s / 10, 0.0, 0.0, 17);
-  const Query clear = query (a, patch (s, s / 10, 0.5 * s, 0.0, 18), 0.02 * s, rq);
-  const Query touching = query (a, patch (s, s / 10, 0.0, 0.0, 19), 0.02 * s, rq);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
+  const Query clear = query (a, patch (s, s / 10, 0.5 * s, 0.0, 18), 0.02 * s, rq, I, hierarchy);
+  const Query touching = query (a, patch (s, s / 10, 0.0, 0.0, 19), 0.02 * s, rq, I, hierarchy);
   ASSERT_TRUE (clear.ok && touching.ok) << clear.r.message << touching.r.message;
   expectSane (clear.r, true, rq);
   expectSane (touching.r, true, rq);
@@ -664,8 +665,8 @@ TEST (Reliability, NonFiniteOrNonRigidPosesFail)
 
 TEST (Reliability, ConcurrentQueriesOnSharedHierarchiesMatchSerialExactly)
 {
-  const ProbabilisticBVH a (sheet (600, 0.2, 0.0, 0.002, 24));
-  const ProbabilisticBVH b (sheet (600, 0.2, 0.0, 0.002, 25));
+  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 24));
+  const CloudModel b (sheet (600, 0.2, 0.0, 0.002, 25));
   for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
   {
     CollisionRequest rq;

@@ -324,13 +324,23 @@ requestFor (const Options& o)
   r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
                              : pcl_probcollision::TraversalMode::ExpectedWeight;
   r.seed = o.seed;
-  r.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
-                                                : pcl_probcollision::BVHParams::SplitStyle::Pca;
-  r.hierarchy.n_max = o.n_max;
-  r.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
-  r.hierarchy.sigma_max = o.sigma_max;
-  r.hierarchy.epsilon = o.epsilon;
   return r;
+}
+
+/** \brief How both inputs are modelled (the noise is set per input). */
+pcl_probcollision::CloudModelParams
+modelParamsFor (const Options& o)
+{
+  pcl_probcollision::CloudModelParams m;
+  m.k = o.k;
+  m.surface_projection = !o.measured;
+  m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
+                                                : pcl_probcollision::BVHParams::SplitStyle::Pca;
+  m.hierarchy.n_max = o.n_max;
+  m.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
+  m.hierarchy.sigma_max = o.sigma_max;
+  m.hierarchy.epsilon = o.epsilon;
+  return m;
 }
 
 void
@@ -425,10 +435,11 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("positions").str (o.measured ? "measured" : "projected");
   j.key ("seed").count (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
-  j.key ("nmax").integer (rq.hierarchy.n_max);
-  j.key ("nmin").integer (rq.hierarchy.n_min);
-  j.key ("sigma_max").num (rq.hierarchy.sigma_max);
-  j.key ("epsilon").num (rq.hierarchy.epsilon);
+  const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
+  j.key ("nmax").integer (hierarchy.n_max);
+  j.key ("nmin").integer (hierarchy.n_min);
+  j.key ("sigma_max").num (hierarchy.sigma_max);
+  j.key ("epsilon").num (hierarchy.epsilon);
   j.key ("split").str (o.split);
   j.end ();
   if (o.output)
@@ -617,8 +628,8 @@ run (int argc, char** argv)
   pcl_probcollision::ProbabilisticCollision<pcl::PointXYZ> pc;
   pc.setInputCloud (a.cloud);
   pc.setTargetCloud (b.cloud);
-  pc.setKSearch (o.k);
-  pc.setSurfaceProjection (!o.measured);
+  pc.setInputModelParams (modelParamsFor (o));
+  pc.setTargetModelParams (modelParamsFor (o));
   if (a.kind == InputKind::Mesh)
     pc.setInputCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (a.cloud->width, a.cloud->height));
   else

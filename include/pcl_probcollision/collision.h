@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/collision_result.h>
-#include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/robust_classifier.h>
 
 #include <Eigen/Geometry>
@@ -12,36 +12,39 @@
 
 namespace pcl_probcollision
 {
-/** \brief The core query: probability that the objects behind two prebuilt hierarchies
-  * collide, with B placed in A's frame by T_a_b (METHOD.md 6-8).
+/** \brief The core query: probability that the objects behind two models collide, with B
+  * placed in A's frame by T_a_b (METHOD.md 6-8).
   *
   * Traverses both hierarchies together (boxes of B mapped on the fly), fits the robust
   * separator on the union of each leaf pair reached and keeps the largest reach-weighted
-  * per-point probability. Points of A have label +1.
+  * per-point probability. Points of A have label +1. The pose is composed with the two models'
+  * local origins in double, so models far from the origin lose no precision (CloudModel).
   *
-  * \param[in] a hierarchy of object A (its frame is the query frame)
-  * \param[in] b hierarchy of object B
+  * \param[in] a model of object A (its frame is the query frame)
+  * \param[in] b model of object B
   * \param[in] T_a_b rigid transform mapping B-frame points into A's frame
   * \param[in] request what to compute (validated)
-  * \param[out] result verdict, probability, witness in A's frame, counters; per-point
-  *             probabilities (request.per_point) index-aligned with a.means() and b.means()
+  * \param[out] result verdict, probability, witness (in the query frame, here A's: see
+  *             CollisionResult::witness_point), counters; per-point probabilities
+  *             (request.per_point) index-aligned with the clouds the models were built from;
+  *             message holds the models' warnings (CloudModel::warning()) on success
   * \param[in] classifier a prebuilt classifier with request.classifier's parameters to reuse
   *            its random-feature draw across queries (optional)
-  * \return result.ok(); false with status and message for an empty hierarchy, a non-finite or
-  *         non-rigid T_a_b, or invalid request parameters.
-  * \note Thread safety: any number of calls may share the same hierarchies and classifier.
+  * \return result.ok(); false with status and message for a non-finite or non-rigid T_a_b or
+  *         invalid request parameters.
+  * \note Thread safety: any number of calls may share the same models and classifier.
   */
-bool collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
+bool collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b,
               const CollisionRequest& request, CollisionResult& result,
               const RobustClassifier* classifier = nullptr);
 
 /** \brief collide() for many poses of B, spread over several threads (issue #8).
   *
-  * Each pose is an independent query on the shared hierarchies and classifier; results are
+  * Each pose is an independent query on the shared models and classifier; results are
   * stored by pose index, so they do not depend on the thread count or on scheduling.
   *
-  * \param[in] a hierarchy of object A (its frame is the query frame)
-  * \param[in] b hierarchy of object B
+  * \param[in] a model of object A (its frame is the query frame)
+  * \param[in] b model of object B
   * \param[in] T_a_b rigid transforms mapping B-frame points into A's frame, one per query
   * \param[in] request what to compute (invalid: every pose fails as in collide())
   * \param[out] results resized to T_a_b.size(); results[i] is what
@@ -56,11 +59,11 @@ bool collide (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
   *         worker (std::bad_alloc) stops the batch and is rethrown here after every worker
   *         has stopped (the earliest pose's); results are then incomplete.
   */
-bool collideBatch (const ProbabilisticBVH& a, const ProbabilisticBVH& b,
-                   const std::vector<Eigen::Isometry3d>& T_a_b, const CollisionRequest& request,
-                   std::vector<CollisionResult>& results, int threads = 0,
+bool collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+                   const CollisionRequest& request, std::vector<CollisionResult>& results, int threads = 0,
                    const RobustClassifier* classifier = nullptr);
 
-/** \brief The verdict of a probability under a request's thresholds (Unknown for NaN). */
+/** \brief The verdict of a probability under a request's thresholds (Unknown for NaN): the one
+  * rule every verdict, label and colour of the library and its tools derives from. */
 Verdict verdictFor (double probability, const CollisionRequest& request);
 } // namespace pcl_probcollision

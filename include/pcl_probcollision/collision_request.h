@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/robust_classifier.h>
 
 #include <cstdint>
@@ -32,7 +31,9 @@ collisionClassifierDefaults ()
   return params;
 }
 
-/** \brief What a collision query computes and how. Every member has a documented default;
+/** \brief What a collision query computes and how: only what a query needs (how each cloud is
+  * modelled is in CloudModelParams, fixed when its CloudModel is built). Every member has a
+  * documented default;
   * validate() throws pcl::BadArgumentException naming the first member out of range.
   *
   * Verdict thresholds are on the collision probability P (METHOD.md 7 states them on
@@ -75,9 +76,6 @@ struct CollisionRequest
     * tilted between side-by-side patches that leaves a few points on the wrong side: free
     * poses 4-7 sigma from contact read P = 1 (docs/RESULTS.md). */
   ClassifierParams classifier = collisionClassifierDefaults ();
-  /** \brief The hierarchy built for each cloud (PCA split, n_max 20, sigma_max 0.05,
-    * epsilon 0.02, k_sigma 1). */
-  BVHParams hierarchy;
 
   void validate () const;
   bool operator== (const CollisionRequest& o) const;

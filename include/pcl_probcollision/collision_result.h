@@ -48,9 +48,12 @@ struct CollisionResult
   /** \brief Its index in its own input cloud (-1 when none). */
   int witness_index = -1;
   /** \brief Its position and the separator's unit normal there (pointing toward A's side),
-    * both in the target's (B's) frame, where the pose puts A. The normal can be NaN even with
-    * a witness: the separator's gradient collapsed there (coincident or exact points, a
-    * degenerate classifier; ClassifierResult::witness_normal). */
+    * both in the query frame: the frame the query's pose maps the other object into. That is
+    * A's frame for collide (a, b, T_a_b, ...) and the target's (B's) for
+    * ProbabilisticCollision::compute (T_target_input, ...); this is the one place the rule is
+    * stated. The normal can be NaN even with a witness: the separator's gradient collapsed
+    * there (coincident or exact points, a degenerate classifier;
+    * ClassifierResult::witness_normal). */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
 

@@ -15,7 +15,8 @@
 /** \brief The point types the library is compiled for (PCL's instantiation-list format).
   * Other types work with PCL_NO_PRECOMPILE or by including the impl/ headers. */
 #define PCL_PROBCOLLISION_POINT_TYPES \
-  (pcl::PointXYZ)(pcl::PointXYZI)(pcl::PointXYZRGB)(pcl::PointXYZRGBA)(pcl::PointNormal)
+  (pcl::PointXYZ)(pcl::PointXYZI)(pcl::PointXYZRGB)(pcl::PointXYZRGBA)(pcl::PointNormal)             \
+  (pcl::PointXYZRGBNormal)(pcl::PointXYZINormal)
 
 namespace pcl_probcollision
 {

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/collision_result.h>
 #include <pcl_probcollision/point_types.h>
-#include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/robust_classifier.h>
 #include <pcl_probcollision/sensor_noise.h>
 
@@ -22,10 +22,20 @@ namespace pcl_probcollision
 /** \brief Probability that the object sampled by the input cloud (A) collides with the object
   * sampled by the target cloud (B), after Pan, Chitta and Manocha (ISRR 2011); see METHOD.md.
   *
-  * Each point is a Gaussian: given covariances, or estimated with CovarianceEstimation
-  * (k = 10) plus the cloud's SensorNoiseModel (none by default: set one for sensor data).
-  * Each cloud gets a ProbabilisticBVH, built once and reused for every pose until a cloud,
-  * its indices, covariances, noise model, k or the hierarchy parameters change.
+  * The PCL face of the library: a thin adaptor that builds one CloudModel per cloud
+  * (buildCloudModel) and queries them with collide(). Each point is a Gaussian: given
+  * covariances, or estimated with CovarianceEstimation (k = 10) plus the cloud's
+  * SensorNoiseModel. The default noise model is none, right for exact samples (meshes, CAD);
+  * for sensor data set the sensor's model (CloudModelParams says which, and why pcd_collision
+  * assumes 5 mm instead).
+  *
+  * Models are built at the first query and reused for every pose. Like
+  * pcl::Registration::setInputTarget, every setter of something a model is built from
+  * (setInputCloud, setIndices, setTargetCloud, setTargetIndices, the covariances, noise models,
+  * k, surface projection and hierarchy parameters) marks that model for rebuild, even when it
+  * is given the same pointer again. A cloud changed in place (pcl::transformPointCloud (*a, *a,
+  * T)) is NOT noticed until it is set again or markForRebuild() is called: until then the old
+  * model answers. Prebuilt models (setInputModel, setTargetModel) are used as they are.
   *
   * As a filter (pcl::FilterIndices), it keeps the points of A whose collision probability
   * reaches setProbabilityThreshold() (default 0.5); setNegative() keeps the others and
@@ -36,8 +46,8 @@ namespace pcl_probcollision
   * \note Non-finite points are skipped (and counted in the result). The two clouds must be in
   * the same units: covariances, thresholds of the hierarchy and noise sigmas are in those units.
   * \note Not thread-safe (a PCL filter object). computeBatch() spreads many poses over
-  * threads; for concurrent queries from the caller's own threads build the hierarchies once
-  * and call collide() from each thread.
+  * threads; for concurrent queries from the caller's own threads build the models once
+  * (buildCloudModel, or getInputModel() after a compute) and call collide() from each thread.
   */
 template <typename PointT>
 class ProbabilisticCollision : public pcl::FilterIndices<PointT>
@@ -51,38 +61,68 @@ public:
 
   ProbabilisticCollision ();
 
-  /** \brief Object B. */
-  void setTargetCloud (const PointCloudConstPtr& target) { target_ = target; }
+  /** \brief Object A; marks its model for rebuild (even for the same pointer). */
+  void setInputCloud (const PointCloudConstPtr& cloud) override;
+  /** \brief Restricts A to these indices; marks its model for rebuild. */
+  void setIndices (const pcl::IndicesPtr& indices) override;
+  /** \brief Restricts A to these indices; marks its model for rebuild. */
+  void setIndices (const pcl::IndicesConstPtr& indices) override;
+  /** \brief Restricts A to these indices; marks its model for rebuild. */
+  void setIndices (const pcl::PointIndicesConstPtr& indices) override;
+  /** \brief Restricts A to a block of an organized cloud; marks its model for rebuild. */
+  void setIndices (std::size_t row_start, std::size_t col_start, std::size_t nb_rows, std::size_t nb_cols) override;
+
+  /** \brief Object B; marks its model for rebuild (even for the same pointer). */
+  void setTargetCloud (const PointCloudConstPtr& target) { target_ = target; markTarget (); }
   PointCloudConstPtr getTargetCloud () const { return target_; }
-  /** \brief Restricts B to these indices (all points by default). */
-  void setTargetIndices (const pcl::IndicesConstPtr& indices) { target_indices_ = indices; }
+  /** \brief Restricts B to these indices (all points by default); marks its model for rebuild. */
+  void setTargetIndices (const pcl::IndicesConstPtr& indices) { target_indices_ = indices; markTarget (); }
   pcl::IndicesConstPtr getTargetIndices () const { return target_indices_; }
 
   /** \brief Covariances of A, index-aligned with the whole input cloud (not its indices);
     * unset means estimated. A non-finite covariance drops its point. */
-  void setInputCovariances (const CovarianceCloudConstPtr& covariances) { input_covariances_ = covariances; }
+  void setInputCovariances (const CovarianceCloudConstPtr& covariances) { input_covariances_ = covariances; markInput (); }
   /** \brief Covariances of B, index-aligned with the whole target cloud; unset means estimated. */
-  void setTargetCovariances (const CovarianceCloudConstPtr& covariances) { target_covariances_ = covariances; }
+  void setTargetCovariances (const CovarianceCloudConstPtr& covariances) { target_covariances_ = covariances; markTarget (); }
 
-  /** \brief Sensor noise added to A's estimated covariances (default none). The depth models
-    * read the input cloud's sensor_origin_ / sensor_orientation_. */
-  void setInputNoise (const SensorNoiseModel& noise) { input_noise_ = noise; input_dirty_ = true; }
-  const SensorNoiseModel& getInputNoise () const { return input_noise_; }
+  /** \brief Sensor noise added to A's estimated covariances (CloudModelParams::noise, default
+    * none). The depth models read the input cloud's sensor_origin_ / sensor_orientation_. */
+  void setInputNoise (const SensorNoiseModel& noise) { input_params_.noise = noise; markInput (); }
+  const SensorNoiseModel& getInputNoise () const { return input_params_.noise; }
   /** \brief Sensor noise added to B's estimated covariances (default none). */
-  void setTargetNoise (const SensorNoiseModel& noise) { target_noise_ = noise; target_dirty_ = true; }
-  const SensorNoiseModel& getTargetNoise () const { return target_noise_; }
+  void setTargetNoise (const SensorNoiseModel& noise) { target_params_.noise = noise; markTarget (); }
+  const SensorNoiseModel& getTargetNoise () const { return target_params_.noise; }
 
-  /** \brief k of the covariance estimation, >= 1 (default 10); throws otherwise. */
+  /** \brief k of the covariance estimation for both clouds, >= 1 (CloudModelParams::k);
+    * throws otherwise. */
   void setKSearch (int k);
-  int getKSearch () const { return k_; }
-  /** \brief Locally denoised point positions for estimated covariances (see
-    * CovarianceEstimation::setSurfaceProjection; default on, chosen by the evaluation in
-    * docs/RESULTS.md). Off gives the paper's model: every point at its measured position with
-    * its full noise and discretisation spread, whose maximum over many points near contact
-    * drifts toward 1. Has no effect on a cloud without a sensor noise model or with
-    * covariances given by the caller. */
-  void setSurfaceProjection (bool project) { project_ = project; input_dirty_ = target_dirty_ = true; }
-  bool getSurfaceProjection () const { return project_; }
+  int getKSearch () const { return input_params_.k; }
+  /** \brief Locally denoised point positions for both clouds
+    * (CloudModelParams::surface_projection, default on). */
+  void setSurfaceProjection (bool project);
+  bool getSurfaceProjection () const { return input_params_.surface_projection; }
+  /** \brief Hierarchy parameters, used for both clouds (CloudModelParams::hierarchy); validated. */
+  void setHierarchyParams (const BVHParams& params);
+  const BVHParams& getHierarchyParams () const { return input_params_.hierarchy; }
+  /** \brief Everything a model of A is built from but the cloud; validated. */
+  void setInputModelParams (const CloudModelParams& params) { params.validate (); input_params_ = params; markInput (); }
+  const CloudModelParams& getInputModelParams () const { return input_params_; }
+  /** \brief Everything a model of B is built from but the cloud; validated. */
+  void setTargetModelParams (const CloudModelParams& params) { params.validate (); target_params_ = params; markTarget (); }
+  const CloudModelParams& getTargetModelParams () const { return target_params_; }
+
+  /** \brief Uses a prebuilt model of A instead of building one from the input cloud (null:
+    * build from the input cloud again). filter() still needs the input cloud it came from. */
+  void setInputModel (const CloudModel::ConstPtr& model) { input_model_ = model; input_prebuilt_ = static_cast<bool> (model); input_dirty_ = !model; }
+  /** \brief Uses a prebuilt model of B instead of building one from the target cloud. */
+  void setTargetModel (const CloudModel::ConstPtr& model) { target_model_ = model; target_prebuilt_ = static_cast<bool> (model); target_dirty_ = !model; }
+  /** \brief The models of the last successful compute (null before): share them with
+    * collide() from other threads. */
+  CloudModel::ConstPtr getInputModel () const { return input_model_; }
+  CloudModel::ConstPtr getTargetModel () const { return target_model_; }
+  /** \brief Rebuilds the models built from clouds at the next query: for clouds changed in place
+    * without being set again. Prebuilt models are kept. */
+  void markForRebuild () { markInput (); markTarget (); }
 
   /** \brief Every query parameter at once; validated (throws pcl::BadArgumentException). */
   void setRequest (const CollisionRequest& request);
@@ -91,8 +131,6 @@ public:
   void setThresholds (double free_below, double collision_above);
   /** \brief Seed of the stochastic traversal (and of nothing else). */
   void setSeed (std::uint64_t seed) { request_.seed = seed; }
-  /** \brief Hierarchy parameters, used for both clouds; validated. */
-  void setHierarchyParams (const BVHParams& params);
 
   /** \brief Minimum P_i kept by filter(), in [0, 1] (default 0.5); throws otherwise. */
   void setProbabilityThreshold (double p);
@@ -101,7 +139,8 @@ public:
   /** \brief Query with both clouds in their own frames as given (identity pose). */
   bool compute (CollisionResult& result) { return compute (Eigen::Isometry3d::Identity (), result); }
   /** \brief Query with A moved by a rigid pose: A's point p is tested at T_target_input * p in
-    * B's frame. Hierarchies are reused across calls.
+    * B's frame. Models are reused across calls (see the class comment for when they are
+    * rebuilt). The witness is in the query frame, here the target's (CollisionResult).
     * \return false, with result.status and message set and a PCL_ERROR, when the inputs are
     * unusable (no cloud, no finite point, a non-rigid or non-finite pose). */
   bool compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result);
@@ -109,9 +148,9 @@ public:
     *
     * results[i] is what compute (T_target_input[i], results[i]) gives (timings aside),
     * whatever the thread count, except that a failed pose's message starts with "pose <i>: ".
-    * A bad pose fails alone; the others are still answered. Hierarchies are (re)built once, before the threads
-    * start; with request.enable_timings every result's build_ms is the time this call spent on
-    * them (0 when they were reused), so do not sum it over the results.
+    * A bad pose fails alone; the others are still answered. Models are (re)built once, before
+    * the threads start; with request.enable_timings every result's build_ms is the time this
+    * call spent on them (0 when they were reused), so do not sum it over the results.
     * \param[in] T_target_input rigid poses of A in B's frame, as for compute()
     * \param[out] results resized to T_target_input.size()
     * \param[in] threads worker threads: 0 = std::thread::hardware_concurrency(), never more
@@ -120,10 +159,6 @@ public:
     *         failure otherwise. */
   bool computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input, std::vector<CollisionResult>& results,
                      int threads = 0);
-
-  /** \brief The hierarchies of the last successful compute (null before). */
-  std::shared_ptr<const ProbabilisticBVH> getInputHierarchy () const { return input_bvh_; }
-  std::shared_ptr<const ProbabilisticBVH> getTargetHierarchy () const { return target_bvh_; }
 
   /** \brief Like pcl::Filter::filter, but the output is cleared first, so a failed call never
     * leaves stale points behind. */
@@ -135,53 +170,27 @@ protected:
   using pcl::FilterIndices<PointT>::applyFilter;
 
 private:
-  /** \brief Checks the inputs and (re)builds whatever hierarchy is out of date; false with
-    * result's status and message on bad input. */
+  void markInput () { input_dirty_ = true; }
+  void markTarget () { target_dirty_ = true; }
+  /** \brief Builds whichever model is marked for rebuild; false with result's status and
+    * message on bad input, build_ms set to the time spent. */
   bool prepare (CollisionResult& result);
-  /** \brief prepare() once the inputs are initialised (initCompute). */
-  bool buildHierarchies (CollisionResult& result);
-  /** \brief Whether T_target_input is a finite rotation plus translation; result says why not. */
-  static bool checkPose (const Eigen::Isometry3d& T_target_input, CollisionResult& result);
-  /** \brief Turns collide()'s answer (A's frame, hierarchy order) into compute()'s: the
-    * witness in the target's frame, per-point values on the callers' clouds, skipped points
-    * and, with timings, build_ms. */
+  /** \brief Turns collide()'s answer (A's frame) into compute()'s: the witness in the
+    * target's frame and, with timings, build_ms. */
   void finishResult (const Eigen::Isometry3d& T_target_input, double build_ms, CollisionResult& result) const;
 
   PointCloudConstPtr target_;
   pcl::IndicesConstPtr target_indices_;
   CovarianceCloudConstPtr input_covariances_;
   CovarianceCloudConstPtr target_covariances_;
-  SensorNoiseModel input_noise_;
-  SensorNoiseModel target_noise_;
-  int k_ = 10;
-  bool project_ = true;
+  CloudModelParams input_params_;
+  CloudModelParams target_params_;
   CollisionRequest request_;
   double probability_threshold_ = 0.5;
 
-  /** \brief What a hierarchy was built from: rebuilt when any of it changes. */
-  struct Source
-  {
-    const void* cloud = nullptr;
-    const void* indices = nullptr;
-    const void* covariances = nullptr;
-    int k = 0;
-    BVHParams params;
-    bool operator== (const Source& o) const
-    {
-      return cloud == o.cloud && indices == o.indices && covariances == o.covariances && k == o.k &&
-             params == o.params;
-    }
-  };
-  /** \brief Builds one cloud's uncertain points and hierarchy. */
-  bool buildHierarchy (const PointCloudConstPtr& cloud, const pcl::IndicesConstPtr& indices,
-                       const CovarianceCloudConstPtr& covariances, const SensorNoiseModel& noise,
-                       const char* which, std::shared_ptr<const ProbabilisticBVH>& bvh,
-                       std::size_t& skipped, std::string& message) const;
-
-  Source input_source_, target_source_;
+  CloudModel::ConstPtr input_model_, target_model_;
   bool input_dirty_ = true, target_dirty_ = true;
-  std::shared_ptr<const ProbabilisticBVH> input_bvh_, target_bvh_;
-  std::size_t input_skipped_ = 0, target_skipped_ = 0;
+  bool input_prebuilt_ = false, target_prebuilt_ = false;
   RobustClassifier classifier_;
 };
 } // namespace pcl_probcollision

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/detail/input_checks.h>
 #include <pcl_probcollision/detail/obb.h>
 #include <pcl_probcollision/normal_distribution.h>
 
@@ -22,40 +24,36 @@ namespace pcl_probcollision
 {
 namespace detail
 {
-/** \brief How disjoint box pairs are handled (METHOD.md 8.5). */
-enum class TraversalMode
-{
-  /** \brief At a disjoint pair draw u ~ U[0, 1) from a generator seeded with seed; continue
-    * when u < q = 1 - P_cov(a) P_cov(b). Repeatable for a given seed. */
-  Stochastic,
-  /** \brief Carry a reach weight rho (1 at the roots); rho *= q at a disjoint pair, prune when
-    * rho < rho_min; a leaf pair contributes rho * P_leaf. Deterministic. (Default.) */
-  ExpectedWeight,
-  /** \brief No leakage: boxes grown to expanded_k_sigma point standard deviations (a
-    * conservative bound, see TraversalParams) and only overlapping pairs are opened. */
-  ExpandedBV
-};
-
-/** \brief Traversal parameters with their defaults (METHOD.md 8.7). */
+/** \brief Traversal parameters (METHOD.md 8.7). Their defaults are CollisionRequest's: the
+  * constructor maps a request, the one place where a query's settings become the
+  * traversal's. */
 struct TraversalParams
 {
-  /** \brief Traversal mode; ExpectedWeight by default. */
-  TraversalMode mode = TraversalMode::ExpectedWeight;
+  /** \brief The traversal of `request` (default: CollisionRequest's defaults). */
+  explicit TraversalParams (const CollisionRequest& request = CollisionRequest ())
+    : mode (request.traversal), rho_min (request.rho_min),
+      // In decision mode a contribution above collision_above makes InCollision final (METHOD.md 7).
+      stop_probability (request.collision_above), exhaustive (request.exhaustive), seed (request.seed),
+      expanded_k_sigma (request.expanded_k_sigma)
+  {}
+
+  /** \brief Traversal mode (CollisionRequest::traversal). */
+  TraversalMode mode;
   /** \brief ExpectedWeight: prune a pair whose reach weight drops below this, [0, 1]. With 0
     * nothing is pruned, even pairs of weight 0. */
-  double rho_min = 1e-3;
+  double rho_min;
   /** \brief Stop as soon as one contribution exceeds this (unless exhaustive), [0, 1]. */
-  double stop_probability = 0.5;
+  double stop_probability;
   /** \brief Visit every reachable leaf pair, never stop early. */
-  bool exhaustive = false;
+  bool exhaustive;
   /** \brief Stochastic: seed of the per-call std::mt19937_64. */
-  std::uint64_t seed = 0;
+  std::uint64_t seed;
   /** \brief Extra margin added to every half extent of both boxes in the disjointness test, in
     * all modes (metres, >= 0). */
   double box_margin = 0.0;
   /** \brief ExpandedBV: boxes are grown by (expanded_k_sigma - k_sigma of the build) times the
     * node's largest point standard deviation along each axis (when positive); >= 0. */
-  double expanded_k_sigma = 3.0;
+  double expanded_k_sigma;
   /** \brief Prune any pair whose reach weight cannot beat the current maximum (rho <= max).
     * Same probability, fewer leaf tests; off by default because a leaf test that records
     * contacts then misses some. Assumes the leaf test returns values in [0, 1]. */
@@ -133,19 +131,6 @@ struct TraversalResult
   bool operator!= (const TraversalResult& o) const { return !(*this == o); }
 };
 
-/** \brief Throws pcl::BadArgumentException unless T's linear part is a rotation (1e-6). */
-inline void
-checkRigid (const Eigen::Isometry3d& T, const char* name)
-{
-  const Eigen::Matrix3d R = T.linear ();
-  const double err = (R.transpose () * R - Eigen::Matrix3d::Identity ()).cwiseAbs ().maxCoeff ();
-  if (!(err <= 1e-6) || !(R.determinant () > 0.0) || !T.translation ().allFinite ())
-    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
-                         "[pcl_probcollision::detail::traverseHierarchies] " << name
-                             << " is not a rigid transform (|R^T R - I| = " << err
-                             << ", det R = " << R.determinant () << ")");
-}
-
 /** \brief Simultaneous descent of two hierarchies under a rigid transform (METHOD.md 8.5, 6.3).
   *
   * Hierarchy A stays in its frame; B's boxes are mapped into A's frame by T_a_b on the fly
@@ -185,7 +170,9 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
                      LeafTest&& leaf_test)
 {
   params.validate ();
-  checkRigid (T_a_b, "T_a_b");
+  const std::string pose_error = poseError (T_a_b, "T_a_b");
+  if (!pose_error.empty ())
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::detail::traverseHierarchies] " << pose_error);
   TraversalResult result;
   if (bvh_a.empty () || bvh_b.empty ())
     return result;

@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
-#include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/probabilistic_collision.h>
+#include <pcl_probcollision/detail/input_checks.h>
 
-#include <pcl/common/point_tests.h>
 #include <pcl/exceptions.h>
 
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,12 +27,71 @@ ProbabilisticCollision<PointT>::ProbabilisticCollision ()
 
 template <typename PointT>
 void
+ProbabilisticCollision<PointT>::setInputCloud (const PointCloudConstPtr& cloud)
+{
+  pcl::FilterIndices<PointT>::setInputCloud (cloud);
+  markInput ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setIndices (const pcl::IndicesPtr& indices)
+{
+  pcl::FilterIndices<PointT>::setIndices (indices);
+  markInput ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setIndices (const pcl::IndicesConstPtr& indices)
+{
+  pcl::FilterIndices<PointT>::setIndices (indices);
+  markInput ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setIndices (const pcl::PointIndicesConstPtr& indices)
+{
+  pcl::FilterIndices<PointT>::setIndices (indices);
+  markInput ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setIndices (std::size_t row_start, std::size_t col_start, std::size_t nb_rows,
+                                            std::size_t nb_cols)
+{
+  pcl::FilterIndices<PointT>::setIndices (row_start, col_start, nb_rows, nb_cols);
+  markInput ();
+}
+
+template <typename PointT>
+void
 ProbabilisticCollision<PointT>::setKSearch (int k)
 {
   if (k < 1)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::ProbabilisticCollision::setKSearch] k = " << k << " must be >= 1");
-  k_ = k;
+  input_params_.k = target_params_.k = k;
+  markForRebuild ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setSurfaceProjection (bool project)
+{
+  input_params_.surface_projection = target_params_.surface_projection = project;
+  markForRebuild ();
+}
+
+template <typename PointT>
+void
+ProbabilisticCollision<PointT>::setHierarchyParams (const BVHParams& params)
+{
+  params.validate ();
+  input_params_.hierarchy = target_params_.hierarchy = params;
+  markForRebuild ();
 }
 
 template <typename PointT>
@@ -62,14 +121,6 @@ ProbabilisticCollision<PointT>::setThresholds (double free_below, double collisi
 
 template <typename PointT>
 void
-ProbabilisticCollision<PointT>::setHierarchyParams (const BVHParams& params)
-{
-  params.validate ();
-  request_.hierarchy = params;
-}
-
-template <typename PointT>
-void
 ProbabilisticCollision<PointT>::setProbabilityThreshold (double p)
 {
   if (!(p >= 0.0 && p <= 1.0))
@@ -81,174 +132,46 @@ ProbabilisticCollision<PointT>::setProbabilityThreshold (double p)
 
 template <typename PointT>
 bool
-ProbabilisticCollision<PointT>::buildHierarchy (const PointCloudConstPtr& cloud, const pcl::IndicesConstPtr& indices,
-                                                const CovarianceCloudConstPtr& covariances,
-                                                const SensorNoiseModel& noise, const char* which,
-                                                std::shared_ptr<const ProbabilisticBVH>& bvh,
-                                                std::size_t& skipped, std::string& message) const
-{
-  std::ostringstream err;
-  if (!cloud)
-  {
-    message = std::string ("no ") + which + " cloud given";
-    return false;
-  }
-  if (covariances && covariances->size () != cloud->size ())
-  {
-    err << which << " covariances have " << covariances->size () << " entries for " << cloud->size () << " points";
-    message = err.str ();
-    return false;
-  }
-  for (const int i : indices ? *indices : pcl::Indices ())
-    if (i < 0 || static_cast<std::size_t> (i) >= cloud->size ())
-    {
-      err << which << " index " << i << " outside the cloud of " << cloud->size () << " points";
-      message = err.str ();
-      return false;
-    }
-
-  // Finite but absurd coordinates (beyond 1e15 units) overflow the float arithmetic of the kd-tree:
-  // FLANN's middle split computes (min + max) / 2 = inf for two values above FLT_MAX / 2 and
-  // aborts on an assertion (found by fuzz/fuzz_collide). Refuse them with the point named.
-  {
-    constexpr float kMaxCoordinate = 1e15f;
-    const std::size_t count = indices ? indices->size () : cloud->size ();
-    for (std::size_t j = 0; j < count; ++j)
-    {
-      const int i = indices ? (*indices)[j] : static_cast<int> (j);
-      const PointT& p = (*cloud)[i];
-      if (pcl::isXYZFinite (p) &&
-          !(std::abs (p.x) <= kMaxCoordinate && std::abs (p.y) <= kMaxCoordinate && std::abs (p.z) <= kMaxCoordinate))
-      {
-        err.precision (9);
-        err << which << " point " << i << " at (" << p.x << ", " << p.y << ", " << p.z
-            << ") is beyond the supported coordinate range of +-1e15";
-        message = err.str ();
-        return false;
-      }
-    }
-  }
-
-  // Estimate what the caller did not give: covariances and the neighbour radii (area weights).
-  pcl::PointCloud<Covariance> estimated;
-  std::vector<float> radii;
-  std::vector<Eigen::Vector3d> displacements;
-  if (!covariances)
-  {
-    CovarianceEstimation<PointT> estimation;
-    estimation.setInputCloud (cloud);
-    if (indices)
-      estimation.setIndices (indices);
-    estimation.setKSearch (k_);
-    estimation.setSensorNoise (noise);
-    estimation.setSurfaceProjection (project_);
-    estimation.compute (estimated);
-    radii = estimation.getNeighbourRadii ();
-    displacements = estimation.getSurfaceDisplacements ();
-  }
-
-  UncertainCloud points;
-  skipped = 0;
-  const std::size_t n = indices ? indices->size () : cloud->size ();
-  points.means.reserve (n);
-  points.covariances.reserve (n);
-  points.source_indices.reserve (n);
-  if (!radii.empty ())
-    points.area_weights.reserve (n);
-  for (std::size_t j = 0; j < n; ++j)
-  {
-    const int i = indices ? (*indices)[j] : static_cast<int> (j);
-    const PointT& p = (*cloud)[i];
-    const Covariance& c = covariances ? (*covariances)[i] : (estimated.size () == n ? estimated[j] : Covariance::nan ());
-    if (!pcl::isXYZFinite (p) || !c.isFinite ())
-    {
-      ++skipped;
-      continue;
-    }
-    points.means.emplace_back (p.getVector3fMap ().template cast<double> ());
-    if (!displacements.empty ())
-      points.means.back () += displacements[j];
-    points.covariances.push_back (c.matrix ());
-    points.source_indices.push_back (i);
-    if (!radii.empty ())
-      points.area_weights.push_back (static_cast<double> (radii[j]) * radii[j]);
-  }
-  if (points.empty ())
-  {
-    err << which << " cloud has no finite point (" << n << " given, " << skipped << " non-finite)";
-    message = err.str ();
-    return false;
-  }
-  auto built = std::make_shared<ProbabilisticBVH> ();
-  built->build (std::move (points), request_.hierarchy);  // no copy of the cloud
-  bvh = built;
-  return true;
-}
-
-template <typename PointT>
-bool
 ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
 {
-  if (!this->input_)
-    result.message = "no input cloud given (setInputCloud)";
-  else if (!pcl::PCLBase<PointT>::initCompute ())
-    result.message = "input cloud or indices unusable";
-  else
-  {
-    const bool built = buildHierarchies (result);
-    this->deinitCompute ();
-    if (built)
-      return true;
-  }
-  result.status = CollisionResult::Status::InvalidInput;
-  return false;
-}
-
-template <typename PointT>
-bool
-ProbabilisticCollision<PointT>::buildHierarchies (CollisionResult& result)
-{
   const auto start = std::chrono::steady_clock::now ();
-  std::string message;
-  Source input_now {this->input_.get (), this->indices_.get (), input_covariances_.get (), k_, request_.hierarchy};
-  Source target_now {target_.get (), target_indices_.get (), target_covariances_.get (), k_, request_.hierarchy};
-  // PCLBase replaces missing indices by "all points" with a fresh vector each time; compare
-  // against what the user set.
-  if (!this->use_indices_)
-    input_now.indices = nullptr;
   bool built = false;
-  try
-  {
-    if (input_dirty_ || !input_bvh_ || !(input_now == input_source_))
+  auto build = [&] (const PointCloudConstPtr& cloud, const pcl::IndicesConstPtr& indices,
+                    const CovarianceCloudConstPtr& covariances, const CloudModelParams& params, const char* which,
+                    CloudModel::ConstPtr& model, bool& dirty) {
+    if (!dirty && model)
+      return true;
+    model.reset ();
+    if (!cloud)
     {
-      input_bvh_.reset ();
-      if (!buildHierarchy (this->input_, this->use_indices_ ? this->indices_ : pcl::IndicesConstPtr (),
-                           input_covariances_, input_noise_, "input", input_bvh_, input_skipped_, message))
-      {
-        result.message = message;
-        return false;
-      }
-      input_source_ = input_now;
-      input_dirty_ = false;
-      built = true;
+      result.message = std::string ("no ") + which + " cloud given (" +
+                       (which == std::string ("input") ? "setInputCloud" : "setTargetCloud") + ")";
+      return false;
     }
-    if (target_dirty_ || !target_bvh_ || !(target_now == target_source_))
+    try
     {
-      target_bvh_.reset ();
-      if (!buildHierarchy (target_, target_indices_, target_covariances_, target_noise_, "target", target_bvh_,
-                           target_skipped_, message))
-      {
-        result.message = message;
-        return false;
-      }
-      target_source_ = target_now;
-      target_dirty_ = false;
-      built = true;
+      model = buildCloudModel (*cloud, params, indices.get (), covariances.get (), which);
     }
-  }
-  catch (const pcl::PCLException& e)
+    catch (const pcl::PCLException& e)
+    {
+      result.message = errorMessage (e);
+      return false;
+    }
+    dirty = false;
+    built = true;
+    return true;
+  };
+  // PCLBase replaces missing indices by "all points": pass only what the user set.
+  const pcl::IndicesConstPtr input_indices = this->use_indices_ ? pcl::IndicesConstPtr (this->indices_) : nullptr;
+  const bool ok = (input_prebuilt_ ||
+                   build (this->input_, input_indices, input_covariances_, input_params_, "input", input_model_,
+                          input_dirty_)) &&
+                  (target_prebuilt_ ||
+                   build (target_, target_indices_, target_covariances_, target_params_, "target", target_model_,
+                          target_dirty_));
+  if (!ok)
   {
-    result.message = e.what ();
+    result.status = CollisionResult::Status::InvalidInput;
     return false;
   }
   result.build_ms = built ? std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count () : 0.0;
@@ -256,41 +179,16 @@ ProbabilisticCollision<PointT>::buildHierarchies (CollisionResult& result)
 }
 
 template <typename PointT>
-bool
-ProbabilisticCollision<PointT>::checkPose (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
-{
-  const Eigen::Matrix3d R = T_target_input.linear ();
-  if (T_target_input.matrix ().allFinite () && (R.transpose () * R).isIdentity (1e-6) && R.determinant () >= 0.0)
-    return true;
-  result.message = "pose T_target_input is not a finite rotation plus translation";
-  return false;
-}
-
-template <typename PointT>
 void
 ProbabilisticCollision<PointT>::finishResult (const Eigen::Isometry3d& T_target_input, double build_ms,
                                               CollisionResult& result) const
 {
-  result.points_skipped_nonfinite = input_skipped_ + target_skipped_;
-  if (request_.enable_timings)
-    result.build_ms = build_ms;
-  // Report the witness in the target's frame, where the pose puts A.
+  result.build_ms = request_.enable_timings ? build_ms : std::numeric_limits<double>::quiet_NaN ();
+  // collide() answers in its query frame, A's; compute()'s query frame is the target's.
   if (result.witness_side != 0)
   {
     result.witness_point = T_target_input * result.witness_point;
     result.witness_normal = T_target_input.linear () * result.witness_normal;
-  }
-  // Per-point values: from hierarchy order to the caller's clouds.
-  if (request_.per_point)
-  {
-    auto scatter = [] (const std::vector<float>& in, const ProbabilisticBVH& bvh, std::size_t size) {
-      std::vector<float> out (size, std::numeric_limits<float>::quiet_NaN ());
-      for (std::size_t j = 0; j < in.size (); ++j)
-        out[bvh.sourceIndex (static_cast<int> (j))] = in[j];
-      return out;
-    };
-    result.probabilities_a = scatter (result.probabilities_a, *input_bvh_, this->input_->size ());
-    result.probabilities_b = scatter (result.probabilities_b, *target_bvh_, target_->size ());
   }
 }
 
@@ -299,11 +197,12 @@ bool
 ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input, CollisionResult& result)
 {
   result = CollisionResult ();
-  if (checkPose (T_target_input, result) && prepare (result))
+  result.message = detail::poseError (T_target_input, "T_target_input");
+  if (result.message.empty () && prepare (result))
   {
     const double build_ms = result.build_ms;
     // collide() works in A's frame: B is mapped there by the inverse pose.
-    if (collide (*input_bvh_, *target_bvh_, T_target_input.inverse (), request_, result, &classifier_))
+    if (collide (*input_model_, *target_model_, T_target_input.inverse (), request_, result, &classifier_))
     {
       finishResult (T_target_input, build_ms, result);
       return true;
@@ -328,11 +227,14 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
   std::vector<std::size_t> posed;
   std::vector<Eigen::Isometry3d> T_input_target;
   for (std::size_t i = 0; i < count; ++i)
-    if (checkPose (T_target_input[i], results[i]))
+  {
+    results[i].message = detail::poseError (T_target_input[i], "T_target_input");
+    if (results[i].message.empty ())
     {
       posed.push_back (i);
       T_input_target.push_back (T_target_input[i].inverse ());
     }
+  }
   // Like compute(), build only when some pose gets that far; every such pose shares the outcome.
   CollisionResult prepared;
   if (!posed.empty ())
@@ -340,7 +242,7 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
     if (prepare (prepared))
     {
       std::vector<CollisionResult> answers;
-      collideBatch (*input_bvh_, *target_bvh_, T_input_target, request_, answers, threads, &classifier_);
+      collideBatch (*input_model_, *target_model_, T_input_target, request_, answers, threads, &classifier_);
       for (std::size_t k = 0; k < posed.size (); ++k)
         results[posed[k]] = std::move (answers[k]);
     }
@@ -384,6 +286,13 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
     return;  // compute() printed the error; the output stays empty
 
   const std::vector<float>& p = result.probabilities_a;
+  if (p.size () != this->input_->size ())
+  {
+    PCL_ERROR ("[pcl_probcollision::%s::applyFilter] the input model was built from a cloud of %zu points, the "
+               "input cloud has %zu\n",
+               this->getClassName ().c_str (), p.size (), this->input_->size ());
+    return;
+  }
   const pcl::Indices& candidates = *this->indices_;
   indices.reserve (candidates.size ());
   for (const int i : candidates)

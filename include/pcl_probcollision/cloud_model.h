@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/point_types.h>
+#include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/sensor_noise.h>
+#include <pcl_probcollision/uncertain_points.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/types.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+namespace pcl_probcollision
+{
+/** \brief How a CloudModel is built from a point cloud: the per-cloud settings, with their
+  * defaults. The query's settings are in CollisionRequest.
+  *
+  * Which noise model to choose: the library's default is none, so that covariances come from
+  * the sampling alone (the k-nearest-neighbour spread) and a cloud whose points are exact
+  * (a mesh sample, a CAD model) stays exact. Sensor data needs its sensor's model:
+  * SensorNoiseModel::kinect(), stereo() or lidar() when the cloud carries its viewpoint
+  * (sensor_origin_), isotropic(sigma) with the sensor's depth noise otherwise. pcd_collision
+  * defaults to isotropic 5 mm instead because its inputs are files of unknown origin, mostly
+  * scans, where assuming no noise would make near-contact answers overconfident (docs/CLI.md).
+  */
+struct CloudModelParams
+{
+  /** \brief Neighbours of the covariance estimation (Pauly et al.), >= 1. Default 10. */
+  int k = 10;
+  /** \brief Sensor noise added to the estimated covariances. Default none (see above). */
+  SensorNoiseModel noise;
+  /** \brief Locally denoised point positions (CovarianceEstimation::setSurfaceProjection).
+    * Default on, chosen by the evaluation (docs/RESULTS.md). Off gives the paper's model:
+    * every point at its measured position with its full noise and discretisation spread,
+    * whose maximum over many points near contact drifts toward 1. No effect without a noise
+    * model or with covariances given by the caller. */
+  bool surface_projection = true;
+  /** \brief The hierarchy built over the points (BVHParams' defaults). */
+  BVHParams hierarchy;
+
+  /** \brief Throws pcl::BadArgumentException naming the first member out of range. */
+  void validate () const;
+};
+
+class CloudModel;
+
+/** \brief Builds the model of the object sampled by a PCL cloud: covariances estimated
+  * (CovarianceEstimation with params.k, params.noise and params.surface_projection) unless
+  * given, non-finite points skipped, the hierarchy built in the local frame (CloudModel).
+  *
+  * \param[in] cloud the points (only x, y, z are read, and the viewpoint for the depth noise
+  *            models); read during the call only
+  * \param[in] params per-cloud settings (validated)
+  * \param[in] indices the points to use (all when null)
+  * \param[in] covariances covariances index-aligned with the whole cloud (estimated when null);
+  *            a non-finite one drops its point
+  * \param[in] name what error messages call the cloud ("input", "target", a file name)
+  * \return the model
+  * \throws pcl::BadArgumentException, its message starting with name, for invalid params,
+  *         covariances of the wrong size, an index outside the cloud, a coordinate beyond
+  *         +-1e15, or no finite point. A PCL warning (PCL_WARN) accompanies warning(). */
+template <typename PointT>
+std::shared_ptr<const CloudModel>
+buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params = CloudModelParams (),
+                 const pcl::Indices* indices = nullptr, const pcl::PointCloud<Covariance>* covariances = nullptr,
+                 const std::string& name = "cloud");
+/** \brief The model of one object known from a point cloud: its uncertain points (one
+  * Gaussian each) and their epsilon-overlap hierarchy, built once and then immutable.
+  *
+  * Build it with buildCloudModel() from a PCL cloud, or from points with covariances you
+  * already have. Query two models with collide (a, b, T_a_b, request, result). A model can be
+  * shared by any number of queries and threads (share it as ConstPtr).
+  *
+  * Local frame: the points are stored and the hierarchy is built about the points' centroid,
+  * kept in double as origin(). Single-precision coordinates far from the origin (a map frame,
+  * UTM) then lose nothing in the arithmetic of the query: the query composes the pose with the
+  * two origins in double (collide()). Everything the model reports to a caller (witness
+  * points, origin()) is in the cloud's own frame; hierarchy() and its boxes are in the local
+  * frame, cloud frame = local frame + origin().
+  *
+  * A model never sees the cloud again after its build: a cloud changed afterwards (e.g. by
+  * pcl::transformPointCloud in place) needs a new model.
+  */
+class CloudModel
+{
+public:
+  /** \brief Shared pointer to a model. */
+  using Ptr = std::shared_ptr<CloudModel>;
+  /** \brief Shared pointer to a const model (what queries share). */
+  using ConstPtr = std::shared_ptr<const CloudModel>;
+
+  /** \brief Builds the model from points with covariances, in the cloud's frame.
+    * \param[in] points means, covariances, optional area weights and source indices; taken over
+    * \param[in] hierarchy hierarchy parameters (validated)
+    * \param[in] source_size size of the caller's cloud the source indices refer to (per-point
+    *            results are index-aligned with it); 0 means points.size() (or one past the
+    *            largest source index, when there are any)
+    * \throws pcl::BadArgumentException for invalid parameters, sizes that disagree or
+    *         non-finite values (ProbabilisticBVH::build), or no point at all. */
+  explicit CloudModel (UncertainCloud points, const BVHParams& hierarchy = BVHParams (), std::size_t source_size = 0);
+
+  /** \brief The hierarchy, in the local frame (cloud frame = local + origin()). */
+  const ProbabilisticBVH& hierarchy () const { return bvh_; }
+  /** \brief The local frame's origin in the cloud's frame: the centroid of the points. */
+  const Eigen::Vector3d& origin () const { return origin_; }
+  /** \brief Number of points in the model (finite points of the cloud, within its indices). */
+  std::size_t size () const { return bvh_.size (); }
+  /** \brief Size of the caller's cloud: per-point results are index-aligned with it. */
+  std::size_t sourceSize () const { return source_size_; }
+  /** \brief Points of the cloud (within its indices) left out as non-finite. */
+  std::size_t skippedPoints () const { return skipped_; }
+  /** \brief The settings the model was built with (defaults but for the hierarchy when built
+    * from points directly). */
+  const CloudModelParams& params () const { return params_; }
+  /** \brief Wall time of the build in milliseconds: covariance estimation and hierarchy. */
+  double buildMilliseconds () const { return build_ms_; }
+  /** \brief Memory held in bytes (the hierarchy and its points). */
+  std::size_t bytes () const { return bvh_.bytes (); }
+  /** \brief A warning about the input, empty when there is none: today, coordinates so far
+    * from the origin that their float spacing exceeds a tenth of the points' typical standard
+    * deviation (the input itself has then lost precision; the model cannot restore it).
+    * collide() passes it on in CollisionResult::message. */
+  const std::string& warning () const { return warning_; }
+
+  /** \brief Float spacing (one ulp) at the largest coordinate magnitude of the cloud divided by
+    * the points' typical standard deviation (median over points of sqrt(trace / 3)); warning()
+    * is set above kPrecisionWarningRatio. */
+  double precisionRatio () const { return precision_ratio_; }
+  /** \brief The ratio above which warning() is set: the input's float spacing above a tenth of
+    * the points' standard deviation. */
+  static constexpr double kPrecisionWarningRatio = 0.1;
+
+private:
+  CloudModel () = default;
+  /** \brief Centres the points on their centroid (origin()) and builds the hierarchy there. */
+  void buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size);
+
+  template <typename PointT>
+  friend std::shared_ptr<const CloudModel>
+  buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
+                   const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
+                   const std::string& name);
+  /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
+  void assessPrecision (double max_abs_coordinate, const std::string& name);
+
+  ProbabilisticBVH bvh_;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero ();
+  std::size_t source_size_ = 0;
+  std::size_t skipped_ = 0;
+  CloudModelParams params_;
+  double build_ms_ = 0.0;
+  double precision_ratio_ = 0.0;
+  std::string warning_;
+};
+
+} // namespace pcl_probcollision
+
+#ifdef PCL_NO_PRECOMPILE
+#include <pcl_probcollision/impl/cloud_model.hpp>
+#endif

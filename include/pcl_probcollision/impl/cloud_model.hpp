@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/detail/input_checks.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/console/print.h>
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+namespace pcl_probcollision
+{
+template <typename PointT>
+std::shared_ptr<const CloudModel>
+buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
+                 const pcl::PointCloud<Covariance>* covariances, const std::string& name)
+{
+  const auto start = std::chrono::steady_clock::now ();
+  params.validate ();
+  std::ostringstream err;
+  if (covariances && covariances->size () != cloud.size ())
+  {
+    err << name << " covariances have " << covariances->size () << " entries for " << cloud.size () << " points";
+    throw pcl::BadArgumentException (err.str ());
+  }
+  if (indices)
+    for (const int i : *indices)
+      if (i < 0 || static_cast<std::size_t> (i) >= cloud.size ())
+      {
+        err << name << " index " << i << " outside the cloud of " << cloud.size () << " points";
+        throw pcl::BadArgumentException (err.str ());
+      }
+  const std::size_t n = indices ? indices->size () : cloud.size ();
+  auto at = [&] (std::size_t j) { return indices ? (*indices)[j] : static_cast<int> (j); };
+
+  // Finite but absurd coordinates overflow the float arithmetic of the k-d tree (FLANN's middle
+  // split computes (min + max) / 2 = inf; found by fuzz/fuzz_collide): refuse them by name.
+  float max_abs = 0.0f;
+  for (std::size_t j = 0; j < n; ++j)
+  {
+    const PointT& p = cloud[at (j)];
+    if (!pcl::isXYZFinite (p))
+      continue;
+    const float m = std::max ({std::abs (p.x), std::abs (p.y), std::abs (p.z)});
+    if (!(m <= static_cast<float> (detail::kMaxCoordinate)))
+    {
+      err.precision (9);
+      err << name << " point " << at (j) << " at (" << p.x << ", " << p.y << ", " << p.z
+          << ") is beyond the supported coordinate range of +-1e15";
+      throw pcl::BadArgumentException (err.str ());
+    }
+    max_abs = std::max (max_abs, m);
+  }
+
+  // Estimate what the caller did not give: covariances, neighbour radii (area weights) and the
+  // surface displacements. The estimation reads the cloud through a non-owning pointer: it is
+  // used only during this call.
+  pcl::PointCloud<Covariance> estimated;
+  std::vector<float> radii;
+  std::vector<Eigen::Vector3d> displacements;
+  if (!covariances)
+  {
+    const typename pcl::PointCloud<PointT>::ConstPtr view (&cloud, [] (const pcl::PointCloud<PointT>*) {});
+    CovarianceEstimation<PointT> estimation;
+    estimation.setInputCloud (view);
+    if (indices)
+      estimation.setIndices (pcl::IndicesConstPtr (indices, [] (const pcl::Indices*) {}));
+    estimation.setKSearch (params.k);
+    estimation.setSensorNoise (params.noise);
+    estimation.setSurfaceProjection (params.surface_projection);
+    estimation.compute (estimated);
+    radii = estimation.getNeighbourRadii ();
+    displacements = estimation.getSurfaceDisplacements ();
+  }
+
+  UncertainCloud points;
+  std::size_t skipped = 0;
+  points.means.reserve (n);
+  points.covariances.reserve (n);
+  points.source_indices.reserve (n);
+  if (!radii.empty ())
+    points.area_weights.reserve (n);
+  for (std::size_t j = 0; j < n; ++j)
+  {
+    const int i = at (j);
+    const PointT& p = cloud[i];
+    const Covariance& c = covariances ? (*covariances)[i] : (estimated.size () == n ? estimated[j] : Covariance::nan ());
+    if (!pcl::isXYZFinite (p) || !c.isFinite ())
+    {
+      ++skipped;
+      continue;
+    }
+    points.means.emplace_back (p.getVector3fMap ().template cast<double> ());
+    if (!displacements.empty ())
+      points.means.back () += displacements[j];
+    points.covariances.push_back (c.matrix ());
+    points.source_indices.push_back (i);
+    if (!radii.empty ())
+      points.area_weights.push_back (static_cast<double> (radii[j]) * radii[j]);
+  }
+  if (points.empty ())
+  {
+    err << name << " cloud has no finite point (" << n << " given, " << skipped << " non-finite)";
+    throw pcl::BadArgumentException (err.str ());
+  }
+
+  std::shared_ptr<CloudModel> model (new CloudModel);
+  model->buildLocal (std::move (points), params.hierarchy, cloud.size ());
+  model->params_ = params;
+  model->skipped_ = skipped;
+  model->assessPrecision (max_abs, name);
+  model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+  if (!model->warning_.empty ())
+    PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", model->warning_.c_str ());
+  return model;
+}
+} // namespace pcl_probcollision
+
+#define PCL_INSTANTIATE_buildCloudModel(T)                                                                   \
+  template PCL_EXPORTS std::shared_ptr<const pcl_probcollision::CloudModel> pcl_probcollision::buildCloudModel<T> ( \
+      const pcl::PointCloud<T>&, const pcl_probcollision::CloudModelParams&, const pcl::Indices*,                 \
+      const pcl::PointCloud<pcl_probcollision::Covariance>*, const std::string&);

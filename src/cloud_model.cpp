@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/impl/cloud_model.hpp>
+
+#include <pcl/exceptions.h>
+#include <pcl/impl/instantiate.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace pcl_probcollision
+{
+void
+CloudModelParams::validate () const
+{
+  if (k < 1)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::CloudModelParams::validate] k = " << k << " must be >= 1");
+  hierarchy.validate ();
+}
+
+CloudModel::CloudModel (UncertainCloud points, const BVHParams& hierarchy, std::size_t source_size)
+{
+  if (points.empty ())
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CloudModel] no point given");
+  params_.hierarchy = hierarchy;
+  buildLocal (std::move (points), hierarchy, source_size);
+  build_ms_ = bvh_.buildMilliseconds ();
+}
+
+void
+CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size)
+{
+  if (source_size == 0)
+  {
+    source_size = points.size ();
+    for (const int i : points.source_indices)
+      source_size = std::max (source_size, static_cast<std::size_t> (std::max (i, 0)) + 1);
+  }
+  // The centroid is the local origin; means are validated by the hierarchy's build, so a
+  // non-finite one is reported there (the centroid is then unused).
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero ();
+  for (const Eigen::Vector3d& m : points.means)
+    sum += m;
+  const Eigen::Vector3d centroid = sum / static_cast<double> (points.size ());
+  if (centroid.allFinite ())
+  {
+    for (Eigen::Vector3d& m : points.means)
+      m -= centroid;
+    origin_ = centroid;
+  }
+  bvh_.build (std::move (points), hierarchy);
+  source_size_ = source_size;
+}
+
+void
+CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
+{
+  // The points' typical standard deviation: median of sqrt(trace / 3) over up to ~1000 points.
+  const std::vector<PackedCovariance>& covs = bvh_.covariances ();
+  const std::size_t stride = std::max<std::size_t> (1, covs.size () / 1000);
+  std::vector<double> sigmas;
+  for (std::size_t i = 0; i < covs.size (); i += stride)
+    sigmas.push_back (std::sqrt (std::max (0.0, (covs[i].xx + covs[i].yy + covs[i].zz) / 3.0)));
+  std::nth_element (sigmas.begin (), sigmas.begin () + sigmas.size () / 2, sigmas.end ());
+  const double sigma = sigmas.empty () ? 0.0 : sigmas[sigmas.size () / 2];
+  const float top = static_cast<float> (max_abs_coordinate);
+  const double spacing = static_cast<double> (std::nextafter (top, std::numeric_limits<float>::infinity ()) - top);
+  // Exact points (no spread at all) have no noise to compare the spacing with.
+  precision_ratio_ = sigma > 0.0 ? spacing / sigma : 0.0;
+  warning_.clear ();
+  if (precision_ratio_ > kPrecisionWarningRatio)
+  {
+    std::ostringstream out;
+    out.precision (3);
+    out << name << " cloud: coordinates up to " << max_abs_coordinate << " have a float spacing of " << spacing
+        << ", more than a tenth of the points' typical standard deviation " << sigma
+        << ": the input lost precision before the library saw it (store the cloud about a local origin)";
+    warning_ = out.str ();
+  }
+}
+} // namespace pcl_probcollision
+
+#ifndef PCL_NO_PRECOMPILE
+PCL_INSTANTIATE (buildCloudModel, PCL_PROBCOLLISION_POINT_TYPES)
+#endif
