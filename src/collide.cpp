@@ -4,6 +4,8 @@
 #include <pcl_probcollision/detail/bvh_traversal.h>
 #include <pcl_probcollision/detail/input_checks.h>
 
+#include "leaf_pair_test.h"
+
 #include <pcl/exceptions.h>
 
 #include <algorithm>
@@ -28,18 +30,9 @@ fail (CollisionResult& result, CollisionResult::Status status, const std::string
   result.probability = std::numeric_limits<double>::quiet_NaN ();
 }
 
-// Keeps the larger of a stored per-point value and a new one; NaN means "not reached yet".
-void
-keepMax (float& slot, double value)
-{
-  const float v = static_cast<float> (value);
-  if (std::isnan (slot) || v > slot)
-    slot = v;
-}
-
 /** \brief collide() on the two hierarchies, B mapped into A's local frame by T_a_b; the
-  * request is valid and the pose rigid. Witness in A's local frame, per-point values in
-  * hierarchy order. */
+  * request is valid and the pose rigid. Traversal (detail/bvh_traversal.h) with the leaf-pair
+  * test (leaf_pair_test.h). Witness in A's local frame, per-point values in hierarchy order. */
 bool
 collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
               const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
@@ -57,88 +50,7 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
 
   result.points_a = a.size ();
   result.points_b = b.size ();
-  if (request.per_point)
-  {
-    result.probabilities_a.assign (a.size (), kNotReached);
-    result.probabilities_b.assign (b.size (), kNotReached);
-  }
-
-  std::vector<Eigen::Vector3d> means_a, means_b;
-  std::vector<Eigen::Matrix3d> covs_a, covs_b;
-  ClassifierResult leaf;
-  double best = -1.0;
-  std::string failure;
-  std::size_t failures = 0;
-  // Fits one leaf pair with the given kernel mode; false (failure noted) when it has no usable
-  // separator.
-  auto fit = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel) {
-    const PointSetView view_a = a.gatherPoints (leaf_a, means_a, covs_a);
-    const PointSetView view_b = b.gatherPoints (leaf_b, T_a_b, means_b, covs_b);
-    if (classifier->classify (view_a, view_b, leaf, kernel))
-      return true;
-    if (failure.empty ())
-      failure = leaf.message;
-    ++failures;
-    return false;
-  };
-  // Takes the fit in `leaf` into the result: counters, per-point values, maximum and witness.
-  auto record = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
-    ++result.leaf_pairs_tested;
-    result.classifier_iterations += static_cast<std::size_t> (leaf.iterations);
-    result.kernel_leaf_pairs += leaf.rung == Rung::RFF || leaf.rung == Rung::RFFLarge ? 1 : 0;
-    result.degenerate_leaf_pairs += leaf.degenerate ? 1 : 0;
-    const auto span_a = a.indices (leaf_a);
-    const auto span_b = b.indices (leaf_b);
-    if (request.per_point)
-    {
-      for (std::size_t i = 0; i < span_a.size; ++i)
-        keepMax (result.probabilities_a[span_a[i]], rho * leaf.probabilities_a[i]);
-      for (std::size_t j = 0; j < span_b.size; ++j)
-        keepMax (result.probabilities_b[span_b[j]], rho * leaf.probabilities_b[j]);
-    }
-    const double contribution = rho * leaf.probability;
-    if (contribution > best)
-    {
-      best = contribution;
-      const bool on_a = leaf.witness_side > 0;
-      const int local = on_a ? span_a[leaf.witness_index] : span_b[leaf.witness_index];
-      result.witness_side = on_a ? 1 : -1;
-      result.witness_index = (on_a ? a : b).sourceIndex (local);
-      result.witness_point = on_a ? means_a[leaf.witness_index] : means_b[leaf.witness_index];
-      result.witness_normal = leaf.witness_normal;
-    }
-    return contribution;
-  };
-
-  // request.defer_kernel_fits: the Ladder's kernel rungs cost a hundred planes. The traversal
-  // fits the plane of every leaf pair it reaches; a pair whose plane asks for a kernel rung
-  // (RobustClassifier::needsKernel) is set aside, contributing nothing yet, and fitted in full
-  // afterwards, largest reach weight first, unless the maximum by then makes it irrelevant.
-  // Every pair fitted ends with the fit of a direct Ladder classify(), so without an early stop
-  // the maximum is the same; with one (P > collision_above, a lower bound either way) the
-  // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
-  // below the default's.
-  struct Deferred
-  {
-    const ProbabilisticBVH::Node* a;
-    const ProbabilisticBVH::Node* b;
-    double rho;
-  };
-  // Per-point values need every pair's final fit in traversal order: no deferral there.
-  const bool lazy_kernel = request.defer_kernel_fits && !request.per_point &&
-                           classifier->getParams ().kernel == KernelMode::Ladder;
-  std::vector<Deferred> deferred;
-  auto leaf_test = [&] (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho) {
-    if (!fit (leaf_a, leaf_b, lazy_kernel ? KernelMode::Linear : classifier->getParams ().kernel))
-      return std::numeric_limits<double>::quiet_NaN ();
-    if (lazy_kernel && classifier->needsKernel (leaf))
-    {
-      deferred.push_back ({&leaf_a, &leaf_b, rho});
-      return 0.0;
-    }
-    record (leaf_a, leaf_b, rho);
-    return leaf.probability;
-  };
+  detail::LeafPairTest leaf_test (a, b, T_a_b, request, *classifier, result);
 
   detail::TraversalParams params (request);
   // A pair whose reach weight is at most the maximum so far cannot raise it (its contribution
@@ -156,34 +68,20 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
     return false;
   }
   bool stopped = traversal.lower_bound;
-  if (!stopped && !deferred.empty ())
-  {
-    std::stable_sort (deferred.begin (), deferred.end (),
-                      [] (const Deferred& x, const Deferred& y) { return x.rho > y.rho; });
-    for (const Deferred& d : deferred)
-    {
-      if (params.skip_dominated && d.rho <= best)
-        break;  // sorted: every later pair is dominated too
-      if (!fit (*d.a, *d.b, KernelMode::Ladder))
-        continue;
-      if (record (*d.a, *d.b, d.rho) > params.stop_probability && !params.exhaustive)
-      {
-        stopped = true;
-        break;
-      }
-    }
-  }
+  if (!stopped)
+    stopped = leaf_test.finishDeferred (params.stop_probability, params.exhaustive, params.skip_dominated);
   result.bv_tests = traversal.node_pairs_tested;
-  if (failures > 0)
+  if (leaf_test.failures () > 0)
   {
     // A leaf pair without a usable separator would make the maximum a guess: report it.
     fail (result, CollisionResult::Status::NumericalFailure,
-          "classifier failed on " + std::to_string (failures) + " leaf pair(s): " + failure);
+          "classifier failed on " + std::to_string (leaf_test.failures ()) + " leaf pair(s): " +
+              leaf_test.firstFailure ());
     return false;
   }
   result.status = CollisionResult::Status::Ok;
   // The traversal's maximum counted set-aside pairs as 0; best holds every recorded pair.
-  result.probability = std::max (traversal.probability, best);
+  result.probability = std::max (traversal.probability, leaf_test.best ());
   result.lower_bound = stopped;
   result.no_leaf_tested = traversal.no_leaf_tested;
   if (result.no_leaf_tested)

@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "leaf_pair_test.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+namespace
+{
+// Keeps the larger of a stored per-point value and a new one; NaN means "not reached yet".
+void
+keepMax (float& slot, double value)
+{
+  const float v = static_cast<float> (value);
+  if (std::isnan (slot) || v > slot)
+    slot = v;
+}
+} // namespace
+
+LeafPairTest::LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
+                            const CollisionRequest& request, const RobustClassifier& classifier,
+                            CollisionResult& result)
+  : a_ (a), b_ (b), T_a_b_ (T_a_b), request_ (request), classifier_ (classifier), result_ (result)
+{
+  // request.defer_kernel_fits: the Ladder's kernel rungs cost a hundred planes. The traversal
+  // fits the plane of every leaf pair it reaches; a pair whose plane asks for a kernel rung
+  // (RobustClassifier::needsKernel) is set aside, contributing nothing yet, and fitted in full
+  // afterwards, largest reach weight first, unless the maximum by then makes it irrelevant.
+  // Every pair fitted ends with the fit of a direct Ladder classify(), so without an early stop
+  // the maximum is the same; with one (P > collision_above, a lower bound either way) the
+  // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
+  // below the default's.
+  lazy_kernel_ = request.defer_kernel_fits && !request.per_point && classifier.getParams ().kernel == KernelMode::Ladder;
+  if (request.per_point)
+  {
+    constexpr float kNotReached = std::numeric_limits<float>::quiet_NaN ();
+    result.probabilities_a.assign (a.size (), kNotReached);
+    result.probabilities_b.assign (b.size (), kNotReached);
+  }
+}
+
+bool
+LeafPairTest::fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel)
+{
+  const PointSetView view_a = a_.gatherPoints (leaf_a, means_a_, covs_a_);
+  const PointSetView view_b = b_.gatherPoints (leaf_b, T_a_b_, means_b_, covs_b_);
+  if (classifier_.classify (view_a, view_b, leaf_, kernel))
+    return true;
+  if (failure_.empty ())
+    failure_ = leaf_.message;
+  ++failures_;
+  return false;
+}
+
+double
+LeafPairTest::record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho)
+{
+  CollisionResult& result = result_;
+  ++result.leaf_pairs_tested;
+  result.classifier_iterations += static_cast<std::size_t> (leaf_.iterations);
+  result.kernel_leaf_pairs += leaf_.rung == Rung::RFF || leaf_.rung == Rung::RFFLarge ? 1 : 0;
+  result.degenerate_leaf_pairs += leaf_.degenerate ? 1 : 0;
+  const auto span_a = a_.indices (leaf_a);
+  const auto span_b = b_.indices (leaf_b);
+  if (request_.per_point)
+  {
+    for (std::size_t i = 0; i < span_a.size; ++i)
+      keepMax (result.probabilities_a[span_a[i]], rho * leaf_.probabilities_a[i]);
+    for (std::size_t j = 0; j < span_b.size; ++j)
+      keepMax (result.probabilities_b[span_b[j]], rho * leaf_.probabilities_b[j]);
+  }
+  const double contribution = rho * leaf_.probability;
+  if (contribution > best_)
+  {
+    best_ = contribution;
+    const bool on_a = leaf_.witness_side > 0;
+    const int local = on_a ? span_a[leaf_.witness_index] : span_b[leaf_.witness_index];
+    result.witness_side = on_a ? 1 : -1;
+    result.witness_index = (on_a ? a_ : b_).sourceIndex (local);
+    result.witness_point = on_a ? means_a_[leaf_.witness_index] : means_b_[leaf_.witness_index];
+    result.witness_normal = leaf_.witness_normal;
+  }
+  return contribution;
+}
+
+double
+LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho)
+{
+  if (!fit (leaf_a, leaf_b, lazy_kernel_ ? KernelMode::Linear : classifier_.getParams ().kernel))
+    return std::numeric_limits<double>::quiet_NaN ();
+  if (lazy_kernel_ && classifier_.needsKernel (leaf_))
+  {
+    deferred_.push_back ({&leaf_a, &leaf_b, rho});
+    return 0.0;
+  }
+  record (leaf_a, leaf_b, rho);
+  return leaf_.probability;
+}
+
+bool
+LeafPairTest::finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated)
+{
+  std::stable_sort (deferred_.begin (), deferred_.end (),
+                    [] (const Deferred& x, const Deferred& y) { return x.rho > y.rho; });
+  for (const Deferred& d : deferred_)
+  {
+    if (skip_dominated && d.rho <= best_)
+      break;  // sorted: every later pair is dominated too
+    if (!fit (*d.a, *d.b, KernelMode::Ladder))
+      continue;
+    if (record (*d.a, *d.b, d.rho) > stop_probability && !exhaustive)
+      return true;
+  }
+  return false;
+}
+} // namespace detail
+} // namespace pcl_probcollision

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The leaf-pair test of collide() (METHOD.md 6.3): one robust separator per pair of leaves the
+// traversal reaches. Private to the library (src/), used by src/collide.cpp.
+#pragma once
+
+#include <pcl_probcollision/collision_request.h>
+#include <pcl_probcollision/collision_result.h>
+#include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/robust_classifier.h>
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief Fits the robust separator to the union of two leaves (B's points mapped into A's
+  * frame) and records each fit into a CollisionResult: counters, per-point values (request.
+  * per_point), the running maximum and its witness (in A's frame, the hierarchies' frame).
+  *
+  * Passed to traverseHierarchies() as its leaf test. With request.defer_kernel_fits a pair
+  * whose plane asks for a kernel rung is set aside (contributing 0) and fitted in full by
+  * finishDeferred(), largest reach weight first.
+  */
+class LeafPairTest
+{
+public:
+  /** \brief result's per-point arrays are sized here when request.per_point. */
+  LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
+                const CollisionRequest& request, const RobustClassifier& classifier, CollisionResult& result);
+
+  /** \brief The traversal's leaf test: P_leaf of the two leaves, NaN when the classifier has
+    * no usable separator (counted in failures()), 0 for a pair set aside. */
+  double operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
+
+  /** \brief Fits the pairs set aside, largest reach weight first, skipping those that cannot
+    * raise the maximum when skip_dominated; true when a contribution exceeded stop_probability
+    * and exhaustive is off (the maximum is then a lower bound). */
+  bool finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated);
+
+  /** \brief The largest recorded contribution rho * P_leaf (-1 before any). */
+  double best () const { return best_; }
+  /** \brief Leaf pairs without a usable separator, and the first one's message. */
+  std::size_t failures () const { return failures_; }
+  const std::string& firstFailure () const { return failure_; }
+
+private:
+  /** \brief Fits one pair with the given kernel mode into leaf_; false (failure noted) when it
+    * has no usable separator. */
+  bool fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel);
+  /** \brief Takes the fit in leaf_ into the result; returns its contribution rho * P_leaf. */
+  double record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
+
+  struct Deferred
+  {
+    const ProbabilisticBVH::Node* a;
+    const ProbabilisticBVH::Node* b;
+    double rho;
+  };
+
+  const ProbabilisticBVH& a_;
+  const ProbabilisticBVH& b_;
+  const Eigen::Isometry3d& T_a_b_;
+  const CollisionRequest& request_;
+  const RobustClassifier& classifier_;
+  CollisionResult& result_;
+  /** \brief Kernel rungs deferred (defer_kernel_fits; never with per-point values, which need
+    * every pair's final fit in traversal order). */
+  bool lazy_kernel_ = false;
+
+  std::vector<Eigen::Vector3d> means_a_, means_b_;
+  std::vector<Eigen::Matrix3d> covs_a_, covs_b_;
+  ClassifierResult leaf_;
+  double best_ = -1.0;
+  std::string failure_;
+  std::size_t failures_ = 0;
+  std::vector<Deferred> deferred_;
+};
+} // namespace detail
+} // namespace pcl_probcollision
