@@ -4,6 +4,7 @@
 // ProbabilisticCollision rebuilds when a cloud is set again after an in-place change.
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
 #include <pcl/common/transforms.h>
@@ -153,6 +154,20 @@ TEST (CloudModel, WarnsOnceWhenTheInputFloatSpacingExceedsATenthOfTheNoise)
   CollisionResult quiet;
   ASSERT_TRUE (collide (*near, *near, Eigen::Isometry3d::Identity (), CollisionRequest (), quiet));
   EXPECT_TRUE (quiet.message.empty ()) << quiet.message;
+}
+
+TEST (CloudModel, DefaultsAreTheBuildingBlocksDefaults)
+{
+  // One owner per default: the model's settings are those of the classes that apply them.
+  const CloudModelParams params;
+  const CovarianceEstimation<pcl::PointXYZ> estimation;
+  EXPECT_EQ (params.k, estimation.getKSearch ());
+  EXPECT_EQ (params.surface_projection, estimation.getSurfaceProjection ());
+  EXPECT_EQ (params.noise.type (), estimation.getSensorNoise ().type ());
+  EXPECT_EQ (params.hierarchy, BVHParams ());
+  const ProbabilisticCollision<pcl::PointXYZ> adaptor;
+  EXPECT_EQ (adaptor.getKSearch (), params.k);
+  EXPECT_EQ (adaptor.getSurfaceProjection (), params.surface_projection);
 }
 
 TEST (CloudModel, BadInputIsRefusedByName)

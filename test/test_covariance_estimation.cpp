@@ -41,11 +41,13 @@ grid (int nx, int ny, double h, const Eigen::Isometry3d& pose = Eigen::Isometry3
   return c;
 }
 
+/** The measured-position model (the paper's: surface projection off). */
 pcl::PointCloud<Covariance>
 estimate (const Cloud::ConstPtr& cloud, int k, const SensorNoiseModel& noise = SensorNoiseModel (),
           bool discretization = true)
 {
   CovarianceEstimation<pcl::PointXYZ> est;
+  est.setSurfaceProjection (false);
   est.setInputCloud (cloud);
   est.setKSearch (k);
   est.setSensorNoise (noise);

@@ -20,7 +20,8 @@ namespace pcl_probcollision
   * Psi_i + Sigma_i, with Sigma_i from the SensorNoiseModel (none by default).
   *
   * Defaults: k = 10, tau = 2 sqrt(k) (so tau_i = 2 r_i, the authors' reference code), the
-  * discretisation term on, no sensor noise, Euclidean k-d tree search unless setSearchMethod()
+  * discretisation term on, no sensor noise, surface projection on (it acts only with a sensor
+  * noise model), Euclidean k-d tree search unless setSearchMethod()
   * gives another. The default search is the k-d tree of pcl::search::KdTree (FLANN, exact, the
   * same neighbours), queried for many points at once; a search set by setSearchMethod() is
   * asked one point at a time, as pcl::Feature does.
@@ -79,7 +80,8 @@ public:
     * hierarchy uses r_i^2 as the surface area a point stands for. */
   const std::vector<float>& getNeighbourRadii () const { return radii_; }
 
-  /** \brief Locally denoised positions (default off; needs a sensor noise model).
+  /** \brief Locally denoised positions (default on, as CloudModelParams::surface_projection,
+    * chosen by the evaluation; needs a sensor noise model: without one nothing moves).
     *
     * A measured point carries its full sensor noise across the surface, and the maximum of
     * many such points near contact drifts toward 1 (docs/RESULTS.md). With projection on,
@@ -118,7 +120,7 @@ private:
   SensorNoiseModel noise_;
   std::optional<SensorPose> sensor_pose_;
   std::vector<float> radii_;
-  bool project_ = false;
+  bool project_ = true;  // CloudModelParams::surface_projection; test_cloud_model checks they agree
   std::vector<Eigen::Vector3d> displacements_;
 };
 } // namespace pcl_probcollision
