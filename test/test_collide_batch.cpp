@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "sanitized_build.h"
-#include "seeded_draws.h"
+#include "scenes.h"
 
 #include <cmath>
 #include <cstring>
@@ -21,7 +21,9 @@
 #include <vector>
 
 using namespace pcl_probcollision;
-using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::jitteredGrid;
+using pcl_probcollision_test::patchWithHole;
+using pcl_probcollision_test::poseSweep;
 
 namespace
 {
@@ -30,45 +32,6 @@ constexpr int kPoses = 9;  // instrumented code is 10-50x slower; still three po
 #else
 constexpr int kPoses = 30;
 #endif
-
-/** A side x side grid with spacing h at z = 0, each point jittered by sigma and given an
-  * isotropic covariance sigma^2 (seeded). */
-UncertainCloud
-grid (int side, double h, double sigma, unsigned seed)
-{
-  std::mt19937 rng (seed);
-  std::normal_distribution<double> jitter (0.0, sigma);
-  UncertainCloud c;
-  for (int j = 0; j < side; ++j)
-    for (int i = 0; i < side; ++i)
-    {
-      const Eigen::Vector3d corner ((i - 0.5 * (side - 1)) * h, (j - 0.5 * (side - 1)) * h, 0.0);
-      c.means.push_back (corner + draw3 (jitter, rng));
-      c.covariances.push_back (Eigen::Matrix3d::Identity () * sigma * sigma);
-      c.source_indices.push_back (j * side + i);
-    }
-  return c;
-}
-
-/** Poses from 2 cm above to 1 cm through the other sheet, shifted and slightly tilted: free,
-  * contact and collision verdicts all occur. */
-std::vector<Eigen::Isometry3d>
-sweep (int n, unsigned seed)
-{
-  std::mt19937 rng (seed);
-  std::uniform_real_distribution<double> u (-1.0, 1.0);
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < n; ++i)
-  {
-    const double x = 0.02 * u (rng);
-    const double y = 0.02 * u (rng);
-    const double z = 0.02 - 0.03 * i / std::max (1, n - 1);
-    const Eigen::Vector3d axis = draw3 (u, rng).normalized ();
-    const double angle = 0.2 * u (rng);
-    poses.push_back (Eigen::Translation3d (x, y, z) * Eigen::AngleAxisd (angle, axis));
-  }
-  return poses;
-}
 
 template <typename T>
 bool
@@ -122,34 +85,13 @@ verdictCounts (const std::vector<CollisionResult>& results)
     ++counts[static_cast<int> (r.verdict)];
   return counts;
 }
-
-using Cloud = pcl::PointCloud<pcl::PointXYZ>;
-
-/** A noisy square patch of PointXYZ centred on `centre`, spacing h, side x side points, with
-  * the point side + 1 NaN. */
-Cloud::Ptr
-patchWithHole (int side, double h, const Eigen::Vector3d& centre, unsigned seed)
-{
-  std::mt19937 rng (seed);
-  std::normal_distribution<double> noise (0.0, 0.0005);
-  Cloud::Ptr c (new Cloud);
-  for (int j = 0; j < side; ++j)
-    for (int i = 0; i < side; ++i)
-    {
-      const Eigen::Vector3d e = draw3 (noise, rng);
-      const Eigen::Vector3d p = centre + e + Eigen::Vector3d ((i - 0.5 * (side - 1)) * h, (j - 0.5 * (side - 1)) * h, 0.0);
-      c->push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
-    }
-  (*c)[side + 1].x = std::numeric_limits<float>::quiet_NaN ();
-  return c;
-}
 } // namespace
 
 TEST (CollideBatch, ConcurrentBatchEqualsSingleQueriesForEveryModeAndThreadCount)
 {
-  const CloudModel a (grid (20, 0.005, 0.001, 1));
-  const CloudModel b (grid (24, 0.005, 0.001, 2));
-  const std::vector<Eigen::Isometry3d> poses = sweep (kPoses, 3);
+  const CloudModel a (jitteredGrid (20, 0.005, 0.001, 1));
+  const CloudModel b (jitteredGrid (24, 0.005, 0.001, 2));
+  const std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 3);
   for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
   {
     CollisionRequest request;
@@ -182,9 +124,9 @@ TEST (CollideBatch, ConcurrentBatchEqualsSingleQueriesForEveryModeAndThreadCount
 
 TEST (CollideBatch, ConcurrentBatchWithBadPosesFailsThemAndAnswersTheOthers)
 {
-  const CloudModel a (grid (16, 0.005, 0.001, 4));
-  const CloudModel b (grid (16, 0.005, 0.001, 5));
-  std::vector<Eigen::Isometry3d> poses = sweep (8, 6);
+  const CloudModel a (jitteredGrid (16, 0.005, 0.001, 4));
+  const CloudModel b (jitteredGrid (16, 0.005, 0.001, 5));
+  std::vector<Eigen::Isometry3d> poses = poseSweep (8, 6);
   poses[2].translation ().y () = std::numeric_limits<double>::quiet_NaN ();
   poses[5].linear () *= 1.5;
   CollisionRequest request;
@@ -215,7 +157,7 @@ TEST (CollideBatch, ConcurrentBatchWithBadPosesFailsThemAndAnswersTheOthers)
 
 TEST (CollideBatch, NegativeThreadCountThrowsNamingIt)
 {
-  const CloudModel a (grid (4, 0.01, 0.001, 7));
+  const CloudModel a (jitteredGrid (4, 0.01, 0.001, 7));
   const std::vector<Eigen::Isometry3d> poses (2, Eigen::Isometry3d::Identity ());
   std::vector<CollisionResult> results;
   try
@@ -246,7 +188,7 @@ TEST (CollideBatch, NegativeThreadCountThrowsNamingIt)
 
 TEST (CollideBatch, EmptyPoseListGivesNoResults)
 {
-  const CloudModel a (grid (4, 0.01, 0.001, 10));
+  const CloudModel a (jitteredGrid (4, 0.01, 0.001, 10));
   std::vector<CollisionResult> results (5);
   EXPECT_TRUE (collideBatch (a, a, {}, CollisionRequest (), results));
   EXPECT_TRUE (results.empty ());
@@ -258,8 +200,8 @@ TEST (CollideBatch, EmptyPoseListGivesNoResults)
 
 TEST (CollideBatch, InvalidRequestOrPoseFailsEveryPoseLikeCollide)
 {
-  const CloudModel a (grid (6, 0.01, 0.001, 11));
-  std::vector<Eigen::Isometry3d> poses = sweep (4, 12);
+  const CloudModel a (jitteredGrid (6, 0.01, 0.001, 11));
+  std::vector<Eigen::Isometry3d> poses = poseSweep (4, 12);
   CollisionRequest bad;
   bad.rho_min = 2.0;
   for (const bool bad_pose : {false, true})
@@ -299,7 +241,7 @@ TEST (CollideBatch, ConcurrentComputeBatchEqualsComputePoseByPose)
     request.exhaustive = true;
     pc.setRequest (request);
   };
-  std::vector<Eigen::Isometry3d> poses = sweep (kPoses, 15);
+  std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 15);
   for (Eigen::Isometry3d& pose : poses)
     pose = pose * Eigen::Translation3d (-offset);
   poses[1].translation ().x () = std::numeric_limits<double>::infinity ();

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "scenes.h"
 #include "seeded_draws.h"
 
 #include <Eigen/Geometry>
@@ -33,109 +34,16 @@ using detail::TraversalParams;
 using detail::TraversalResult;
 using Node = ProbabilisticBVH::Node;
 using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::Phi;
+using pcl_probcollision_test::randomPose;
+using pcl_probcollision_test::randomRotation;
+using pcl_probcollision_test::Shape;
+using pcl_probcollision_test::shapeCloud;
+using pcl_probcollision_test::shapeName;
+using pcl_probcollision_test::transformCloud;
 
 namespace
 {
-double
-Phi (double z)
-{
-  return 0.5 * std::erfc (-z / std::sqrt (2.0));
-}
-
-Eigen::Matrix3d
-randomRotation (std::mt19937_64& rng)
-{
-  std::normal_distribution<double> g (0.0, 1.0);
-  const double w = g (rng);  // one draw per statement: seeded_draws.h
-  const Eigen::Vector3d v = draw3 (g, rng);
-  Eigen::Quaterniond q (w, v.x (), v.y (), v.z ());
-  q.normalize ();
-  return q.toRotationMatrix ();
-}
-
-Eigen::Isometry3d
-randomPose (std::mt19937_64& rng, double translation_scale)
-{
-  std::uniform_real_distribution<double> u (-1.0, 1.0);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
-  T.linear () = randomRotation (rng);
-  T.translation () = translation_scale * draw3 (u, rng);
-  return T;
-}
-
-enum class Shape
-{
-  Box,
-  Sphere,
-  NoisyPlane
-};
-
-const char*
-shapeName (Shape s)
-{
-  switch (s)
-  {
-    case Shape::Box: return "Box";
-    case Shape::Sphere: return "Sphere";
-    case Shape::NoisyPlane: return "NoisyPlane";
-  }
-  return "?";
-}
-
-// Random cloud with random anisotropic covariances (std devs up to sigma) and random area
-// weights; shape fills a box of side 1, a sphere of radius 0.5, or a plane patch with noise.
-UncertainCloud
-makeCloud (Shape shape, std::size_t n, std::uint64_t seed, double sigma = 0.002,
-           bool weights = true)
-{
-  std::mt19937_64 rng (seed);
-  std::uniform_real_distribution<double> u (-0.5, 0.5);
-  std::normal_distribution<double> g (0.0, 1.0);
-  UncertainCloud c;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    Eigen::Vector3d x;
-    switch (shape)
-    {
-      case Shape::Box: x = draw3 (u, rng); break;
-      case Shape::Sphere:
-      {
-        const Eigen::Vector3d d = draw3 (g, rng);
-        x = 0.5 * d.normalized () + 0.001 * draw3 (g, rng);
-        break;
-      }
-      case Shape::NoisyPlane:
-      {
-        const double px = u (rng);
-        const double py = 0.6 * u (rng);
-        x = Eigen::Vector3d (px, py, 0.002 * g (rng));
-        break;
-      }
-    }
-    c.means.push_back (x);
-    const Eigen::Matrix3d R = randomRotation (rng);
-    const Eigen::Vector3d s = (sigma * (0.2 + 0.8 * (draw3 (u, rng).array () + 0.5))).matrix ();
-    c.covariances.push_back (R * s.cwiseAbs2 ().asDiagonal () * R.transpose ());
-    if (weights)
-      c.area_weights.push_back (0.5 + (u (rng) + 0.5));
-    c.source_indices.push_back (static_cast<int> (i));
-  }
-  return c;
-}
-
-UncertainCloud
-transformCloud (const UncertainCloud& c, const Eigen::Isometry3d& T)
-{
-  UncertainCloud out = c;
-  const Eigen::Matrix3d R = T.linear ();
-  for (std::size_t i = 0; i < c.size (); ++i)
-  {
-    out.means[i] = T * c.means[i];
-    out.covariances[i] = R * c.covariances[i] * R.transpose ();
-  }
-  return out;
-}
-
 std::vector<int>
 distinctPoints (const ProbabilisticBVH& bvh, const Node& node)
 {
@@ -320,36 +228,36 @@ TEST (BVHParams, ValidateRejectsEachParameterByName)
 TEST (ProbabilisticBVH, BadInputThrowsAndKeepsPreviousHierarchy)
 {
   ProbabilisticBVH bvh;
-  ASSERT_TRUE (bvh.build (makeCloud (Shape::Box, 50, 1)));
+  ASSERT_TRUE (bvh.build (shapeCloud (Shape::Box, 50, 1)));
   const std::size_t nodes_before = bvh.nodes ().size ();
 
-  UncertainCloud bad = makeCloud (Shape::Box, 10, 2);
+  UncertainCloud bad = shapeCloud (Shape::Box, 10, 2);
   bad.covariances.pop_back ();
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
-  bad = makeCloud (Shape::Box, 10, 2);
+  bad = shapeCloud (Shape::Box, 10, 2);
   bad.means[3].y () = std::numeric_limits<double>::quiet_NaN ();
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
-  bad = makeCloud (Shape::Box, 10, 2);
+  bad = shapeCloud (Shape::Box, 10, 2);
   bad.covariances[4] (1, 2) = std::numeric_limits<double>::infinity ();
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
-  bad = makeCloud (Shape::Box, 10, 2);
+  bad = shapeCloud (Shape::Box, 10, 2);
   bad.area_weights[5] = -1.0;
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
-  bad = makeCloud (Shape::Box, 10, 2);
+  bad = shapeCloud (Shape::Box, 10, 2);
   bad.area_weights.pop_back ();
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
-  bad = makeCloud (Shape::Box, 10, 2);
+  bad = shapeCloud (Shape::Box, 10, 2);
   bad.source_indices.push_back (7);
   EXPECT_THROW (bvh.build (bad), pcl::BadArgumentException);
 
   BVHParams p;
   p.epsilon = -0.1;
-  EXPECT_THROW (bvh.build (makeCloud (Shape::Box, 10, 2), p), pcl::BadArgumentException);
+  EXPECT_THROW (bvh.build (shapeCloud (Shape::Box, 10, 2), p), pcl::BadArgumentException);
 
   EXPECT_EQ (bvh.size (), 50u);
   EXPECT_EQ (bvh.nodes ().size (), nodes_before);
@@ -369,7 +277,7 @@ TEST_P (BVHInvariants, Hold)
   const std::size_t n = std::get<1> (GetParam ());
   BVHParams params;
   params.split_style = std::get<2> (GetParam ());
-  const UncertainCloud cloud = makeCloud (shape, n, 1000 + n);
+  const UncertainCloud cloud = shapeCloud (shape, n, 1000 + n);
   ProbabilisticBVH bvh;
   ASSERT_TRUE (bvh.build (cloud, params));
   ASSERT_FALSE (bvh.empty ());
@@ -568,7 +476,7 @@ TEST (ProbabilisticBVH, OctreeChildrenAreCellsOfTheParentAxes)
   // each principal axis it splits.
   BVHParams params;
   params.split_style = BVHParams::SplitStyle::Octree;
-  const UncertainCloud cloud = makeCloud (Shape::Box, 2000, 77);
+  const UncertainCloud cloud = shapeCloud (Shape::Box, 2000, 77);
   ProbabilisticBVH bvh (cloud, params);
   std::size_t eight = 0;
   for (const Node& nd : bvh.nodes ())
@@ -631,7 +539,7 @@ TEST (ProbabilisticBVH, VariationOracles)
 
   // Uniform in a cube: sigma_n -> 1/3. Sample variances of 10^4 uniform points have relative
   // standard deviation sqrt(0.8 / 10^4) = 0.009, so sigma_n is within 0.015 of 1/3.
-  const UncertainCloud cube = makeCloud (Shape::Box, 10000, 6);
+  const UncertainCloud cube = shapeCloud (Shape::Box, 10000, 6);
   ProbabilisticBVH bvh_cube (cube);
   EXPECT_NEAR (bvh_cube.node (0).variation, 1.0 / 3.0, 0.015);
   EXPECT_LE (bvh_cube.node (0).variation, 1.0 / 3.0 + 1e-7);
@@ -862,7 +770,7 @@ TEST (OrientedBox, SampledCommonPointImpliesOverlap)
 TEST (OrientedBox, FitContainsInflatedPoints)
 {
   std::mt19937_64 rng (15);
-  const UncertainCloud c = makeCloud (Shape::Sphere, 200, 16, 0.01);
+  const UncertainCloud c = shapeCloud (Shape::Sphere, 200, 16, 0.01);
   const Eigen::Matrix3d axes = randomRotation (rng);
   const OrientedBox box = detail::fitOrientedBox (axes, c.means.data (), c.covariances.data (), nullptr, c.size (), 2.0);
   for (std::size_t j = 0; j < c.size (); ++j)
@@ -970,8 +878,8 @@ TEST_P (BVHTraversalBruteForce, MatchesAllPairs)
   params.split_style = GetParam ();
   const double sigma_f = 0.01, margin = 0.04;
   const double slack = Phi ((GaussianPairLeafTest::kContactRadius - 2.0 * margin) / sigma_f);
-  ProbabilisticBVH a (makeCloud (Shape::Sphere, 400, 21, 0.003), params);
-  ProbabilisticBVH b (makeCloud (Shape::Box, 300, 22, 0.003), params);
+  ProbabilisticBVH a (shapeCloud (Shape::Sphere, 400, 21, 0.003), params);
+  ProbabilisticBVH b (shapeCloud (Shape::Box, 300, 22, 0.003), params);
   std::mt19937_64 rng (23);
   int colliding = 0, free = 0;
   for (int trial = 0; trial < 60; ++trial)
@@ -1035,8 +943,8 @@ TEST (BVHTraversal, StochasticRepeatsWithSeedAndMeanBoundsExpectedWeight)
   for (const Config cfg : {Config{0.02, 0.03, 0.03, 31, 32}, Config{0.01, 0.12, 0.2, 33, 34}})
   {
     SCOPED_TRACE ("point sigma " + std::to_string (cfg.point_sigma));
-    ProbabilisticBVH a (makeCloud (Shape::Sphere, 300, cfg.seed_a, cfg.point_sigma));
-    ProbabilisticBVH b (makeCloud (Shape::Sphere, 300, cfg.seed_b, cfg.point_sigma));
+    ProbabilisticBVH a (shapeCloud (Shape::Sphere, 300, cfg.seed_a, cfg.point_sigma));
+    ProbabilisticBVH b (shapeCloud (Shape::Sphere, 300, cfg.seed_b, cfg.point_sigma));
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
     T.translation () = Eigen::Vector3d (1.0 + cfg.gap, 0.0, 0.0);
     const double sigma_f = 0.01;
@@ -1133,7 +1041,7 @@ TEST (BVHTraversal, ExpectedWeightWeightsAreProductsOfQ)
 
 TEST (BVHTraversal, EarlyStopGivesLowerBound)
 {
-  const UncertainCloud c = makeCloud (Shape::Box, 500, 41);
+  const UncertainCloud c = shapeCloud (Shape::Box, 500, 41);
   ProbabilisticBVH a (c), b (c);
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
   auto always = [] (const Node&, const Node&, double) { return 0.9; };
@@ -1165,8 +1073,8 @@ TEST (BVHTraversal, EarlyStopGivesLowerBound)
 
 TEST (BVHTraversal, ThreadsGiveSerialAnswers)
 {
-  ProbabilisticBVH a (makeCloud (Shape::Sphere, 2000, 51, 0.005));
-  ProbabilisticBVH b (makeCloud (Shape::NoisyPlane, 1500, 52, 0.005));
+  ProbabilisticBVH a (shapeCloud (Shape::Sphere, 2000, 51, 0.005));
+  ProbabilisticBVH b (shapeCloud (Shape::NoisyPlane, 1500, 52, 0.005));
   std::mt19937_64 rng (53);
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < 16; ++i)
@@ -1219,8 +1127,8 @@ TEST (BVHTraversal, PoseEqualsPretransformedRebuild)
 {
   // METHOD.md 11.6 relative pose: traversal with T_a_b equals traversal against B's cloud moved
   // by T_a_b and rebuilt, with the identity.
-  const UncertainCloud ca = makeCloud (Shape::Sphere, 600, 61, 0.004);
-  const UncertainCloud cb = makeCloud (Shape::NoisyPlane, 500, 62, 0.004);
+  const UncertainCloud ca = shapeCloud (Shape::Sphere, 600, 61, 0.004);
+  const UncertainCloud cb = shapeCloud (Shape::NoisyPlane, 500, 62, 0.004);
   ProbabilisticBVH a (ca), b (cb);
   std::mt19937_64 rng (63);
   int collisions = 0;
@@ -1262,7 +1170,7 @@ TEST (BVHTraversal, PoseEqualsPretransformedRebuild)
 
 TEST (BVHTraversal, CountersAndFlags)
 {
-  const UncertainCloud c = makeCloud (Shape::Sphere, 300, 71, 0.005);
+  const UncertainCloud c = shapeCloud (Shape::Sphere, 300, 71, 0.005);
   ProbabilisticBVH a (c), b (c), empty;
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
   auto zero = [] (const Node&, const Node&, double) { return 0.0; };
@@ -1322,7 +1230,7 @@ TEST (BVHTraversal, CountersAndFlags)
 
 TEST (ProbabilisticBVH, GatherAppliesTheTransform)
 {
-  const UncertainCloud c = makeCloud (Shape::Box, 100, 81, 0.01);
+  const UncertainCloud c = shapeCloud (Shape::Box, 100, 81, 0.01);
   ProbabilisticBVH bvh (c);
   std::mt19937_64 rng (82);
   const Eigen::Isometry3d T = randomPose (rng, 3.0);
@@ -1358,7 +1266,7 @@ TEST (ProbabilisticBVH, FarFromTheOriginGivesTheSameTree)
 {
   // A translation by 10^5 m changes neither the leaves nor the leakage (projections are taken
   // about the node mean, so large coordinates keep their precision).
-  const UncertainCloud c = makeCloud (Shape::Sphere, 3000, 91, 0.003);
+  const UncertainCloud c = shapeCloud (Shape::Sphere, 3000, 91, 0.003);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
   T.translation () = Eigen::Vector3d (1e5, -2e5, 3e5);
   ProbabilisticBVH near (c), far (transformCloud (c, T));
@@ -1376,7 +1284,7 @@ TEST (ProbabilisticBVH, FarFromTheOriginGivesTheSameTree)
 
 TEST (ProbabilisticBVH, MoveBuildAndUnionBound)
 {
-  UncertainCloud c = makeCloud (Shape::NoisyPlane, 800, 92, 0.004);
+  UncertainCloud c = shapeCloud (Shape::NoisyPlane, 800, 92, 0.004);
   const UncertainCloud copy = c;
   ProbabilisticBVH by_copy (copy);
   ProbabilisticBVH by_move;
@@ -1418,10 +1326,10 @@ TEST (ProbabilisticBVH, EmptyCloudGivesEmptyHierarchy)
   EXPECT_EQ (bvh.leafCount (), 0u);
   EXPECT_EQ (bvh.depth (), 0);
   // Rebuilding after a real build also empties it.
-  ASSERT_TRUE (bvh.build (makeCloud (Shape::Box, 30, 1)));
+  ASSERT_TRUE (bvh.build (shapeCloud (Shape::Box, 30, 1)));
   EXPECT_FALSE (bvh.build (UncertainCloud ()));
   EXPECT_TRUE (bvh.empty ());
-  bvh.build (makeCloud (Shape::Box, 30, 1));
+  bvh.build (shapeCloud (Shape::Box, 30, 1));
   bvh.clear ();
   EXPECT_TRUE (bvh.empty ());
   EXPECT_EQ (bvh.size (), 0u);
@@ -1521,7 +1429,7 @@ TEST (ProbabilisticBVH, TwoClustersOfDuplicatesSplitOnce)
 // and epsilon 0.49 exhausted memory).
 TEST (ProbabilisticBVH, LargeEpsilonKeepsTheHierarchyLinearInSize)
 {
-  const UncertainCloud cloud = makeCloud (Shape::Box, 1000, 5);
+  const UncertainCloud cloud = shapeCloud (Shape::Box, 1000, 5);
   for (const auto style : {BVHParams::SplitStyle::Pca, BVHParams::SplitStyle::Octree})
   {
     BVHParams params;

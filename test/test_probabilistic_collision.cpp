@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "seeded_draws.h"
+#include "scenes.h"
 
 #include <cmath>
 #include <fstream>
@@ -20,31 +20,12 @@
 #include <thread>
 
 using namespace pcl_probcollision;
-using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::organizedPatch;
+using pcl_probcollision_test::randomAxisAnglePose;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
 {
-/** A square patch of side `size` at height z, spacing h, with Gaussian noise sigma (seeded). */
-Cloud::Ptr
-patch (double size, double h, double z, double sigma, unsigned seed)
-{
-  std::mt19937 rng (seed);
-  std::normal_distribution<double> noise (0.0, sigma);
-  Cloud::Ptr c (new Cloud);
-  const int n = static_cast<int> (std::round (size / h)) + 1;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-    {
-      const Eigen::Vector3d e = sigma > 0 ? draw3 (noise, rng) : Eigen::Vector3d (0.0, 0.0, 0.0);
-      c->push_back (pcl::PointXYZ (static_cast<float> (i * h - size / 2 + e.x ()), static_cast<float> (j * h - size / 2 + e.y ()),
-                                   static_cast<float> (z + e.z ())));
-    }
-  c->width = n;
-  c->height = n;
-  return c;
-}
-
 CollisionResult
 query (const Cloud::Ptr& a, const Cloud::Ptr& b, double sigma,
        const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity (), CollisionRequest request = CollisionRequest ())
@@ -59,33 +40,24 @@ query (const Cloud::Ptr& a, const Cloud::Ptr& b, double sigma,
   EXPECT_TRUE (pc.compute (pose, r)) << r.message;
   return r;
 }
-
-Eigen::Isometry3d
-randomPose (std::mt19937& rng, double translation)
-{
-  std::uniform_real_distribution<double> u (-1.0, 1.0);
-  const Eigen::Vector3d axis = draw3 (u, rng).normalized ();
-  const Eigen::Vector3d t = translation * draw3 (u, rng);
-  return Eigen::Translation3d (t) * Eigen::AngleAxisd (M_PI * u (rng), axis);
-}
 } // namespace
 
 TEST (ProbabilisticCollision, SeparatedTouchingAndCrossingPlanesGetTheirVerdicts)
 {
   const double sigma = 0.002;
-  const auto a = patch (0.2, 0.01, 0.0, 0.0, 1);
+  const auto a = organizedPatch (0.2, 0.01, 0.0, 0.0, 1);
   // 25 sigma (and 5 sample spacings) apart: free.
-  const CollisionResult far = query (a, patch (0.2, 0.01, 0.05, 0.0, 2), sigma);
+  const CollisionResult far = query (a, organizedPatch (0.2, 0.01, 0.05, 0.0, 2), sigma);
   EXPECT_EQ (far.verdict, Verdict::Free) << far.probability;
   EXPECT_LT (far.probability, 1e-6);
   // Coincident surfaces: P >= 0.5, contact or collision, never free.
-  const CollisionResult touching = query (a, patch (0.2, 0.01, 0.0, 0.0, 3), sigma);
+  const CollisionResult touching = query (a, organizedPatch (0.2, 0.01, 0.0, 0.0, 3), sigma);
   EXPECT_GE (touching.probability, 0.5 - 1e-9);
   EXPECT_NE (touching.verdict, Verdict::Free);
   // B tilted through A. Crossing sheets are separable everywhere but along their intersection
   // (a saddle does it), so the method reads them as at least touching (METHOD.md 10).
   Cloud::Ptr tilted (new Cloud);
-  pcl::transformPointCloud (*patch (0.2, 0.01, 0.0, 0.0, 4), *tilted,
+  pcl::transformPointCloud (*organizedPatch (0.2, 0.01, 0.0, 0.0, 4), *tilted,
                             Eigen::Affine3f (Eigen::AngleAxisf (0.5f, Eigen::Vector3f::UnitX ())));
   const CollisionResult crossing = query (a, tilted, sigma);
   EXPECT_GE (crossing.probability, 0.5);
@@ -101,11 +73,11 @@ TEST (ProbabilisticCollision, ProbabilityFallsWithTheGapAndStaysNearTheFlatAnswe
   // can tilt, so the hierarchy's value may fall below it; it must not rise above it by more
   // than METHOD.md 11.4's 0.02 once the gap exceeds a sample spacing's worth of ambiguity.
   const double sigma = 0.002;
-  const auto a = patch (0.1, 0.01, 0.0, 0.0, 1);
+  const auto a = organizedPatch (0.1, 0.01, 0.0, 0.0, 1);
   double last = 1.0;
   for (double gap : {0.0005, 0.001, 0.002, 0.004, 0.008, 0.016, 0.032})
   {
-    const CollisionResult r = query (a, patch (0.1, 0.01, gap, 0.0, 1), sigma);
+    const CollisionResult r = query (a, organizedPatch (0.1, 0.01, gap, 0.0, 1), sigma);
     const double flat = normalCdf (-gap / (2 * sigma));
     std::cout << "gap " << gap << " P " << r.probability << " flat " << flat << "\n";
     EXPECT_LE (r.probability, last + 1e-9) << gap;
@@ -128,8 +100,8 @@ TEST (ProbabilisticCollision, ProbabilityFallsWithTheGapAndStaysNearTheFlatAnswe
 TEST (ProbabilisticCollision, PoseReuseEqualsTransformingTheCloudAndRebuilding)
 {
   const double sigma = 0.003;
-  const auto a = patch (0.15, 0.01, 0.0, 0.001, 5);
-  const auto b = patch (0.2, 0.01, 0.0, 0.001, 6);
+  const auto a = organizedPatch (0.15, 0.01, 0.0, 0.001, 5);
+  const auto b = organizedPatch (0.2, 0.01, 0.0, 0.001, 6);
   ProbabilisticCollision<pcl::PointXYZ> reused;
   reused.setInputCloud (a);
   reused.setTargetCloud (b);
@@ -151,7 +123,7 @@ TEST (ProbabilisticCollision, PoseReuseEqualsTransformingTheCloudAndRebuilding)
     std::mt19937 rng (7);
     for (int trial = 0; trial < 6; ++trial)
     {
-      const Eigen::Isometry3d pose = randomPose (rng, 0.05);
+      const Eigen::Isometry3d pose = randomAxisAnglePose (rng, 0.05);
       CollisionResult with_pose;
       ASSERT_TRUE (reused.compute (pose, with_pose));
       Cloud::Ptr moved (new Cloud);
@@ -168,8 +140,8 @@ TEST (ProbabilisticCollision, PoseReuseEqualsTransformingTheCloudAndRebuilding)
 TEST (ProbabilisticCollision, SwappingTheCloudsKeepsTheProbability)
 {
   const double sigma = 0.002;
-  const auto a = patch (0.1, 0.01, 0.0, 0.0005, 8);
-  const auto b = patch (0.12, 0.01, 0.003, 0.0005, 9);
+  const auto a = organizedPatch (0.1, 0.01, 0.0, 0.0005, 8);
+  const auto b = organizedPatch (0.12, 0.01, 0.003, 0.0005, 9);
   CollisionRequest request;
   request.exhaustive = true;
   request.classifier.kernel = KernelMode::Linear;
@@ -181,8 +153,8 @@ TEST (ProbabilisticCollision, SwappingTheCloudsKeepsTheProbability)
 
 TEST (ProbabilisticCollision, StochasticTraversalRepeatsWithTheSameSeed)
 {
-  const auto a = patch (0.1, 0.01, 0.0, 0.001, 10);
-  const auto b = patch (0.1, 0.01, 0.006, 0.001, 11);
+  const auto a = organizedPatch (0.1, 0.01, 0.0, 0.001, 10);
+  const auto b = organizedPatch (0.1, 0.01, 0.006, 0.001, 11);
   CollisionRequest request;
   request.traversal = TraversalMode::Stochastic;
   request.seed = 42;
@@ -197,8 +169,8 @@ TEST (ProbabilisticCollision, StochasticTraversalRepeatsWithTheSameSeed)
 TEST (ProbabilisticCollision, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
 {
   ProbabilisticCollision<pcl::PointXYZ> pc;
-  pc.setInputCloud (patch (0.1, 0.01, 0.0, 0.001, 12));
-  pc.setTargetCloud (patch (0.2, 0.01, 0.0, 0.001, 13));
+  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.001, 12));
+  pc.setTargetCloud (organizedPatch (0.2, 0.01, 0.0, 0.001, 13));
   pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
   pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
   CollisionResult warmup;
@@ -211,7 +183,7 @@ TEST (ProbabilisticCollision, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
   std::mt19937 rng (14);
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < 16; ++i)
-    poses.push_back (randomPose (rng, 0.03));
+    poses.push_back (randomAxisAnglePose (rng, 0.03));
   std::vector<double> serial (poses.size ()), parallel (poses.size (), -1.0);
   for (std::size_t i = 0; i < poses.size (); ++i)
   {
@@ -238,8 +210,8 @@ TEST (ProbabilisticCollision, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
 TEST (ProbabilisticCollision, FilterKeepsThePointsNearTheTarget)
 {
   // A: a 20 cm patch; B: a 4 cm patch lying on A's centre. Only A's centre should be kept.
-  const auto a = patch (0.2, 0.01, 0.0, 0.0, 15);
-  const auto b = patch (0.04, 0.01, 0.0005, 0.0, 16);
+  const auto a = organizedPatch (0.2, 0.01, 0.0, 0.0, 15);
+  const auto b = organizedPatch (0.04, 0.01, 0.0005, 0.0, 16);
   ProbabilisticCollision<pcl::PointXYZ> pc;
   pc.setInputCloud (a);
   pc.setTargetCloud (b);
@@ -268,8 +240,8 @@ TEST (ProbabilisticCollision, FilterKeepsThePointsNearTheTarget)
 
 TEST (ProbabilisticCollision, NaNPointsAreSkippedAndCountedLikeRemovingThem)
 {
-  auto a = patch (0.1, 0.01, 0.0, 0.0, 17);
-  const auto b = patch (0.1, 0.01, 0.006, 0.0, 18);
+  auto a = organizedPatch (0.1, 0.01, 0.0, 0.0, 17);
+  const auto b = organizedPatch (0.1, 0.01, 0.006, 0.0, 18);
   for (int i : {3, 50, 51, 99})
     (*a)[i].x = std::numeric_limits<float>::quiet_NaN ();
   a->is_dense = false;
@@ -291,7 +263,7 @@ TEST (ProbabilisticCollision, UnusableInputsFailWithAMessage)
   CollisionResult r;
   EXPECT_FALSE (pc.compute (r));
   EXPECT_NE (r.message.find ("input"), std::string::npos);
-  pc.setInputCloud (patch (0.1, 0.01, 0.0, 0.0, 19));
+  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.0, 19));
   EXPECT_FALSE (pc.compute (r));
   EXPECT_NE (r.message.find ("target"), std::string::npos) << r.message;
   Cloud::Ptr nan_cloud (new Cloud);
@@ -301,7 +273,7 @@ TEST (ProbabilisticCollision, UnusableInputsFailWithAMessage)
   EXPECT_FALSE (pc.compute (r));
   EXPECT_NE (r.message.find ("no finite point"), std::string::npos) << r.message;
   EXPECT_TRUE (std::isnan (r.probability));
-  pc.setTargetCloud (patch (0.1, 0.01, 0.05, 0.0, 20));
+  pc.setTargetCloud (organizedPatch (0.1, 0.01, 0.05, 0.0, 20));
   pcl::PointCloud<Covariance>::Ptr wrong (new pcl::PointCloud<Covariance>);
   wrong->resize (3);
   pc.setTargetCovariances (wrong);

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "sanitized_build.h"
+#include "scenes.h"
 #include "seeded_draws.h"
 
 #include <algorithm>
@@ -26,6 +27,8 @@
 
 using namespace pcl_probcollision;
 using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::patch;
+using pcl_probcollision_test::randomSheet;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
@@ -86,25 +89,6 @@ expectSane (const CollisionResult& r, bool ok, const CollisionRequest& rq = Coll
     EXPECT_TRUE (std::isnan (t) || (std::isfinite (t) && t >= 0.0)) << t;
 }
 
-/** A square patch of side `size` at height z, spacing h, Gaussian noise sigma (seeded). */
-Cloud::Ptr
-patch (double size, double h, double z, double sigma, unsigned seed, Eigen::Vector3d offset = Eigen::Vector3d::Zero ())
-{
-  std::mt19937 rng (seed);
-  std::normal_distribution<double> noise (0.0, sigma);
-  Cloud::Ptr c (new Cloud);
-  const int n = static_cast<int> (std::round (size / h)) + 1;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-    {
-      const double dx = sigma > 0 ? noise (rng) : 0.0, dy = sigma > 0 ? noise (rng) : 0.0, dz = sigma > 0 ? noise (rng) : 0.0;
-      c->push_back (pcl::PointXYZ (static_cast<float> (offset.x () + i * h - size / 2 + dx),
-                                   static_cast<float> (offset.y () + j * h - size / 2 + dy),
-                                   static_cast<float> (offset.z () + z + dz)));
-    }
-  return c;
-}
-
 struct Query
 {
   bool ok = false;
@@ -128,25 +112,6 @@ query (const Cloud::Ptr& a, const Cloud::Ptr& b, double sigma, CollisionRequest 
   Query q;
   q.ok = pc.compute (pose, q.r);
   return q;
-}
-
-/** Seeded random Gaussians on a noisy sheet, in double (for collide() directly). */
-UncertainCloud
-sheet (int n, double size, double z, double sigma, unsigned seed, const Eigen::Vector3d& offset = Eigen::Vector3d::Zero ())
-{
-  std::mt19937 rng (seed);
-  std::uniform_real_distribution<double> u (-size / 2, size / 2);
-  std::normal_distribution<double> dz (0.0, sigma);
-  UncertainCloud c;
-  for (int i = 0; i < n; ++i)
-  {
-    const double x = u (rng);  // one draw per statement: seeded_draws.h
-    const double y = u (rng);
-    c.means.push_back (offset + Eigen::Vector3d (x, y, z + dz (rng)));
-    c.covariances.push_back (Eigen::Matrix3d::Identity () * sigma * sigma);
-    c.source_indices.push_back (i);
-  }
-  return c;
 }
 
 std::size_t
@@ -437,10 +402,10 @@ TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
   for (const double gap : {0.02, 0.003, 0.0})
   {
     SCOPED_TRACE (gap);
-    const CloudModel a0 (sheet (400, 0.2, 0.0, 0.002, 12));
-    const CloudModel b0 (sheet (400, 0.2, gap, 0.002, 13));
-    const CloudModel a1 (sheet (400, 0.2, 0.0, 0.002, 12, offset));
-    const CloudModel b1 (sheet (400, 0.2, gap, 0.002, 13, offset));
+    const CloudModel a0 (randomSheet (400, 0.2, 0.0, 0.002, 12));
+    const CloudModel b0 (randomSheet (400, 0.2, gap, 0.002, 13));
+    const CloudModel a1 (randomSheet (400, 0.2, 0.0, 0.002, 12, offset));
+    const CloudModel b1 (randomSheet (400, 0.2, gap, 0.002, 13, offset));
     CollisionResult r0, r1;
     ASSERT_TRUE (collide (a0, b0, Eigen::Isometry3d::Identity (), rq, r0)) << r0.message;
     ASSERT_TRUE (collide (a1, b1, Eigen::Isometry3d::Identity (), rq, r1)) << r1.message;
@@ -455,12 +420,12 @@ TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
 // so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
 TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
 {
-  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 31));
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 31));
   std::size_t fewer = 0;
   for (const double gap : {0.03, 0.008, 0.004, 0.0})
   {
     SCOPED_TRACE (gap);
-    const CloudModel b (sheet (600, 0.2, gap, 0.002, 32));
+    const CloudModel b (randomSheet (600, 0.2, gap, 0.002, 32));
     for (const double tilt : {0.0, 0.2})
     {
       const Eigen::Isometry3d T (Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ()));
@@ -485,8 +450,8 @@ TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
 // same verdict always, fewer kernel fits; ignored with per-point values.
 TEST (Reliability, DeferredKernelFitsKeepTheAnswer)
 {
-  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 41));
-  const CloudModel b (sheet (600, 0.2, 0.0, 0.002, 42));
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 41));
+  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 42));
   std::size_t kernel_default = 0, kernel_deferred = 0;
   for (const double tilt : {0.0, 0.15, 0.4})
     for (const double lift : {0.004, 0.0, -0.01})
@@ -665,8 +630,8 @@ TEST (Reliability, NonFiniteOrNonRigidPosesFail)
 
 TEST (Reliability, ConcurrentQueriesOnSharedHierarchiesMatchSerialExactly)
 {
-  const CloudModel a (sheet (600, 0.2, 0.0, 0.002, 24));
-  const CloudModel b (sheet (600, 0.2, 0.0, 0.002, 25));
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 24));
+  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 25));
   for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
   {
     CollisionRequest rq;
