@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # The driver: every method on every workload, CSV out (scripts/evaluate.sh renders the charts).
 add_executable(evaluate_collision evaluate_collision.cpp workloads.cpp scenes.cpp)
-target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcd_collision_mesh
+target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io
   pcl_probcollision pcl_io FLANN::FLANN)
 target_compile_options(evaluate_collision PRIVATE -Wall -Wextra)
 
@@ -15,7 +15,7 @@ target_compile_options(calibration_drift PRIVATE -Wall -Wextra)
 find_package(benchmark QUIET)
 if(benchmark_FOUND)
   add_executable(bench_performance bench_performance.cpp workloads.cpp)
-  target_link_libraries(bench_performance PRIVATE eval_ground_truth eval_metrics pcd_collision_mesh
+  target_link_libraries(bench_performance PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io
     pcl_probcollision benchmark::benchmark)
   target_compile_options(bench_performance PRIVATE -Wall -Wextra)
   target_compile_definitions(bench_performance PRIVATE

@@ -3,7 +3,7 @@
 # nearest-neighbour threshold, reconstruct then collide). Included by evaluation/CMakeLists.txt
 # after find_package(fcl), find_package(octomap) and find_package(PCL ... surface).
 # FCL, octomap, FLANN and pcl_surface are private: the public headers need only PCL's point
-# cloud, Eigen and tools/mesh_input.h.
+# cloud, Eigen and io/mesh_input.h.
 find_package(Threads REQUIRED)
 # FLANN's index headers (baselines.cpp) compile its LZ4 serialisation into the vtables.
 find_library(PCL_PROBCOLLISION_LZ4_LIBRARY NAMES lz4)
@@ -17,7 +17,7 @@ add_library(eval_ground_truth STATIC
 target_include_directories(eval_ground_truth PUBLIC ${CMAKE_CURRENT_LIST_DIR})
 target_include_directories(eval_ground_truth SYSTEM PRIVATE ${OCTOMAP_INCLUDE_DIRS})
 target_link_libraries(eval_ground_truth
-  PUBLIC pcd_collision_mesh pcl_probcollision pcl_common
+  PUBLIC pcl_probcollision_io pcl_probcollision pcl_common
   PRIVATE fcl ${OCTOMAP_LIBRARIES} pcl_kdtree pcl_search pcl_features pcl_surface
     ${PCL_PROBCOLLISION_LZ4_LIBRARY} Threads::Threads)
 target_compile_options(eval_ground_truth PRIVATE -Wall -Wextra)

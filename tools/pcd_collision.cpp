@@ -3,6 +3,7 @@
 // The contract is in docs/CLI.md and `pcd_collision -h`.
 
 #include "cli_options.h"
+#include "json_writer.h"
 #include "mesh_input.h"
 #include "mesh_sampling.h"
 #include "pcd_files.h"
@@ -21,7 +22,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -47,128 +47,6 @@ msSince (std::chrono::steady_clock::time_point start)
 {
   return std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
 }
-
-// ---------------------------------------------------------------------------------------------
-// JSON (one object per line; NaN and Inf become null).
-class Json
-{
-public:
-  Json& key (const char* k)
-  {
-    if (comma_)
-      out_ << ',';
-    quoted (k);
-    out_ << ':';
-    comma_ = false;
-    after_key_ = true;
-    return *this;
-  }
-  Json& begin () { return open ('{'); }
-  Json& end () { return close ('}'); }
-  Json& beginArray () { return open ('['); }
-  Json& endArray () { return close (']'); }
-  Json& num (double v)
-  {
-    pre ();
-    if (!std::isfinite (v))
-      out_ << "null";
-    else
-    {
-      char buf[32];
-      std::snprintf (buf, sizeof (buf), "%.10g", v);
-      out_ << buf;
-    }
-    return *this;
-  }
-  Json& count (std::uint64_t v)
-  {
-    pre ();
-    out_ << v;
-    return *this;
-  }
-  Json& integer (long long v)
-  {
-    pre ();
-    out_ << v;
-    return *this;
-  }
-  Json& boolean (bool v)
-  {
-    pre ();
-    out_ << (v ? "true" : "false");
-    return *this;
-  }
-  Json& null ()
-  {
-    pre ();
-    out_ << "null";
-    return *this;
-  }
-  Json& str (const std::string& s)
-  {
-    pre ();
-    quoted (s);
-    return *this;
-  }
-  Json& vec3 (const Eigen::Vector3d& v)
-  {
-    beginArray ();
-    num (v.x ()).num (v.y ()).num (v.z ());
-    return endArray ();
-  }
-  std::string text () const { return out_.str (); }
-
-private:
-  void pre ()
-  {
-    if (!after_key_ && comma_)
-      out_ << ',';
-    after_key_ = false;
-    comma_ = true;
-  }
-  Json& open (char c)
-  {
-    pre ();
-    out_ << c;
-    comma_ = false;
-    return *this;
-  }
-  Json& close (char c)
-  {
-    out_ << c;
-    comma_ = true;
-    return *this;
-  }
-  void quoted (const std::string& s)
-  {
-    out_ << '"';
-    for (const char ch : s)
-    {
-      const auto c = static_cast<unsigned char> (ch);
-      switch (c)
-      {
-        case '"': out_ << "\\\""; break;
-        case '\\': out_ << "\\\\"; break;
-        case '\n': out_ << "\\n"; break;
-        case '\r': out_ << "\\r"; break;
-        case '\t': out_ << "\\t"; break;
-        default:
-          if (c < 0x20 || c == 0x7f)
-          {
-            char buf[8];
-            std::snprintf (buf, sizeof (buf), "\\u%04x", c);
-            out_ << buf;
-          }
-          else
-            out_ << ch;
-      }
-    }
-    out_ << '"';
-  }
-  std::ostringstream out_;
-  bool comma_ = false;
-  bool after_key_ = false;
-};
 
 // ---------------------------------------------------------------------------------------------
 /** \brief Sizes (bounding-box diagonals) differing by more than this get a units warning. */
@@ -344,28 +222,28 @@ modelParamsFor (const Options& o)
 }
 
 void
-inputJson (Json& j, const Input& in)
+inputJson (JsonWriter& j, const Input& in)
 {
-  j.begin ();
-  j.key ("path").str (in.path);
+  j.beginObject ();
+  j.key ("path").string (in.path);
   if (in.kind == InputKind::Cloud)
   {
-    j.key ("kind").str ("cloud");
-    j.key ("points").count (in.cloud->size ());
-    j.key ("finite").count (in.finite);
-    j.key ("width").count (in.cloud->width);
-    j.key ("height").count (in.cloud->height);
+    j.key ("kind").string ("cloud");
+    j.key ("points").unsignedInteger (in.cloud->size ());
+    j.key ("finite").unsignedInteger (in.finite);
+    j.key ("width").unsignedInteger (in.cloud->width);
+    j.key ("height").unsignedInteger (in.cloud->height);
   }
   else
   {
-    j.key ("kind").str ("mesh");
-    j.key ("vertices").count (in.mesh.vertices.size ());
-    j.key ("triangles").count (in.mesh.triangles.size ());
-    j.key ("points").count (in.cloud->size ());
-    j.key ("spacing").num (in.spacing);
-    j.key ("spacing_source").str (in.spacing_source);
+    j.key ("kind").string ("mesh");
+    j.key ("vertices").unsignedInteger (in.mesh.vertices.size ());
+    j.key ("triangles").unsignedInteger (in.mesh.triangles.size ());
+    j.key ("points").unsignedInteger (in.cloud->size ());
+    j.key ("spacing").number (in.spacing);
+    j.key ("spacing_source").string (in.spacing_source);
   }
-  j.end ();
+  j.endObject ();
 }
 
 std::string
@@ -374,82 +252,79 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
             std::size_t points_written)
 {
   const auto& rq = requestFor (o);
-  Json j;
-  j.begin ();
+  JsonWriter j;
+  j.beginObject ();
   if (pose_index >= 0)
     j.key ("pose_index").integer (pose_index);
-  j.key ("pose").beginArray ();
-  for (const double v : pose)
-    j.num (v);
-  j.endArray ();
-  j.key ("verdict").str (pcl_probcollision::verdictName (r.verdict));
-  j.key ("probability").num (r.probability);
+  j.key ("pose").numbers ({pose[0], pose[1], pose[2], pose[3], pose[4], pose[5]});
+  j.key ("verdict").string (pcl_probcollision::verdictName (r.verdict));
+  j.key ("probability").number (r.probability);
   j.key ("lower_bound").boolean (r.lower_bound);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
-  j.key ("points_a").count (r.points_a);
-  j.key ("points_b").count (r.points_b);
-  j.key ("points_skipped_nonfinite").count (r.points_skipped_nonfinite);
-  j.key ("leaf_pairs").count (r.leaf_pairs_tested);
-  j.key ("bv_tests").count (r.bv_tests);
-  j.key ("kernel_leaf_pairs").count (r.kernel_leaf_pairs);
-  j.key ("degenerate_leaf_pairs").count (r.degenerate_leaf_pairs);
-  j.key ("classifier_iterations").count (r.classifier_iterations);
-  j.key ("build_ms").num (r.build_ms);
-  j.key ("query_ms").num (r.query_ms);
+  j.key ("points_a").unsignedInteger (r.points_a);
+  j.key ("points_b").unsignedInteger (r.points_b);
+  j.key ("points_skipped_nonfinite").unsignedInteger (r.points_skipped_nonfinite);
+  j.key ("leaf_pairs").unsignedInteger (r.leaf_pairs_tested);
+  j.key ("bv_tests").unsignedInteger (r.bv_tests);
+  j.key ("kernel_leaf_pairs").unsignedInteger (r.kernel_leaf_pairs);
+  j.key ("degenerate_leaf_pairs").unsignedInteger (r.degenerate_leaf_pairs);
+  j.key ("classifier_iterations").unsignedInteger (r.classifier_iterations);
+  j.key ("build_ms").number (r.build_ms);
+  j.key ("query_ms").number (r.query_ms);
   j.key ("witness");
   if (r.witness_side == 0)
     j.null ();
   else
   {
-    j.begin ();
-    j.key ("point").vec3 (r.witness_point);
-    j.key ("side").str (r.witness_side > 0 ? "a" : "b");
+    j.beginObject ();
+    j.key ("point").numbers ({r.witness_point.x (), r.witness_point.y (), r.witness_point.z ()});
+    j.key ("side").string (r.witness_side > 0 ? "a" : "b");
     j.key ("index").integer (r.witness_index);
-    j.key ("normal").vec3 (r.witness_normal);
-    j.end ();
+    j.key ("normal").numbers ({r.witness_normal.x (), r.witness_normal.y (), r.witness_normal.z ()});
+    j.endObject ();
   }
-  j.key ("timings_ms").begin ();
-  j.key ("load_a").num (a.load_ms);
-  j.key ("load_b").num (b.load_ms);
-  j.key ("sample_meshes").num (a.sample_ms + b.sample_ms);
-  j.key ("build").num (r.build_ms);
-  j.key ("query").num (r.query_ms);
+  j.key ("timings_ms").beginObject ();
+  j.key ("load_a").number (a.load_ms);
+  j.key ("load_b").number (b.load_ms);
+  j.key ("sample_meshes").number (a.sample_ms + b.sample_ms);
+  j.key ("build").number (r.build_ms);
+  j.key ("query").number (r.query_ms);
   if (write_ms)
-    j.key ("write").num (*write_ms);
-  j.end ();
-  j.key ("inputs").begin ();
+    j.key ("write").number (*write_ms);
+  j.endObject ();
+  j.key ("inputs").beginObject ();
   j.key ("a");
   inputJson (j, a);
   j.key ("b");
   inputJson (j, b);
-  j.end ();
-  j.key ("parameters").begin ();
-  j.key ("sensor").str (o.sensor);
+  j.endObject ();
+  j.key ("parameters").beginObject ();
+  j.key ("sensor").string (o.sensor);
   j.key ("sigma_a");
-  (o.sensor == "isotropic" && a.kind == InputKind::Cloud) ? j.num (o.sigma_a) : j.null ();
+  (o.sensor == "isotropic" && a.kind == InputKind::Cloud) ? j.number (o.sigma_a) : j.null ();
   j.key ("sigma_b");
-  (o.sensor == "isotropic" && b.kind == InputKind::Cloud) ? j.num (o.sigma_b) : j.null ();
+  (o.sensor == "isotropic" && b.kind == InputKind::Cloud) ? j.number (o.sigma_b) : j.null ();
   j.key ("k").integer (o.k);
-  j.key ("thresholds").beginArray ().num (o.free_below).num (o.collision_above).endArray ();
-  j.key ("traversal").str (o.stochastic ? "stochastic" : "deterministic");
-  j.key ("positions").str (o.measured ? "measured" : "projected");
-  j.key ("seed").count (o.seed);
+  j.key ("thresholds").numbers ({o.free_below, o.collision_above});
+  j.key ("traversal").string (o.stochastic ? "stochastic" : "deterministic");
+  j.key ("positions").string (o.measured ? "measured" : "projected");
+  j.key ("seed").unsignedInteger (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);
-  j.key ("sigma_max").num (hierarchy.sigma_max);
-  j.key ("epsilon").num (hierarchy.epsilon);
-  j.key ("split").str (o.split);
-  j.end ();
+  j.key ("sigma_max").number (hierarchy.sigma_max);
+  j.key ("epsilon").number (hierarchy.epsilon);
+  j.key ("split").string (o.split);
+  j.endObject ();
   if (o.output)
   {
-    j.key ("output").begin ();
-    j.key ("path").str (*o.output);
-    j.key ("points").count (points_written);
-    j.end ();
+    j.key ("output").beginObject ();
+    j.key ("path").string (*o.output);
+    j.key ("points").unsignedInteger (points_written);
+    j.endObject ();
   }
-  j.end ();
+  j.endObject ();
   return j.text ();
 }
 

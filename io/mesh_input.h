@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-// Triangle-mesh input of pcd_collision. Loading goes through PCL's VTK readers
-// (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its headers are heavy.
+// Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. Loading goes
+// through PCL's VTK readers (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its
+// headers are heavy. The namespace is still the tool's, where this code started.
 
 #include <array>
 #include <string>
