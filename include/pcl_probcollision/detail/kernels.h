@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The hot loops of the classifier: O(n) per Newton step of the linear rung, O(n D) per L-BFGS
-// step of the random Fourier feature rung. Defined in src/robust_classifier.cpp, where GCC on
+// step of the random Fourier feature rung. Defined in src/detail/kernels.cpp, where GCC on
 // x86-64 compiles them for AVX-512, AVX2 + FMA and baseline SSE2 and picks one at load time
 // (target_clones): the project builds with plain -O2, and these loops are nearly all of the
 // cost. Clones differ only in rounding (FMA contraction), at the ulp level.
