@@ -3,27 +3,74 @@
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/common/io.h>
+#include <pcl/console/print.h>
 #include <pcl/conversions.h>
 #include <pcl/io/vtk_lib_io.h>
 #include <pcl/point_types.h>
 
 #include <vtkObject.h>
+#include <vtkOutputWindow.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
+#include <mutex>
 
 namespace pcd_collision
 {
+namespace
+{
+std::once_flag g_vtk_messages_set;
+std::atomic<bool> g_vtk_messages{false};
+
+void
+applyVtkMessages (bool enabled)
+{
+  g_vtk_messages = enabled;
+  // The warning/error macros check the global flag; the output window covers direct calls.
+  vtkObject::SetGlobalWarningDisplay (enabled ? 1 : 0);
+  vtkOutputWindow::GetInstance ()->SetDisplayMode (enabled ? vtkOutputWindow::DEFAULT : vtkOutputWindow::NEVER);
+}
+
+/** \brief Silences PCL's console for its lifetime, unless setVtkMessages (true) asked for the
+  * readers' messages: pcl::io::vtk2mesh reports a failed VTK read with PCL_ERROR. */
+class QuietPclConsole
+{
+public:
+  QuietPclConsole () : level_ (pcl::console::getVerbosityLevel ()), quiet_ (!g_vtk_messages)
+  {
+    if (quiet_)
+      pcl::console::setVerbosityLevel (pcl::console::L_ALWAYS);
+  }
+  ~QuietPclConsole ()
+  {
+    if (quiet_)
+      pcl::console::setVerbosityLevel (level_);
+  }
+  QuietPclConsole (const QuietPclConsole&) = delete;
+  QuietPclConsole& operator= (const QuietPclConsole&) = delete;
+
+private:
+  pcl::console::VERBOSITY_LEVEL level_;
+  bool quiet_;
+};
+} // namespace
+
 void
 setVtkMessages (bool enabled)
 {
-  vtkObject::SetGlobalWarningDisplay (enabled ? 1 : 0);
+  std::call_once (g_vtk_messages_set, [] {});  // an explicit choice: the loader keeps it
+  applyVtkMessages (enabled);
 }
 
 bool
 loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& error)
 {
+  // VTK is silent unless a caller asked otherwise first: the reason returned in `error` is the
+  // one report of a bad file, in every program that loads meshes.
+  std::call_once (g_vtk_messages_set, [] { applyVtkMessages (false); });
+  const QuietPclConsole quiet;
   mesh = TriangleMesh ();
   std::string ext = path.substr (path.find_last_of ('.') == std::string::npos ? path.size ()
                                                                                : path.find_last_of ('.') + 1);

@@ -20,9 +20,13 @@ struct TriangleMesh
 
 /** \brief Loads a .ply, .obj, .stl or .vtk mesh (extension case-insensitive). False with a
   * reason in error (naming the file) when the file cannot be read, has no vertex or no triangle,
-  * or refers to a missing vertex. Triangles with a non-finite vertex are dropped. */
+  * or refers to a missing vertex. Triangles with a non-finite vertex are dropped.
+  *
+  * The readers print nothing: the first call silences VTK's warnings and output window for the
+  * whole process (unless setVtkMessages() chose first), and PCL's console during the read. */
 bool loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& error);
 
-/** \brief Silences (or restores) VTK's own warning and error windows. */
+/** \brief Shows (true) or silences (false, the default) the messages of VTK and of PCL's VTK
+  * bridge, process-wide, for every later load (pcd_collision -v shows them). */
 void setVtkMessages (bool enabled);
 } // namespace pcd_collision

@@ -450,11 +450,12 @@ run (int argc, char** argv)
     throw Failure{kUsageError, parsed.error};
   const Options& o = parsed.options;
 
-  if (!o.verbose)
-  {
+  // PCL's and VTK's own messages would repeat our one-line errors; -v shows them (the mesh
+  // loader keeps VTK silent by default).
+  if (o.verbose)
+    setVtkMessages (true);
+  else
     pcl::console::setVerbosityLevel (pcl::console::L_ALWAYS);
-    setVtkMessages (false);
-  }
   FILE* const log = stderr;                           // progress and stage lines
   FILE* const human = o.json ? stderr : stdout;       // the summary
 

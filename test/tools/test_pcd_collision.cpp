@@ -561,6 +561,31 @@ TEST_F (PcdCollisionTool, MeshFormatsAndDensity)
   EXPECT_NEAR (mm[0]["inputs"]["a"]["spacing"].number, 0.01 * std::sqrt (0.12 * 0.12 + 0.03 * 0.03 + 0.08 * 0.08), 1e-6);
 }
 
+// A normal run prints its stage lines on stderr and nothing else: no VTK or PCL warning.
+TEST_F (PcdCollisionTool, NormalRunsPrintOnlyStageLinesOnStderr)
+{
+  writeFile (dir_ / "quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                "0 0 0\n0.1 0 0\n0.1 0.1 0\n0 0.1 0\n4 0 1 2 3\n");
+  writeFile (dir_ / "quad.vtk", "# vtk DataFile Version 3.0\nquad\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+                                "0 0 0 0.1 0 0 0.1 0.1 0 0 0.1 0\nPOLYGONS 1 5\n4 0 1 2 3\n");
+  for (const fs::path& a : {kGripper, dir_ / "quad.ply", dir_ / "quad.vtk"})
+  {
+    SCOPED_TRACE (a.string ());
+    const ToolRun r = run ({a.string (), kScene.string (), "-pose", "0,0,0.3,0,0,0"});
+    ASSERT_EQ (r.status, 0) << r.err;
+    for (std::string l : lines (r.err))
+    {
+      EXPECT_TRUE (l.rfind ("Loading ", 0) == 0 || l.rfind ("Sampling ", 0) == 0) << l;
+      for (const std::string& path : {a.string (), kScene.string ()})
+        for (std::size_t at = l.find (path); at != std::string::npos; at = l.find (path))
+          l.erase (at, path.size ());
+      EXPECT_EQ (lowercase (l).find ("vtk"), std::string::npos) << l;
+      EXPECT_EQ (lowercase (l).find ("warn"), std::string::npos) << l;
+    }
+  }
+}
+
 TEST_F (PcdCollisionTool, StochasticTraversalIsSeeded)
 {
   const std::vector<std::string> base = {kGripper.string (), kScene.string (), "-pose", "-0.15,0.05,-0.01,0,0,0",

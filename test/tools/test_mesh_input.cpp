@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Mesh loading of io/ on its own, as the evaluation and the benchmarks call it (no CLI around).
+
+#include "mesh_input.h"
+#include "test_files.h"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+using pcd_collision::TriangleMesh;
+
+namespace
+{
+/** \brief Everything written to file descriptor 2 while `f` runs (VTK writes there directly,
+  * bypassing std::cerr). */
+template <typename F>
+std::string
+captureStderr (const fs::path& file, F&& f)
+{
+  std::fflush (stderr);
+  const int saved = ::dup (2);
+  const int fd = ::open (file.c_str (), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ::dup2 (fd, 2);
+  ::close (fd);
+  f ();
+  std::fflush (stderr);
+  ::dup2 (saved, 2);
+  ::close (saved);
+  return test_files::readFile (file);
+}
+
+std::string
+lowercase (std::string s)
+{
+  std::transform (s.begin (), s.end (), s.begin (), [] (unsigned char c) { return static_cast<char> (std::tolower (c)); });
+  return s;
+}
+
+class MeshInput : public ::testing::Test
+{
+protected:
+  void SetUp () override
+  {
+    dir_ = fs::path (TEST_WORK_DIR) / ("mesh_input_" + std::string (::testing::UnitTest::GetInstance ()->current_test_info ()->name ()));
+    fs::remove_all (dir_);
+    fs::create_directories (dir_);
+  }
+  fs::path dir_;
+};
+} // namespace
+
+// VTK's readers report unreadable files through their own output window; the loader silences it,
+// so that its false-with-a-reason is the only report, whoever calls it.
+TEST_F (MeshInput, VtkPrintsNothing)
+{
+  test_files::writeFile (dir_ / "junk.ply", "not a ply file\n");
+  test_files::writeFile (dir_ / "junk.stl", "solid x\n");
+  test_files::writeFile (dir_ / "quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  for (const char* name : {"junk.ply", "junk.stl", "quad.obj"})
+  {
+    SCOPED_TRACE (name);
+    TriangleMesh mesh;
+    std::string error;
+    bool ok = false;
+    const std::string err = captureStderr (dir_ / "stderr", [&] { ok = pcd_collision::loadTriangleMesh ((dir_ / name).string (), mesh, error); });
+    EXPECT_EQ (ok, std::string (name) == "quad.obj") << error;
+    EXPECT_EQ (lowercase (err).find ("vtk"), std::string::npos) << err;
+    EXPECT_EQ (lowercase (err).find ("warn"), std::string::npos) << err;
+    if (!ok)
+    {
+      EXPECT_NE (error.find (name), std::string::npos) << error;
+    }
+    else
+    {
+      EXPECT_EQ (mesh.triangles.size (), 2u);  // the quad, fan-triangulated
+    }
+  }
+}
