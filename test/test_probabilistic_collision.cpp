@@ -10,22 +10,35 @@
 
 #include <gtest/gtest.h>
 
+#include "result_checks.h"
+#include "sanitized_build.h"
 #include "scenes.h"
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
-#include <thread>
+#include <vector>
 
 using namespace pcl_probcollision;
+using pcl_probcollision_test::expectSameResult;
 using pcl_probcollision_test::organizedPatch;
+using pcl_probcollision_test::patchWithHole;
+using pcl_probcollision_test::poseSweep;
 using pcl_probcollision_test::randomAxisAnglePose;
+using pcl_probcollision_test::verdictCounts;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
 {
+#ifdef PCL_PC_SANITIZED
+constexpr int kPoses = 9;  // instrumented code is 10-50x slower; still three poses per thread
+#else
+constexpr int kPoses = 30;
+#endif
+
 CollisionResult
 query (const Cloud::Ptr& a, const Cloud::Ptr& b, double sigma,
        const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity (), CollisionRequest request = CollisionRequest ())
@@ -166,45 +179,69 @@ TEST (ProbabilisticCollision, StochasticTraversalRepeatsWithTheSameSeed)
   EXPECT_EQ (first.bv_tests, second.bv_tests);
 }
 
-TEST (ProbabilisticCollision, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
+TEST (ProbabilisticCollision, ConcurrentComputeBatchEqualsComputePoseByPose)
 {
-  ProbabilisticCollision<pcl::PointXYZ> pc;
-  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.001, 12));
-  pc.setTargetCloud (organizedPatch (0.2, 0.01, 0.0, 0.001, 13));
-  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
-  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
-  CollisionResult warmup;
-  ASSERT_TRUE (pc.compute (warmup));
-  const auto a = pc.getInputModel ();
-  const auto b = pc.getTargetModel ();
-  CollisionRequest request;
-  request.exhaustive = true;
-  const RobustClassifier classifier (request.classifier);
-  std::mt19937 rng (14);
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < 16; ++i)
-    poses.push_back (randomAxisAnglePose (rng, 0.03));
-  std::vector<double> serial (poses.size ()), parallel (poses.size (), -1.0);
+  // A lies 0.5 m off in its own frame and the poses bring it onto B: a witness of A reported in
+  // A's frame instead of B's would be far from B's patch.
+  const Eigen::Vector3d offset (0.5, -0.3, 0.0);
+  const auto input = patchWithHole (12, 0.008, offset, 13);
+  const auto target = patchWithHole (16, 0.008, Eigen::Vector3d::Zero (), 14);
+  auto configure = [&] (ProbabilisticCollision<pcl::PointXYZ>& pc) {
+    pc.setInputCloud (input);
+    pc.setTargetCloud (target);
+    pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+    pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+    CollisionRequest request;
+    request.per_point = true;
+    request.exhaustive = true;
+    pc.setRequest (request);
+  };
+  std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 15);
+  for (Eigen::Isometry3d& pose : poses)
+    pose = pose * Eigen::Translation3d (-offset);
+  poses[1].translation ().x () = std::numeric_limits<double>::infinity ();
+  poses[4].linear () = Eigen::Matrix3d (Eigen::Vector3d (1.0, 1.0, -1.0).asDiagonal ());  // a reflection
+
+  ProbabilisticCollision<pcl::PointXYZ> one_by_one;
+  configure (one_by_one);
+  std::vector<CollisionResult> single (poses.size ());
   for (std::size_t i = 0; i < poses.size (); ++i)
+    EXPECT_EQ (one_by_one.compute (poses[i], single[i]), i != 1 && i != 4) << i << ": " << single[i].message;
+  const std::vector<int> counts = verdictCounts (single);
+  EXPECT_GT (counts[static_cast<int> (Verdict::Free)], 0);
+  EXPECT_GT (counts[static_cast<int> (Verdict::InContact)] + counts[static_cast<int> (Verdict::InCollision)], 0);
+
+  for (const int threads : {1, 2})
   {
-    CollisionResult r;
-    ASSERT_TRUE (collide (*a, *b, poses[i], request, r, &classifier));
-    serial[i] = r.probability;
-  }
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 4; ++t)
-    threads.emplace_back ([&, t] () {
-      for (std::size_t i = t; i < poses.size (); i += 4)
+    ProbabilisticCollision<pcl::PointXYZ> batched;
+    configure (batched);
+    std::vector<CollisionResult> batch;
+    EXPECT_FALSE (batched.computeBatch (poses, batch, threads));
+    ASSERT_EQ (batch.size (), poses.size ());
+    for (std::size_t i = 0; i < poses.size (); ++i)
+    {
+      CollisionResult want = single[i];
+      if (!want.ok ())
+        want.message = "pose " + std::to_string (i) + ": " + want.message;
+      expectSameResult (want, batch[i], "threads " + std::to_string (threads) + ", pose " + std::to_string (i));
+      if (!batch[i].ok ())
+        continue;
+      // Per-point values on the callers' clouds (the NaN point stays NaN), skipped points counted.
+      ASSERT_EQ (batch[i].probabilities_a.size (), input->size ());
+      ASSERT_EQ (batch[i].probabilities_b.size (), target->size ());
+      EXPECT_TRUE (std::isnan (batch[i].probabilities_a[13]));
+      EXPECT_TRUE (std::isnan (batch[i].probabilities_b[17]));
+      EXPECT_EQ (batch[i].points_skipped_nonfinite, 2u);
+      // The witness is in the target's frame: on or near B's patch (16 x 8 mm wide, at z = 0).
+      if (batch[i].witness_side != 0)
       {
-        CollisionResult r;
-        if (collide (*a, *b, poses[i], request, r, &classifier))
-          parallel[i] = r.probability;
+        EXPECT_LT (batch[i].witness_point.head<2> ().cwiseAbs ().maxCoeff (), 0.08) << batch[i].witness_point.transpose ();
+        EXPECT_LT (std::abs (batch[i].witness_point.z ()), 0.03) << batch[i].witness_point.transpose ();
       }
-    });
-  for (auto& th : threads)
-    th.join ();
-  for (std::size_t i = 0; i < poses.size (); ++i)
-    EXPECT_EQ (serial[i], parallel[i]) << i;
+    }
+    EXPECT_NE (batch[4].message.find ("pose 4: "), std::string::npos) << batch[4].message;
+    EXPECT_TRUE (batched.getInputModel () && batched.getTargetModel ());
+  }
 }
 
 TEST (ProbabilisticCollision, FilterKeepsThePointsNearTheTarget)

@@ -12,7 +12,6 @@
 
 #include "sanitized_build.h"
 #include "scenes.h"
-#include "seeded_draws.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,15 +19,12 @@
 #include <limits>
 #include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <unistd.h>
 
 using namespace pcl_probcollision;
-using pcl_probcollision_test::draw3;
 using pcl_probcollision_test::patch;
-using pcl_probcollision_test::randomSheet;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
@@ -36,11 +32,9 @@ namespace
 // Sanitized builds (CI's ASan and TSan steps) run smaller workloads of the same tests: the
 // contracts are the same, instrumented code is 10-50x slower.
 #ifdef PCL_PC_SANITIZED
-constexpr int kConcurrentPoses = 8;  // still one per thread
 constexpr std::size_t kBatchPoses = 12000;
 constexpr double kFarPatch = 0.5;  // side of the far-from-the-origin patch, metres
 #else
-constexpr int kConcurrentPoses = 48;
 constexpr std::size_t kBatchPoses = 100000;
 constexpr double kFarPatch = 1.0;
 #endif
@@ -393,110 +387,6 @@ TEST (Reliability, FarFromTheOriginGivesTheSameAnswerAsAtTheOrigin)
   }
 }
 
-// The core in double: collide() on hierarchies of noisy sheets, then the same sheets moved by 1e5.
-TEST (Reliability, CollideIsStableUnderATranslationBy1e5)
-{
-  const Eigen::Vector3d offset (1e5, 1e5, -1e5);
-  CollisionRequest rq;
-  rq.exhaustive = true;
-  for (const double gap : {0.02, 0.003, 0.0})
-  {
-    SCOPED_TRACE (gap);
-    const CloudModel a0 (randomSheet (400, 0.2, 0.0, 0.002, 12));
-    const CloudModel b0 (randomSheet (400, 0.2, gap, 0.002, 13));
-    const CloudModel a1 (randomSheet (400, 0.2, 0.0, 0.002, 12, offset));
-    const CloudModel b1 (randomSheet (400, 0.2, gap, 0.002, 13, offset));
-    CollisionResult r0, r1;
-    ASSERT_TRUE (collide (a0, b0, Eigen::Isometry3d::Identity (), rq, r0)) << r0.message;
-    ASSERT_TRUE (collide (a1, b1, Eigen::Isometry3d::Identity (), rq, r1)) << r1.message;
-    expectSane (r0, true, rq);
-    expectSane (r1, true, rq);
-    EXPECT_NEAR (r0.probability, r1.probability, 1e-6);
-    EXPECT_EQ (r0.verdict, r1.verdict);
-  }
-}
-
-// Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
-// so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
-TEST (Reliability, SkippingDominatedPairsKeepsProbabilityAndWitness)
-{
-  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 31));
-  std::size_t fewer = 0;
-  for (const double gap : {0.03, 0.008, 0.004, 0.0})
-  {
-    SCOPED_TRACE (gap);
-    const CloudModel b (randomSheet (600, 0.2, gap, 0.002, 32));
-    for (const double tilt : {0.0, 0.2})
-    {
-      const Eigen::Isometry3d T (Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ()));
-      CollisionRequest full, lean;
-      full.per_point = true;  // every reachable leaf pair
-      lean.per_point = false;
-      CollisionResult rf, rl;
-      ASSERT_TRUE (collide (a, b, T, full, rf)) << rf.message;
-      ASSERT_TRUE (collide (a, b, T, lean, rl)) << rl.message;
-      EXPECT_EQ (rf.probability, rl.probability);
-      EXPECT_EQ (rf.verdict, rl.verdict);
-      EXPECT_EQ (rf.witness_side, rl.witness_side);
-      EXPECT_EQ (rf.witness_index, rl.witness_index);
-      EXPECT_LE (rl.leaf_pairs_tested, rf.leaf_pairs_tested);
-      fewer += rl.leaf_pairs_tested < rf.leaf_pairs_tested;
-    }
-  }
-  EXPECT_GT (fewer, 0u) << "no query was cheaper without per-point values";
-}
-
-// CollisionRequest::defer_kernel_fits: the same P whenever the query does not stop early, the
-// same verdict always, fewer kernel fits; ignored with per-point values.
-TEST (Reliability, DeferredKernelFitsKeepTheAnswer)
-{
-  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 41));
-  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 42));
-  std::size_t kernel_default = 0, kernel_deferred = 0;
-  for (const double tilt : {0.0, 0.15, 0.4})
-    for (const double lift : {0.004, 0.0, -0.01})
-    {
-      SCOPED_TRACE (::testing::Message () << "tilt " << tilt << " lift " << lift);
-      const Eigen::Isometry3d T = Eigen::Translation3d (0.0, 0.0, lift) * Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ());
-      for (const bool exhaustive : {true, false})
-      {
-        CollisionRequest plain, deferring;
-        plain.exhaustive = deferring.exhaustive = exhaustive;
-        deferring.defer_kernel_fits = true;
-        CollisionResult rp, rd;
-        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
-        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
-        EXPECT_EQ (rp.verdict, rd.verdict);
-        if (!rp.lower_bound && !rd.lower_bound)
-        {
-          EXPECT_EQ (rp.probability, rd.probability);
-          EXPECT_EQ (rp.witness_index, rd.witness_index);
-        }
-        else
-          EXPECT_GT (rd.probability, plain.collision_above);
-        if (exhaustive)
-        {
-          kernel_default += rp.kernel_leaf_pairs;
-          kernel_deferred += rd.kernel_leaf_pairs;
-        }
-        // Per-point values need every pair's final fit: the option is ignored.
-        plain.per_point = deferring.per_point = true;
-        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
-        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
-        EXPECT_EQ (rp.probability, rd.probability);
-        ASSERT_EQ (rp.probabilities_a.size (), rd.probabilities_a.size ());
-        for (std::size_t i = 0; i < rp.probabilities_a.size (); ++i)
-        {
-          const float p_plain = rp.probabilities_a[i], p_deferring = rd.probabilities_a[i];
-          EXPECT_TRUE (p_plain == p_deferring || (std::isnan (p_plain) && std::isnan (p_deferring))) << i;
-        }
-        EXPECT_EQ (rp.kernel_leaf_pairs, rd.kernel_leaf_pairs);
-      }
-    }
-  EXPECT_GT (kernel_default, 0u) << "no scene needed a kernel rung: the test would prove nothing";
-  EXPECT_LE (kernel_deferred, kernel_default);
-}
-
 TEST (Reliability, ReorderingThePointsKeepsTheProbability)
 {
   CollisionRequest rq;
@@ -627,58 +517,6 @@ TEST (Reliability, NonFiniteOrNonRigidPosesFail)
 // ---------------------------------------------------------------------------------------------
 // Concurrency and load. Hierarchies are built from UncertainCloud directly (no FLANN, no
 // OpenMP), so that ThreadSanitizer sees only our code; the CI runs these under TSan.
-
-TEST (Reliability, ConcurrentQueriesOnSharedHierarchiesMatchSerialExactly)
-{
-  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 24));
-  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 25));
-  for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
-  {
-    CollisionRequest rq;
-    rq.traversal = mode;
-    rq.exhaustive = true;
-    rq.per_point = true;
-    const RobustClassifier classifier (rq.classifier);
-    std::mt19937 rng (26);
-    std::uniform_real_distribution<double> u (-1.0, 1.0);
-    std::vector<Eigen::Isometry3d> poses;
-    for (int i = 0; i < kConcurrentPoses; ++i)
-    {
-      const Eigen::Vector3d t = draw3 (u, rng).cwiseProduct (Eigen::Vector3d (0.05, 0.05, 0.01));
-      const double angle = 0.3 * u (rng);
-      const double ax = u (rng);
-      const Eigen::Vector3d axis (ax, u (rng), 1.0);
-      poses.push_back (Eigen::Translation3d (t) * Eigen::AngleAxisd (angle, axis.normalized ()));
-    }
-    std::vector<CollisionResult> serial (poses.size ()), parallel (poses.size ());
-    for (std::size_t i = 0; i < poses.size (); ++i)
-      ASSERT_TRUE (collide (a, b, poses[i], rq, serial[i], &classifier)) << serial[i].message;
-    const int threads = 8;
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-      pool.emplace_back ([&, t] () {
-        for (std::size_t i = t; i < poses.size (); i += threads)
-          collide (a, b, poses[i], rq, parallel[i], &classifier);
-      });
-    for (auto& th : pool)
-      th.join ();
-    for (std::size_t i = 0; i < poses.size (); ++i)
-    {
-      expectSane (parallel[i], true, rq);
-      EXPECT_EQ (serial[i].probability, parallel[i].probability) << i;
-      EXPECT_EQ (serial[i].verdict, parallel[i].verdict) << i;
-      EXPECT_EQ (serial[i].witness_index, parallel[i].witness_index) << i;
-      EXPECT_EQ (serial[i].leaf_pairs_tested, parallel[i].leaf_pairs_tested) << i;
-      EXPECT_EQ (serial[i].bv_tests, parallel[i].bv_tests) << i;
-      ASSERT_EQ (serial[i].probabilities_a.size (), parallel[i].probabilities_a.size ());
-      for (std::size_t k = 0; k < serial[i].probabilities_a.size (); ++k)
-      {
-        const float s = serial[i].probabilities_a[k], p = parallel[i].probabilities_a[k];
-        EXPECT_TRUE ((std::isnan (s) && std::isnan (p)) || s == p) << i << " " << k;
-      }
-    }
-  }
-}
 
 // A batch of 100,000 poses through one ProbabilisticCollision: memory does not grow per query,
 // and spot-checked results equal fresh single queries. RSS is compared between 10,000 and 100,000

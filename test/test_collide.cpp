@@ -1,0 +1,393 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// collide(), collideBatch() and verdictFor() (collision.h): the query on two CloudModel, one
+// pose at a time or many on several threads. Most models are built from UncertainCloud directly
+// (scenes.h: no FLANN, no OpenMP), so that ThreadSanitizer sees only our code; every model is
+// built before any thread starts. Tests named *Concurrent* run under ThreadSanitizer in CI
+// (scripts/ci-reliability.sh). verdictFor() is checked on every answer by expectSane().
+#include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/probabilistic_collision.h>
+
+#include <pcl/exceptions.h>
+
+#include <gtest/gtest.h>
+
+#include "result_checks.h"
+#include "sanitized_build.h"
+#include "scenes.h"
+#include "seeded_draws.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::expectSameResult;
+using pcl_probcollision_test::expectSane;
+using pcl_probcollision_test::jitteredGrid;
+using pcl_probcollision_test::organizedPatch;
+using pcl_probcollision_test::patchWithHole;
+using pcl_probcollision_test::poseSweep;
+using pcl_probcollision_test::randomAxisAnglePose;
+using pcl_probcollision_test::randomSheet;
+using pcl_probcollision_test::verdictCounts;
+
+namespace
+{
+// Sanitized builds (CI's ASan and TSan steps) run smaller workloads of the same tests: the
+// contracts are the same, instrumented code is 10-50x slower.
+#ifdef PCL_PC_SANITIZED
+constexpr int kConcurrentPoses = 8;  // still one per thread
+constexpr int kPoses = 9;            // still three poses per thread
+#else
+constexpr int kConcurrentPoses = 48;
+constexpr int kPoses = 30;
+#endif
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// collide()
+
+TEST (Collide, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
+{
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.001, 12));
+  pc.setTargetCloud (organizedPatch (0.2, 0.01, 0.0, 0.001, 13));
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+  CollisionResult warmup;
+  ASSERT_TRUE (pc.compute (warmup));
+  const auto a = pc.getInputModel ();
+  const auto b = pc.getTargetModel ();
+  CollisionRequest request;
+  request.exhaustive = true;
+  const RobustClassifier classifier (request.classifier);
+  std::mt19937 rng (14);
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 16; ++i)
+    poses.push_back (randomAxisAnglePose (rng, 0.03));
+  std::vector<double> serial (poses.size ()), parallel (poses.size (), -1.0);
+  for (std::size_t i = 0; i < poses.size (); ++i)
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*a, *b, poses[i], request, r, &classifier));
+    serial[i] = r.probability;
+  }
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back ([&, t] () {
+      for (std::size_t i = t; i < poses.size (); i += 4)
+      {
+        CollisionResult r;
+        if (collide (*a, *b, poses[i], request, r, &classifier))
+          parallel[i] = r.probability;
+      }
+    });
+  for (auto& th : threads)
+    th.join ();
+  for (std::size_t i = 0; i < poses.size (); ++i)
+    EXPECT_EQ (serial[i], parallel[i]) << i;
+}
+
+// Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
+// so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
+TEST (Collide, SkippingDominatedPairsKeepsProbabilityAndWitness)
+{
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 31));
+  std::size_t fewer = 0;
+  for (const double gap : {0.03, 0.008, 0.004, 0.0})
+  {
+    SCOPED_TRACE (gap);
+    const CloudModel b (randomSheet (600, 0.2, gap, 0.002, 32));
+    for (const double tilt : {0.0, 0.2})
+    {
+      const Eigen::Isometry3d T (Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ()));
+      CollisionRequest full, lean;
+      full.per_point = true;  // every reachable leaf pair
+      lean.per_point = false;
+      CollisionResult rf, rl;
+      ASSERT_TRUE (collide (a, b, T, full, rf)) << rf.message;
+      ASSERT_TRUE (collide (a, b, T, lean, rl)) << rl.message;
+      EXPECT_EQ (rf.probability, rl.probability);
+      EXPECT_EQ (rf.verdict, rl.verdict);
+      EXPECT_EQ (rf.witness_side, rl.witness_side);
+      EXPECT_EQ (rf.witness_index, rl.witness_index);
+      EXPECT_LE (rl.leaf_pairs_tested, rf.leaf_pairs_tested);
+      fewer += rl.leaf_pairs_tested < rf.leaf_pairs_tested;
+    }
+  }
+  EXPECT_GT (fewer, 0u) << "no query was cheaper without per-point values";
+}
+
+// CollisionRequest::defer_kernel_fits: the same P whenever the query does not stop early, the
+// same verdict always, fewer kernel fits; ignored with per-point values.
+TEST (Collide, DeferredKernelFitsKeepTheAnswer)
+{
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 41));
+  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 42));
+  std::size_t kernel_default = 0, kernel_deferred = 0;
+  for (const double tilt : {0.0, 0.15, 0.4})
+    for (const double lift : {0.004, 0.0, -0.01})
+    {
+      SCOPED_TRACE (::testing::Message () << "tilt " << tilt << " lift " << lift);
+      const Eigen::Isometry3d T = Eigen::Translation3d (0.0, 0.0, lift) * Eigen::AngleAxisd (tilt, Eigen::Vector3d::UnitX ());
+      for (const bool exhaustive : {true, false})
+      {
+        CollisionRequest plain, deferring;
+        plain.exhaustive = deferring.exhaustive = exhaustive;
+        deferring.defer_kernel_fits = true;
+        CollisionResult rp, rd;
+        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
+        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
+        EXPECT_EQ (rp.verdict, rd.verdict);
+        if (!rp.lower_bound && !rd.lower_bound)
+        {
+          EXPECT_EQ (rp.probability, rd.probability);
+          EXPECT_EQ (rp.witness_index, rd.witness_index);
+        }
+        else
+          EXPECT_GT (rd.probability, plain.collision_above);
+        if (exhaustive)
+        {
+          kernel_default += rp.kernel_leaf_pairs;
+          kernel_deferred += rd.kernel_leaf_pairs;
+        }
+        // Per-point values need every pair's final fit: the option is ignored.
+        plain.per_point = deferring.per_point = true;
+        ASSERT_TRUE (collide (a, b, T, plain, rp)) << rp.message;
+        ASSERT_TRUE (collide (a, b, T, deferring, rd)) << rd.message;
+        EXPECT_EQ (rp.probability, rd.probability);
+        ASSERT_EQ (rp.probabilities_a.size (), rd.probabilities_a.size ());
+        for (std::size_t i = 0; i < rp.probabilities_a.size (); ++i)
+        {
+          const float p_plain = rp.probabilities_a[i], p_deferring = rd.probabilities_a[i];
+          EXPECT_TRUE (p_plain == p_deferring || (std::isnan (p_plain) && std::isnan (p_deferring))) << i;
+        }
+        EXPECT_EQ (rp.kernel_leaf_pairs, rd.kernel_leaf_pairs);
+      }
+    }
+  EXPECT_GT (kernel_default, 0u) << "no scene needed a kernel rung: the test would prove nothing";
+  EXPECT_LE (kernel_deferred, kernel_default);
+}
+
+// ---------------------------------------------------------------------------------------------
+// collide() under numerical stress and concurrency (issue #7, docs/RELIABILITY.md)
+
+// The core in double: collide() on hierarchies of noisy sheets, then the same sheets moved by 1e5.
+TEST (CollideReliability, CollideIsStableUnderATranslationBy1e5)
+{
+  const Eigen::Vector3d offset (1e5, 1e5, -1e5);
+  CollisionRequest rq;
+  rq.exhaustive = true;
+  for (const double gap : {0.02, 0.003, 0.0})
+  {
+    SCOPED_TRACE (gap);
+    const CloudModel a0 (randomSheet (400, 0.2, 0.0, 0.002, 12));
+    const CloudModel b0 (randomSheet (400, 0.2, gap, 0.002, 13));
+    const CloudModel a1 (randomSheet (400, 0.2, 0.0, 0.002, 12, offset));
+    const CloudModel b1 (randomSheet (400, 0.2, gap, 0.002, 13, offset));
+    CollisionResult r0, r1;
+    ASSERT_TRUE (collide (a0, b0, Eigen::Isometry3d::Identity (), rq, r0)) << r0.message;
+    ASSERT_TRUE (collide (a1, b1, Eigen::Isometry3d::Identity (), rq, r1)) << r1.message;
+    expectSane (r0, true, rq);
+    expectSane (r1, true, rq);
+    EXPECT_NEAR (r0.probability, r1.probability, 1e-6);
+    EXPECT_EQ (r0.verdict, r1.verdict);
+  }
+}
+
+TEST (CollideReliability, ConcurrentQueriesOnSharedHierarchiesMatchSerialExactly)
+{
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 24));
+  const CloudModel b (randomSheet (600, 0.2, 0.0, 0.002, 25));
+  for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
+  {
+    CollisionRequest rq;
+    rq.traversal = mode;
+    rq.exhaustive = true;
+    rq.per_point = true;
+    const RobustClassifier classifier (rq.classifier);
+    std::mt19937 rng (26);
+    std::uniform_real_distribution<double> u (-1.0, 1.0);
+    std::vector<Eigen::Isometry3d> poses;
+    for (int i = 0; i < kConcurrentPoses; ++i)
+    {
+      const Eigen::Vector3d t = draw3 (u, rng).cwiseProduct (Eigen::Vector3d (0.05, 0.05, 0.01));
+      const double angle = 0.3 * u (rng);
+      const double ax = u (rng);
+      const Eigen::Vector3d axis (ax, u (rng), 1.0);
+      poses.push_back (Eigen::Translation3d (t) * Eigen::AngleAxisd (angle, axis.normalized ()));
+    }
+    std::vector<CollisionResult> serial (poses.size ()), parallel (poses.size ());
+    for (std::size_t i = 0; i < poses.size (); ++i)
+      ASSERT_TRUE (collide (a, b, poses[i], rq, serial[i], &classifier)) << serial[i].message;
+    const int threads = 8;
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t)
+      pool.emplace_back ([&, t] () {
+        for (std::size_t i = t; i < poses.size (); i += threads)
+          collide (a, b, poses[i], rq, parallel[i], &classifier);
+      });
+    for (auto& th : pool)
+      th.join ();
+    for (std::size_t i = 0; i < poses.size (); ++i)
+    {
+      expectSane (parallel[i], true, rq);
+      EXPECT_EQ (serial[i].probability, parallel[i].probability) << i;
+      EXPECT_EQ (serial[i].verdict, parallel[i].verdict) << i;
+      EXPECT_EQ (serial[i].witness_index, parallel[i].witness_index) << i;
+      EXPECT_EQ (serial[i].leaf_pairs_tested, parallel[i].leaf_pairs_tested) << i;
+      EXPECT_EQ (serial[i].bv_tests, parallel[i].bv_tests) << i;
+      ASSERT_EQ (serial[i].probabilities_a.size (), parallel[i].probabilities_a.size ());
+      for (std::size_t k = 0; k < serial[i].probabilities_a.size (); ++k)
+      {
+        const float s = serial[i].probabilities_a[k], p = parallel[i].probabilities_a[k];
+        EXPECT_TRUE ((std::isnan (s) && std::isnan (p)) || s == p) << i << " " << k;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// collideBatch() (issue #8): every pose answered exactly as the single query does, whatever the
+// thread count
+
+TEST (CollideBatch, ConcurrentBatchEqualsSingleQueriesForEveryModeAndThreadCount)
+{
+  const CloudModel a (jitteredGrid (20, 0.005, 0.001, 1));
+  const CloudModel b (jitteredGrid (24, 0.005, 0.001, 2));
+  const std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 3);
+  for (const TraversalMode mode : {TraversalMode::ExpectedWeight, TraversalMode::Stochastic, TraversalMode::ExpandedBV})
+  {
+    CollisionRequest request;
+    request.traversal = mode;
+    request.seed = 77;
+    request.exhaustive = true;
+    request.per_point = true;
+    // The reference: one collide() per pose, each drawing its own classifier.
+    std::vector<CollisionResult> single (poses.size ());
+    for (std::size_t i = 0; i < poses.size (); ++i)
+      ASSERT_TRUE (collide (a, b, poses[i], request, single[i])) << single[i].message;
+    const std::vector<int> counts = verdictCounts (single);
+    EXPECT_GT (counts[static_cast<int> (Verdict::Free)], 0);
+    EXPECT_GT (counts[static_cast<int> (Verdict::InContact)] + counts[static_cast<int> (Verdict::InCollision)], 0);
+    for (const int threads : {1, 2, 3})
+    {
+      std::vector<CollisionResult> batch;
+      EXPECT_TRUE (collideBatch (a, b, poses, request, batch, threads));
+      ASSERT_EQ (batch.size (), poses.size ());
+      for (std::size_t i = 0; i < poses.size (); ++i)
+      {
+        ASSERT_EQ (batch[i].probabilities_a.size (), a.size ());
+        expectSameResult (single[i], batch[i],
+                          "mode " + std::to_string (static_cast<int> (mode)) + ", threads " + std::to_string (threads) +
+                              ", pose " + std::to_string (i));
+      }
+    }
+  }
+}
+
+TEST (CollideBatch, ConcurrentBatchWithBadPosesFailsThemAndAnswersTheOthers)
+{
+  const CloudModel a (jitteredGrid (16, 0.005, 0.001, 4));
+  const CloudModel b (jitteredGrid (16, 0.005, 0.001, 5));
+  std::vector<Eigen::Isometry3d> poses = poseSweep (8, 6);
+  poses[2].translation ().y () = std::numeric_limits<double>::quiet_NaN ();
+  poses[5].linear () *= 1.5;
+  CollisionRequest request;
+  request.per_point = true;
+  const RobustClassifier classifier (request.classifier);
+  std::vector<CollisionResult> batch (3);  // stale content is replaced
+  EXPECT_FALSE (collideBatch (a, b, poses, request, batch, 2, &classifier));
+  ASSERT_EQ (batch.size (), poses.size ());
+  for (std::size_t i = 0; i < poses.size (); ++i)
+  {
+    CollisionResult single;
+    const bool ok = collide (a, b, poses[i], request, single, &classifier);
+    EXPECT_EQ (ok, i != 2 && i != 5) << i;
+    if (!ok)
+    {
+      EXPECT_EQ (batch[i].status, CollisionResult::Status::InvalidInput) << i;
+      EXPECT_NE (batch[i].message.find ("pose"), std::string::npos) << batch[i].message;
+      EXPECT_TRUE (std::isnan (batch[i].probability)) << i;
+      EXPECT_EQ (batch[i].verdict, Verdict::Unknown) << i;
+    }
+    else
+    {
+      EXPECT_TRUE (batch[i].ok ()) << i << ": " << batch[i].message;
+    }
+    expectSameResult (single, batch[i], "pose " + std::to_string (i));
+  }
+}
+
+TEST (CollideBatch, NegativeThreadCountThrowsNamingIt)
+{
+  const CloudModel a (jitteredGrid (4, 0.01, 0.001, 7));
+  const std::vector<Eigen::Isometry3d> poses (2, Eigen::Isometry3d::Identity ());
+  std::vector<CollisionResult> results;
+  try
+  {
+    collideBatch (a, a, poses, CollisionRequest (), results, -1);
+    FAIL () << "threads = -1 accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    const std::string what = e.what ();
+    EXPECT_NE (what.find ("threads"), std::string::npos) << what;
+    EXPECT_NE (what.find ("-1"), std::string::npos) << what;
+  }
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (patchWithHole (4, 0.01, Eigen::Vector3d::Zero (), 8));
+  pc.setTargetCloud (patchWithHole (4, 0.01, Eigen::Vector3d::Zero (), 9));
+  try
+  {
+    pc.computeBatch (poses, results, -3);
+    FAIL () << "threads = -3 accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    const std::string what = e.what ();
+    EXPECT_NE (what.find ("threads = -3"), std::string::npos) << what;
+  }
+}
+
+TEST (CollideBatch, EmptyPoseListGivesNoResults)
+{
+  const CloudModel a (jitteredGrid (4, 0.01, 0.001, 10));
+  std::vector<CollisionResult> results (5);
+  EXPECT_TRUE (collideBatch (a, a, {}, CollisionRequest (), results));
+  EXPECT_TRUE (results.empty ());
+  ProbabilisticCollision<pcl::PointXYZ> pc;  // no clouds: nothing to answer, nothing fails
+  results.resize (2);
+  EXPECT_TRUE (pc.computeBatch ({}, results, 2));
+  EXPECT_TRUE (results.empty ());
+}
+
+TEST (CollideBatch, InvalidRequestOrPoseFailsEveryPoseLikeCollide)
+{
+  const CloudModel a (jitteredGrid (6, 0.01, 0.001, 11));
+  std::vector<Eigen::Isometry3d> poses = poseSweep (4, 12);
+  CollisionRequest bad;
+  bad.rho_min = 2.0;
+  for (const bool bad_pose : {false, true})
+  {
+    const CollisionRequest& request = bad_pose ? CollisionRequest () : bad;
+    if (bad_pose)
+      for (Eigen::Isometry3d& T : poses)
+        T.linear () *= 2.0;  // a scale, not a rotation
+    const CloudModel& b = a;
+    std::vector<CollisionResult> batch;
+    EXPECT_FALSE (collideBatch (a, b, poses, request, batch, 2));
+    ASSERT_EQ (batch.size (), poses.size ());
+    for (std::size_t i = 0; i < poses.size (); ++i)
+    {
+      CollisionResult single;
+      EXPECT_FALSE (collide (a, b, poses[i], request, single));
+      EXPECT_FALSE (batch[i].message.empty ());
+      expectSameResult (single, batch[i], "pose " + std::to_string (i));
+    }
+  }
+}
