@@ -250,22 +250,28 @@ parseCommandLine (const std::vector<std::string>& args)
 
   for (std::size_t i = 0; i < args.size (); ++i)
   {
-    const std::string& a = args[i];
-    if (only_positional || a.empty () || a[0] != '-' || a == "-")
+    const std::string& arg = args[i];
+    if (only_positional || arg.empty () || arg[0] != '-' || arg == "-")
     {
-      positional.push_back (a);
+      positional.push_back (arg);
       continue;
     }
-    if (a == "--")
+    if (arg == "--")
     {
       only_positional = true;
       continue;
     }
+    // -name=value is -name value (split at the first '=', so a value may hold more).
+    const std::size_t eq = arg.find ('=');
+    const std::string a = arg.substr (0, eq);
+    const bool inline_value = eq != std::string::npos;
     const bool takes_value = kValueFlags.count (a) > 0;
     if (!takes_value && kSwitchFlags.count (a) == 0)
       return usage ("unknown option '" + a + "' (see -h)");
     if (!seen.insert (a).second)
       return usage ("option " + a + " given more than once");
+    if (!takes_value && inline_value)
+      return usage ("option " + a + " takes no value");
     if (!takes_value)
     {
       if (a == "-deterministic")
@@ -282,9 +288,9 @@ parseCommandLine (const std::vector<std::string>& args)
         o.verbose = true;
       continue;
     }
-    if (i + 1 >= args.size ())
+    if (!inline_value && i + 1 >= args.size ())
       return usage ("option " + a + " needs a value (see -h)");
-    const std::string v = args[++i];
+    const std::string v = inline_value ? arg.substr (eq + 1) : args[++i];
     const std::string bad = "option " + a + ": '" + v + "' ";
 
     auto nonNegative = [&] (std::optional<double>& out) -> std::optional<ParseResult> {
@@ -443,6 +449,7 @@ helpText ()
        "  <a>, <b>   a .pcd point cloud with x y z fields (any point type; organized clouds and NaN\n"
        "             points are fine) or a triangle mesh .ply .obj .stl .vtk. <a> is moved by the pose,\n"
        "             <b> stays where it is. Both must be in the same units.\n"
+       "  An option's value is the next argument or follows '=': -k 20 or -k=20.\n"
        "\n"
        "Pose of <a> (p' = Rz(yaw) Ry(pitch) Rx(roll) p + t; data units and radians):\n"
        "  -pose tx,ty,tz,roll,pitch,yaw   = 0,0,0,0,0,0\n"

@@ -91,9 +91,10 @@ struct ParseResult
   std::string error;
 };
 
-/** \brief Parses argv[1..argc-1]. Strict: unknown flags, missing or malformed values, values
-  * out of range, repeated flags, conflicting flags and a wrong number of positional arguments
-  * are usage errors naming the flag or argument. */
+/** \brief Parses argv[1..argc-1]. A flag's value is the next argument or follows '='
+  * (-pose 0,0,1,0,0,0 or -pose=0,0,1,0,0,0). Strict: unknown flags, missing or malformed values,
+  * values out of range, repeated flags, conflicting flags and a wrong number of positional
+  * arguments are usage errors naming the flag or argument. */
 ParseResult parseCommandLine (const std::vector<std::string>& args);
 ParseResult parseCommandLine (int argc, const char* const* argv);
 

@@ -158,6 +158,47 @@ TEST (CliOptions, FlagsAndPositionals)
   EXPECT_EQ (parse ({"-sensor", "kinect"}).options.sensor, "kinect");
 }
 
+TEST (CliOptions, NameEqualsValue)
+{
+  // Every value flag takes -name=value as it takes -name value, with the same checks.
+  const std::vector<std::string> separate = {"-pose", "1,2,3,0.1,-0.2,0.3", "-sigma", "0.01", "-sigma_b", "0.02",
+                                             "-k", "7", "-thresholds", "0.2,0.8", "-seed", "9", "-nmax", "5",
+                                             "-sigma_max", "0.1", "-epsilon", "0", "-split", "octree",
+                                             "-mesh_density", "0.004", "-o", "out.pcd"};
+  std::vector<std::string> joined;
+  for (std::size_t i = 0; i < separate.size (); i += 2)
+    joined.push_back (separate[i] + "=" + separate[i + 1]);
+  const ParseResult s = parse (separate), j = parse (joined);
+  ASSERT_EQ (s.kind, Kind::Run) << s.error;
+  ASSERT_EQ (j.kind, Kind::Run) << j.error;
+  EXPECT_EQ (*j.options.pose, *s.options.pose);
+  EXPECT_EQ (j.options.sigma_a, 0.01);
+  EXPECT_EQ (j.options.sigma_b, 0.02);
+  EXPECT_EQ (j.options.k, 7);
+  EXPECT_EQ (j.options.collision_above, 0.8);
+  EXPECT_EQ (j.options.seed, 9u);
+  EXPECT_EQ (j.options.n_max, 5);
+  EXPECT_EQ (j.options.sigma_max, 0.1);
+  EXPECT_EQ (j.options.split, "octree");
+  EXPECT_EQ (*j.options.mesh_spacing, 0.004);
+  EXPECT_EQ (*j.options.output, "out.pcd");
+  const ParseResult sensor = parse ({"-sensor=kinect", "-poses=dir/a=b.txt"});
+  ASSERT_EQ (sensor.kind, Kind::Run) << sensor.error;
+  EXPECT_EQ (sensor.options.sensor, "kinect");
+  EXPECT_EQ (*sensor.options.poses_file, "dir/a=b.txt");  // split at the first '='
+  EXPECT_EQ ((*parse ({"-pose=-1,-2,-3,0,0,0"}).options.pose)[2], -3.0);
+
+  expectUsageError ({"-sigma="}, "-sigma");
+  expectUsageError ({"-sigma=1O"}, "-sigma");
+  expectUsageError ({"-k=0"}, "-k");
+  expectUsageError ({"-pose=0,0,0,0,0"}, "-pose");
+  expectUsageError ({"-poses="}, "-poses");
+  expectUsageError ({"-sigm=0.1"}, "unknown option '-sigm'");
+  expectUsageError ({"-json=1"}, "-json takes no value");
+  expectUsageError ({"-sigma=0.1", "-sigma", "0.2"}, "more than once");
+  expectUsageError ({"-sensor=kinect", "-sigma=0.01"}, "-sigma");
+}
+
 TEST (CliOptions, InputKinds)
 {
   EXPECT_EQ (inputKindOf ("x.pcd"), InputKind::Cloud);
