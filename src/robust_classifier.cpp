@@ -8,10 +8,10 @@
 #include <pcl_probcollision/detail/rff_features.h>
 #include <pcl_probcollision/detail/separator_fit.h>
 #include <pcl_probcollision/detail/separator_problem.h>
+#include <pcl_probcollision/normalization.h>
 
 #include <pcl/exceptions.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -78,6 +78,52 @@ checkSide (const PointSetView& side, const char* name, ClassifierResult& result)
     return false;
   }
   return true;
+}
+
+/** \brief The two-class problem of METHOD.md 5.1 in the unit cube: A's points (label +1) then
+  * B's, mapped by to_cube, with class-balanced weights C_i = C n / (2 n_{c_i}).
+  * \return false when some input mean or covariance entry is not finite (p is then unusable):
+  *         the check costs nothing in this pass, a pass of its own would. */
+bool
+makeProblem (const PointSetView& a, const PointSetView& b, const UnitCubeTransform& transform,
+             double C, detail::SeparatorProblem& p)
+{
+  // a local copy, which no store below can alias, so that its entries stay in registers
+  const UnitCubeTransform to_cube = transform;
+  // stays 0 unless an entry is inf or NaN (or a covariance's entries sum past the double range)
+  double finite_check = 0.0;
+  const std::size_t n = a.size + b.size;
+  p.n = static_cast<Eigen::Index> (n);
+  p.n_a = static_cast<Eigen::Index> (a.size);
+  for (Eigen::ArrayXd* array : {&p.x, &p.y, &p.z, &p.sxx, &p.sxy, &p.sxz, &p.syy, &p.syz, &p.szz, &p.label, &p.weight})
+    array->resize (p.n);
+  Eigen::Index k = 0;
+  for (const PointSetView* side : {&a, &b})
+  {
+    const double label = side == &a ? 1.0 : -1.0;
+    // each cloud carries half of the total weight
+    const double weight = C * static_cast<double> (n) / (2.0 * static_cast<double> (side->size));
+    for (std::size_t i = 0; i < side->size; ++i, ++k)
+    {
+      const Eigen::Vector3d& m = side->means[i];
+      const Eigen::Matrix3d& sigma = side->covariances[i];
+      finite_check += (0.0 * m).sum () + 0.0 * sigma.sum ();
+      const Eigen::Vector3d x = to_cube.apply (m);
+      const Eigen::Matrix3d s = to_cube.applyToCovariance (sigma);
+      p.x (k) = x.x ();
+      p.y (k) = x.y ();
+      p.z (k) = x.z ();
+      p.sxx (k) = s (0, 0);
+      p.syy (k) = s (1, 1);
+      p.szz (k) = s (2, 2);
+      p.sxy (k) = s (0, 1);
+      p.sxz (k) = s (0, 2);
+      p.syz (k) = s (1, 2);
+      p.label (k) = label;
+      p.weight (k) = weight;
+    }
+  }
+  return finite_check == 0.0;
 }
 } // namespace
 
@@ -155,64 +201,19 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
     return false;
   }
 
-  // Uniform normalisation (METHOD.md 4): x' = (x - c) / (2 r_c) + 1/2, Sigma' = Sigma / (2 r_c)^2
-  const std::size_t na = a.size, nb = b.size, n = na + nb;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
-  double covariance_check = 0.0;  // stays 0 unless some covariance entry is inf or NaN
-  for (const PointSetView* side : {&a, &b})
-    for (std::size_t i = 0; i < side->size; ++i)
-    {
-      centroid += side->means[i];
-      covariance_check += 0.0 * side->covariances[i].sum ();
-    }
-  centroid /= static_cast<double> (n);
-  double r2 = 0.0;
-  if (centroid.allFinite () && covariance_check == 0.0)
-    for (const PointSetView* side : {&a, &b})
-      for (std::size_t i = 0; i < side->size; ++i)
-        r2 = std::max (r2, (side->means[i] - centroid).squaredNorm ());
-  const double r_c = std::sqrt (r2);
-  if (!centroid.allFinite () || covariance_check != 0.0 || !std::isfinite (r_c))
+  // Uniform normalisation (METHOD.md 4); checkSide() names an offending point only when the
+  // cheap checks fail
+  const UnitCubeTransform to_cube = computeUnitCubeTransform ({a, b});
+  detail::SeparatorProblem p;
+  if (!makeProblem (a, b, to_cube, params_.C, p) || !to_cube.isFinite ())
   {
-    // find the offending point for the message (slow path)
     if (checkSide (a, "A", result) && checkSide (b, "B", result))
       result.message = "[pcl_probcollision::RobustClassifier::classify] the coordinates overflow "
                        "double precision (centroid or radius not finite)";
     return false;
   }
-  double scale = 1.0;
-  if (r_c > 0.0 && std::isfinite (0.5 / r_c))
-    scale = 0.5 / r_c;
-
-  detail::SeparatorProblem p;
-  p.n = static_cast<Eigen::Index> (n);
-  p.n_a = static_cast<Eigen::Index> (na);
-  for (Eigen::ArrayXd* array : {&p.x, &p.y, &p.z, &p.sxx, &p.sxy, &p.sxz, &p.syy, &p.syz, &p.szz, &p.label, &p.weight})
-    array->resize (p.n);
-  const double scale2 = scale * scale;
-  Eigen::Index k = 0;
-  for (const PointSetView* side : {&a, &b})
-  {
-    const double label = side == &a ? 1.0 : -1.0;
-    // C_i = C n / (2 n_c): each cloud carries half of the total weight
-    const double weight = params_.C * static_cast<double> (n) / (2.0 * static_cast<double> (side->size));
-    for (std::size_t i = 0; i < side->size; ++i, ++k)
-    {
-      const Eigen::Vector3d x = scale * (side->means[i] - centroid);
-      const Eigen::Matrix3d& s = side->covariances[i];
-      p.x (k) = x.x () + 0.5;
-      p.y (k) = x.y () + 0.5;
-      p.z (k) = x.z () + 0.5;
-      p.sxx (k) = scale2 * s (0, 0);
-      p.syy (k) = scale2 * s (1, 1);
-      p.szz (k) = scale2 * s (2, 2);
-      p.sxy (k) = scale2 * 0.5 * (s (0, 1) + s (1, 0));
-      p.sxz (k) = scale2 * 0.5 * (s (0, 2) + s (2, 0));
-      p.syz (k) = scale2 * 0.5 * (s (1, 2) + s (2, 1));
-      p.label (k) = label;
-      p.weight (k) = weight;
-    }
-  }
+  const std::size_t na = a.size, n = static_cast<std::size_t> (p.n);
+  const double scale = to_cube.scale.x ();
 
   detail::MarginLoss loss;
   loss.huber = params_.loss == Loss::Huber;
@@ -301,7 +302,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
 
   result.separator.rung = best.rung;
-  result.separator.centroid = centroid;
+  result.separator.centroid = to_cube.shift;
   result.separator.scale = scale;
   result.separator.weights = best.theta.head (best.theta.size () - 1);
   result.separator.bias = best.theta (best.theta.size () - 1);
@@ -322,7 +323,7 @@ RobustClassifier::evaluate (const SeparatorModel& model, const Eigen::Vector3d& 
       gradient->setConstant (std::numeric_limits<double>::quiet_NaN ());
     return std::numeric_limits<double>::quiet_NaN ();
   }
-  const Eigen::Vector3d xn = model.scale * (x - model.centroid) + Eigen::Vector3d::Constant (0.5);
+  const Eigen::Vector3d xn = uniformUnitCubeTransform (model.centroid, model.scale).apply (x);
   if (linear)
   {
     if (gradient)

@@ -97,7 +97,8 @@ struct ClassifierParams
   * RobustClassifier::evaluate() can evaluate anywhere.
   *
   * With x' = scale * (x - centroid) + (0.5, 0.5, 0.5) the unit-cube coordinates of an input
-  * point x (Uniform scaling, METHOD.md 4), the function is f(x') = w^T x' + b (Linear) or
+  * point x (Uniform scaling, METHOD.md 4: uniformUnitCubeTransform (centroid, scale) of
+  * normalization.h), the function is f(x') = w^T x' + b (Linear) or
   * f(x') = w^T phi(x') + b with phi the random Fourier feature map of D = weights.size ()
   * features (RFF, RFFLarge). f > 0 on A's side. */
 struct SeparatorModel
