@@ -90,7 +90,7 @@ tsan_build () {
   # gtest_discover_tests runs the instrumented tests at build time: they need the options too.
   export TSAN_OPTIONS="$tsan_options"
   sanitized_configure "$tsan_dir" thread -DPCL_PROBCOLLISION_BUILD_EXAMPLES=OFF
-  cmake --build "$tsan_dir" -j"$jobs" --target test_collide test_probabilistic_bvh test_robust_classifier \
+  cmake --build "$tsan_dir" -j"$jobs" --target test_collide test_bvh_traversal test_robust_classifier \
     test_probabilistic_collision
 }
 tsan_test () {
@@ -99,7 +99,7 @@ tsan_test () {
   # the one suppression (libOpenNI2's static initializer).
   export TSAN_OPTIONS="$tsan_options"
   "$tsan_dir/test/test_collide" --gtest_filter='*Concurrent*'
-  "$tsan_dir/test/test_probabilistic_bvh" --gtest_filter='*Threads*'
+  "$tsan_dir/test/test_bvh_traversal" --gtest_filter='*Threads*'
   "$tsan_dir/test/test_robust_classifier" --gtest_filter='*Concurrent*'
   "$tsan_dir/test/test_probabilistic_collision" --gtest_filter='*Concurrent*'
 }

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// detail/leakage.h: the probability that a Gaussian point lies outside a box (METHOD.md 8.4,
+// 11.7), its tabulated normal tail, and the leakage a hierarchy node stores (the area-weighted
+// mean over its points). Oracles: closed forms in Phi from std::erfc.
+#include <pcl_probcollision/detail/leakage.h>
+#include <pcl_probcollision/detail/obb.h>
+#include <pcl_probcollision/normal_distribution.h>
+#include <pcl_probcollision/probabilistic_bvh.h>
+
+#include <gtest/gtest.h>
+
+#include "scenes.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+using namespace pcl_probcollision;
+using detail::OrientedBox;
+using pcl_probcollision_test::Phi;
+using pcl_probcollision_test::randomPose;
+
+TEST (Leakage, PointOracles)
+{
+  // Box [-0.05, 0.05]^3, isotropic sigma = 0.01 (METHOD.md 11.7).
+  OrientedBox box;
+  box.half_extents = Eigen::Vector3d::Constant (0.05);
+  const Eigen::Matrix3d cov = Eigen::Matrix3d::Identity () * 1e-4;
+  // Centre: 2 Phi(-5) = 5.733e-7 (exact form; relative accuracy).
+  const double centre = detail::pointOutsideProbability (box, Eigen::Vector3d::Zero (), cov);
+  EXPECT_NEAR (centre, 2.0 * Phi (-5.0), 1e-15);
+  EXPECT_NEAR (centre, 5.733e-7, 1e-10);
+  // 0.01 inside a face: Phi(-1) + Phi(-9) = 0.158655.
+  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (0, 0, 0.04), cov), 0.158655, 1e-6);
+  // On a face: 0.5 + Phi(-10) ~ 0.5.
+  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (0.05, 0, 0), cov), 0.5, 1e-12);
+  // Union bound at the centre: 3 * 2 Phi(-5).
+  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d::Zero (), cov, detail::LeakageBound::UnionBound),
+               6.0 * Phi (-5.0), 1e-15);
+  // Rotating box and point together changes nothing.
+  std::mt19937_64 rng (3);
+  Eigen::Isometry3d T = randomPose (rng, 2.0);
+  const OrientedBox moved = box.transformed (T);
+  EXPECT_NEAR (detail::pointOutsideProbability (moved, T * Eigen::Vector3d (0, 0, 0.04),
+                                                T.linear () * cov * T.linear ().transpose ()),
+               0.158655, 1e-6);
+  // Zero covariance: the indicator of being outside.
+  EXPECT_EQ (detail::pointOutsideProbability (box, Eigen::Vector3d (0.05, 0, 0), Eigen::Matrix3d::Zero ()), 0.0);
+  EXPECT_EQ (detail::pointOutsideProbability (box, Eigen::Vector3d (0.0501, 0, 0), Eigen::Matrix3d::Zero ()), 1.0);
+  // Degenerate along one axis only: that slab is an indicator, the others are Gaussian.
+  Eigen::Matrix3d flat = Eigen::Vector3d (1e-4, 1e-4, 0.0).asDiagonal ();
+  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (0, 0.04, 0.0), flat), 0.158655, 1e-6);
+  EXPECT_EQ (detail::pointOutsideProbability (box, Eigen::Vector3d (0, 0, 0.06), flat), 1.0);
+}
+
+// The build's tabulated tail against erfc: absolute error below 1e-11 everywhere.
+TEST (Leakage, TabulatedTailMatchesErfc)
+{
+  double worst = 0.0;
+  for (int i = -20000; i <= 24000; ++i)
+  {
+    const double z = i * 5.123e-4;  // not on the table's grid
+    const double exact = normalCdf (-z);
+    const double tab = detail::normalTailTabulated (z);
+    worst = std::max (worst, std::abs (tab - exact));
+    ASSERT_GE (tab, -1e-11) << z;
+    ASSERT_LE (tab, 1.0 + 1e-11) << z;
+  }
+  EXPECT_LT (worst, 1e-11);
+  EXPECT_GT (worst, 0.0);  // it is an approximation: the test would notice erfc in its place
+  EXPECT_EQ (detail::normalTailTabulated (0.0), 0.5);
+  EXPECT_EQ (detail::normalTailTabulated (10.0), 0.0);
+  EXPECT_EQ (detail::normalTailTabulated (1e300), 0.0);
+  EXPECT_EQ (detail::normalTailTabulated (-1e300), 1.0);
+  EXPECT_TRUE (std::isnan (detail::normalTailTabulated (std::numeric_limits<double>::quiet_NaN ())));
+}
+
+TEST (Leakage, SinglePointNodeOracle)
+{
+  // One point, isotropic sigma, box inflated by k_sigma = 1: the point sits at the centre of a
+  // cube of half extent sigma, so leakage = 1 - (Phi(1) - Phi(-1)) = 2 Phi(-1) = 0.317311.
+  UncertainCloud c;
+  c.means.push_back (Eigen::Vector3d (1, 2, 3));
+  c.covariances.push_back (Eigen::Matrix3d::Identity () * 1e-4);
+  ProbabilisticBVH bvh (c);
+  ASSERT_EQ (bvh.nodes ().size (), 1u);
+  EXPECT_NEAR (bvh.node (0).leakage, 2.0 * Phi (-1.0), 1e-12);
+  EXPECT_NEAR (bvh.node (0).box.half_extents.maxCoeff (), 0.01, 1e-12);
+  EXPECT_NEAR (bvh.node (0).box.half_extents.minCoeff (), 0.01, 1e-12);
+  // k_sigma = 3: 2 Phi(-3).
+  BVHParams p;
+  p.k_sigma = 3.0;
+  bvh.build (c, p);
+  EXPECT_NEAR (bvh.node (0).leakage, 2.0 * Phi (-3.0), 1e-12);
+}
+
+TEST (Leakage, AreaWeightsWeightTheMean)
+{
+  // Two points in one leaf: one exact (P_x = 0), one noisy; weights move the node's leakage.
+  UncertainCloud c;
+  c.means = {Eigen::Vector3d (0, 0, 0), Eigen::Vector3d (1, 0, 0)};
+  c.covariances = {Eigen::Matrix3d::Zero (), Eigen::Matrix3d::Identity () * 1e-4};
+  ProbabilisticBVH equal (c);
+  const double p_noisy = detail::pointOutsideProbability (equal.node (0).box, c.means[1], c.covariances[1]);
+  EXPECT_GT (p_noisy, 0.1);
+  EXPECT_NEAR (equal.node (0).leakage, 0.5 * p_noisy, 1e-12);
+  c.area_weights = {3.0, 1.0};
+  ProbabilisticBVH weighted (c);
+  EXPECT_NEAR (weighted.node (0).leakage, 0.25 * p_noisy, 1e-12);
+  c.area_weights = {0.0, 0.0};  // no area information: equal weights
+  ProbabilisticBVH zero (c);
+  EXPECT_NEAR (zero.node (0).leakage, 0.5 * p_noisy, 1e-12);
+}
