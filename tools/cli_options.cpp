@@ -38,7 +38,7 @@ fmt (double v)
 
 // Flags that take one value, and flags that take none.
 const std::set<std::string> kValueFlags = {
-  "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-k", "-thresholds", "-seed",
+  "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
                                             "-measured", "-v"};
@@ -245,6 +245,7 @@ parseCommandLine (const std::vector<std::string>& args)
   std::vector<std::string> positional;
   std::set<std::string> seen;
   std::optional<double> sigma, sigma_a, sigma_b;
+  std::optional<std::string> sensor, sensor_a, sensor_b;
   bool deterministic = false;
   bool only_positional = false;
 
@@ -333,11 +334,11 @@ parseCommandLine (const std::vector<std::string>& args)
       if (auto e = nonNegative (sigma_b))
         return *e;
     }
-    else if (a == "-sensor")
+    else if (a == "-sensor" || a == "-sensor_a" || a == "-sensor_b")
     {
       if (v != "none" && v != "isotropic" && v != "kinect" && v != "stereo" && v != "lidar")
         return usage (bad + "must be one of isotropic, kinect, stereo, lidar, none");
-      o.sensor = v;
+      (a == "-sensor" ? sensor : a == "-sensor_a" ? sensor_a : sensor_b) = v;
     }
     else if (a == "-k")
     {
@@ -422,8 +423,18 @@ parseCommandLine (const std::vector<std::string>& args)
     return usage ("option -o writes one query's result and cannot be combined with -poses");
   if (deterministic && o.stochastic)
     return usage ("options -deterministic and -stochastic cannot be combined");
-  if (o.sensor != "isotropic" && (sigma || sigma_a || sigma_b))
-    return usage ("options -sigma, -sigma_a and -sigma_b need -sensor isotropic (got -sensor " + o.sensor + ")");
+  // -sensor sets both inputs, -sensor_a / -sensor_b one each whatever the order; likewise the
+  // sigmas, which only an isotropic input uses.
+  o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
+  o.sensor_b = sensor_b.value_or (sensor.value_or (Defaults::sensor));
+  const std::string iso = "isotropic";
+  if (sigma && (o.sensor_a != iso || o.sensor_b != iso))
+    return usage ("option -sigma needs the isotropic model for both inputs (got " + o.sensor_a + " for <a>, " +
+                  o.sensor_b + " for <b>); use -sigma_a or -sigma_b for one input");
+  if (sigma_a && o.sensor_a != iso)
+    return usage ("option -sigma_a needs the isotropic model for <a> (got " + o.sensor_a + ")");
+  if (sigma_b && o.sensor_b != iso)
+    return usage ("option -sigma_b needs the isotropic model for <b> (got " + o.sensor_b + ")");
   if (sigma)
     o.sigma_a = o.sigma_b = *sigma;
   if (sigma_a)
@@ -461,9 +472,11 @@ helpText ()
     << D::sensor
     << "\n"
        "                  sensor noise added to both clouds; depth models use each PCD's VIEWPOINT\n"
+       "  -sensor_a M     = -sensor   sensor noise model of <a> only (same names)\n"
+       "  -sensor_b M     = -sensor   sensor noise model of <b> only\n"
        "  -sigma S        = "
     << fmt (D::sigma)
-    << "   isotropic noise sigma of both clouds, data units (-sensor isotropic only)\n"
+    << "   isotropic noise sigma of both clouds, data units (isotropic model only)\n"
        "  -sigma_a S      = -sigma   isotropic sigma of <a> only\n"
        "  -sigma_b S      = -sigma   isotropic sigma of <b> only\n"
        "  -k K            = "

@@ -49,10 +49,12 @@ struct Options
   /** \brief -poses FILE (batch mode). */
   std::optional<std::string> poses_file;
 
-  /** \brief -sensor: none, isotropic, kinect, stereo, lidar. */
-  std::string sensor = Defaults::sensor;
+  /** \brief Sensor noise model of each input: none, isotropic, kinect, stereo, lidar; -sensor
+    * sets both, -sensor_a / -sensor_b one each. Not used for a mesh (exact). */
+  std::string sensor_a = Defaults::sensor;
+  std::string sensor_b = Defaults::sensor;
   /** \brief Isotropic sigma of each input (data units); -sigma sets both, -sigma_a / -sigma_b
-    * one each. Only meaningful with sensor == "isotropic". */
+    * one each. Only meaningful when that input's sensor is "isotropic". */
   double sigma_a = Defaults::sigma;
   double sigma_b = Defaults::sigma;
   int k = Defaults::k;

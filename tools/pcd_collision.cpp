@@ -182,14 +182,6 @@ checkOutput (const Options& o)
     throw Failure{kRuntimeFailure, "cannot write '" + *o.output + "': is a directory"};
 }
 
-pcl_probcollision::SensorNoiseModel
-noiseFor (const Options& o, double sigma)
-{
-  if (o.sensor == "isotropic")
-    return pcl_probcollision::SensorNoiseModel::isotropic (sigma);
-  return pcl_probcollision::SensorNoiseModel::fromName (o.sensor);
-}
-
 pcl_probcollision::CollisionRequest
 requestFor (const Options& o)
 {
@@ -299,11 +291,17 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   inputJson (j, b);
   j.endObject ();
   j.key ("parameters").beginObject ();
-  j.key ("sensor").string (o.sensor);
+  // "sensor" is the model of both inputs, null when they differ; a mesh gets no noise.
+  j.key ("sensor");
+  o.sensor_a == o.sensor_b ? j.string (o.sensor_a) : j.null ();
+  j.key ("sensor_a");
+  a.kind == InputKind::Cloud ? j.string (o.sensor_a) : j.null ();
+  j.key ("sensor_b");
+  b.kind == InputKind::Cloud ? j.string (o.sensor_b) : j.null ();
   j.key ("sigma_a");
-  (o.sensor == "isotropic" && a.kind == InputKind::Cloud) ? j.number (o.sigma_a) : j.null ();
+  (o.sensor_a == "isotropic" && a.kind == InputKind::Cloud) ? j.number (o.sigma_a) : j.null ();
   j.key ("sigma_b");
-  (o.sensor == "isotropic" && b.kind == InputKind::Cloud) ? j.number (o.sigma_b) : j.null ();
+  (o.sensor_b == "isotropic" && b.kind == InputKind::Cloud) ? j.number (o.sigma_b) : j.null ();
   j.key ("k").integer (o.k);
   j.key ("thresholds").numbers ({o.free_below, o.collision_above});
   j.key ("traversal").string (o.stochastic ? "stochastic" : "deterministic");
@@ -509,11 +507,11 @@ run (int argc, char** argv)
   if (a.kind == InputKind::Mesh)
     pc.setInputCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (a.cloud->width, a.cloud->height));
   else
-    pc.setInputNoise (noiseFor (o, o.sigma_a));
+    pc.setInputNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_a, o.sigma_a));
   if (b.kind == InputKind::Mesh)
     pc.setTargetCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (b.cloud->width, b.cloud->height));
   else
-    pc.setTargetNoise (noiseFor (o, o.sigma_b));
+    pc.setTargetNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
   pc.setRequest (requestFor (o));
 
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));

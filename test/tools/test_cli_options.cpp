@@ -40,7 +40,8 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (o.input_b, "b.obj");
   EXPECT_FALSE (o.pose);
   EXPECT_FALSE (o.poses_file);
-  EXPECT_EQ (o.sensor, "isotropic");
+  EXPECT_EQ (o.sensor_a, "isotropic");
+  EXPECT_EQ (o.sensor_b, "isotropic");
   EXPECT_EQ (o.sigma_a, 0.005);
   EXPECT_EQ (o.sigma_b, 0.005);
   EXPECT_EQ (o.k, 10);
@@ -155,7 +156,7 @@ TEST (CliOptions, FlagsAndPositionals)
   EXPECT_EQ (dashed.options.input_a, "-a.pcd");
   EXPECT_TRUE (dashed.options.json);
   EXPECT_EQ (parse ({"-deterministic"}).kind, Kind::Run);
-  EXPECT_EQ (parse ({"-sensor", "kinect"}).options.sensor, "kinect");
+  EXPECT_EQ (parse ({"-sensor", "kinect"}).options.sensor_b, "kinect");
 }
 
 TEST (CliOptions, NameEqualsValue)
@@ -184,7 +185,7 @@ TEST (CliOptions, NameEqualsValue)
   EXPECT_EQ (*j.options.output, "out.pcd");
   const ParseResult sensor = parse ({"-sensor=kinect", "-poses=dir/a=b.txt"});
   ASSERT_EQ (sensor.kind, Kind::Run) << sensor.error;
-  EXPECT_EQ (sensor.options.sensor, "kinect");
+  EXPECT_EQ (sensor.options.sensor_a, "kinect");
   EXPECT_EQ (*sensor.options.poses_file, "dir/a=b.txt");  // split at the first '='
   EXPECT_EQ ((*parse ({"-pose=-1,-2,-3,0,0,0"}).options.pose)[2], -3.0);
 
@@ -197,6 +198,37 @@ TEST (CliOptions, NameEqualsValue)
   expectUsageError ({"-json=1"}, "-json takes no value");
   expectUsageError ({"-sigma=0.1", "-sigma", "0.2"}, "more than once");
   expectUsageError ({"-sensor=kinect", "-sigma=0.01"}, "-sigma");
+}
+
+TEST (CliOptions, SensorPerInput)
+{
+  // -sensor sets both inputs; -sensor_a / -sensor_b override it for one, whatever the order.
+  const ParseResult both = parse ({"-sensor", "kinect"});
+  ASSERT_EQ (both.kind, Kind::Run) << both.error;
+  EXPECT_EQ (both.options.sensor_a, "kinect");
+  EXPECT_EQ (both.options.sensor_b, "kinect");
+  const ParseResult one = parse ({"-sensor_b", "lidar", "-sensor", "stereo"});
+  ASSERT_EQ (one.kind, Kind::Run) << one.error;
+  EXPECT_EQ (one.options.sensor_a, "stereo");
+  EXPECT_EQ (one.options.sensor_b, "lidar");
+  const ParseResult each = parse ({"-sensor_a", "none", "-sensor_b=kinect"});
+  ASSERT_EQ (each.kind, Kind::Run) << each.error;
+  EXPECT_EQ (each.options.sensor_a, "none");
+  EXPECT_EQ (each.options.sensor_b, "kinect");
+  EXPECT_EQ (each.options.sigma_a, 0.005);
+
+  // A sigma needs the isotropic model on every input it sets.
+  const ParseResult sigma_a = parse ({"-sensor_b", "kinect", "-sigma_a", "0.002"});
+  ASSERT_EQ (sigma_a.kind, Kind::Run) << sigma_a.error;
+  EXPECT_EQ (sigma_a.options.sigma_a, 0.002);
+  const ParseResult sigma_b = parse ({"-sensor", "stereo", "-sensor_b", "isotropic", "-sigma_b", "0.003"});
+  ASSERT_EQ (sigma_b.kind, Kind::Run) << sigma_b.error;
+  EXPECT_EQ (sigma_b.options.sigma_b, 0.003);
+  expectUsageError ({"-sensor_b", "kinect", "-sigma", "0.01"}, "-sigma_b");  // suggests the per-input flag
+  expectUsageError ({"-sensor_a", "kinect", "-sigma_a", "0.01"}, "-sigma_a");
+  expectUsageError ({"-sensor_b", "none", "-sigma_b", "0.01"}, "-sigma_b");
+  expectUsageError ({"-sensor_a", "sonar"}, "-sensor_a");
+  expectUsageError ({"-sensor_b", "kinect", "-sensor_b", "stereo"}, "more than once");
 }
 
 TEST (CliOptions, InputKinds)

@@ -586,6 +586,42 @@ TEST_F (PcdCollisionTool, NormalRunsPrintOnlyStageLinesOnStderr)
   }
 }
 
+// -sensor_a / -sensor_b give each cloud its own noise model; -sensor sets both.
+TEST_F (PcdCollisionTool, SensorPerInput)
+{
+  auto query = [&] (std::vector<std::string> sensors) {
+    std::vector<std::string> args = {kScene.string (), kScene.string (), "-pose", "0,0,0.01,0,0,0"};
+    args.insert (args.end (), sensors.begin (), sensors.end ());
+    const auto v = runJson (args);
+    EXPECT_EQ (v.size (), 1u);
+    return v.empty () ? Value () : v[0];
+  };
+  const Value none = query ({"-sensor", "none"}), none_each = query ({"-sensor_a", "none", "-sensor_b", "none"});
+  EXPECT_EQ (none["probability"].text, none_each["probability"].text);
+  EXPECT_EQ (none_each["parameters"]["sensor"].text, "none");
+
+  const Value b_only = query ({"-sensor_b", "kinect"}), overridden = query ({"-sensor", "kinect", "-sensor_a", "isotropic"});
+  EXPECT_EQ (b_only["probability"].text, overridden["probability"].text);
+  const Value& p = b_only["parameters"];
+  EXPECT_EQ (p["sensor"].type, Value::Type::Null);  // the inputs differ
+  EXPECT_EQ (p["sensor_a"].text, "isotropic");
+  EXPECT_EQ (p["sensor_b"].text, "kinect");
+  EXPECT_EQ (p["sigma_a"].number, 0.005);
+  EXPECT_EQ (p["sigma_b"].type, Value::Type::Null);  // no sigma in the kinect model
+
+  // Each input gets its own model: the mixed pair answers unlike either model on both.
+  const Value mixed = query ({"-sensor_a", "stereo", "-sensor_b", "kinect"});
+  EXPECT_NE (mixed["probability"].text, query ({"-sensor", "stereo"})["probability"].text);
+  EXPECT_NE (mixed["probability"].text, query ({"-sensor", "kinect"})["probability"].text);
+  EXPECT_NE (mixed["probability"].text, query ({"-sensor_a", "kinect", "-sensor_b", "stereo"})["probability"].text);
+
+  // A mesh gets no noise: its sensor is null.
+  const auto mesh = runJson ({kGripper.string (), kScene.string (), "-sensor_b", "stereo", "-pose", "0,0,0.3,0,0,0"});
+  ASSERT_EQ (mesh.size (), 1u);
+  EXPECT_EQ (mesh[0]["parameters"]["sensor_a"].type, Value::Type::Null);
+  EXPECT_EQ (mesh[0]["parameters"]["sensor_b"].text, "stereo");
+}
+
 TEST_F (PcdCollisionTool, StochasticTraversalIsSeeded)
 {
   const std::vector<std::string> base = {kGripper.string (), kScene.string (), "-pose", "-0.15,0.05,-0.01,0,0,0",
