@@ -108,7 +108,7 @@ enum class InputKind
 {
   Unsupported,
   Cloud,  ///< .pcd
-  Mesh    ///< .ply .obj .stl .vtk
+  Mesh    ///< .ply .obj .stl .vtk; the tool reads a .ply without faces as a cloud (isFacelessPly)
 };
 InputKind inputKindOf (const std::string& path);
 

@@ -93,6 +93,8 @@ void
 loadInput (Input& in, FILE* log)
 {
   requireReadable (in.path);
+  if (in.kind == InputKind::Mesh && isFacelessPly (in.path))
+    in.kind = InputKind::Cloud;
   const auto start = std::chrono::steady_clock::now ();
   std::string error;
   if (in.kind == InputKind::Cloud)

@@ -5,18 +5,23 @@
 #include <pcl/common/io.h>
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
 
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 namespace pcd_collision
 {
@@ -106,33 +111,86 @@ fieldSize (std::uint8_t datatype)
     default: return 0;
   }
 }
+bool
+isPly (const std::string& path)
+{
+  std::string ext = std::filesystem::path (path).extension ().string ();
+  std::transform (ext.begin (), ext.end (), ext.begin (), [] (unsigned char c) { return static_cast<char> (std::tolower (c)); });
+  return ext == ".ply";
+}
 } // namespace
+
+bool
+isFacelessPly (const std::string& path)
+{
+  if (!isPly (path))
+    return false;
+  std::ifstream in (path, std::ios::binary);
+  std::string line;
+  bool vertices = false;
+  // A header has a few dozen lines; the bound stops at a binary file that only starts with "ply".
+  for (int n = 0; n < 10000 && std::getline (in, line); ++n)
+  {
+    if (!line.empty () && line.back () == '\r')
+      line.pop_back ();
+    if (n == 0 && line != "ply")
+      return false;
+    if (line == "end_header")
+      return vertices;
+    std::istringstream words (line);
+    std::string keyword, element;
+    long long count = 0;
+    if (words >> keyword >> element >> count && keyword == "element")
+    {
+      if (element == "face" && count > 0)
+        return false;
+      vertices = vertices || (element == "vertex" && count > 0);
+    }
+  }
+  return false;  // no end_header: not a PLY header the tool understands
+}
 
 bool
 loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error)
 {
   cloud.clear ();
-  pcl::PCDReader reader;
   pcl::PCLPointCloud2 blob;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0, data_type = 0;
-  unsigned int data_idx = 0;
-  if (reader.readHeader (path, blob, origin, orientation, version, data_type, data_idx) < 0)
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero ();
+  Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity ();
+  const bool ply = isPly (path);
+  const char* format = ply ? "PLY" : "PCD";
+  if (ply)
   {
-    error = "'" + path + "' is not a PCD file (malformed or missing header)";
-    return false;
+    pcl::PLYReader reader;
+    int version = 0;
+    if (reader.read (path, blob, origin, orientation, version) < 0)
+    {
+      error = "'" + path + "' is truncated or corrupt (PLY data could not be read)";
+      return false;
+    }
   }
-  if (blob.fields.empty ())
+  else
   {
-    error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
-    return false;
+    pcl::PCDReader reader;
+    int version = 0, data_type = 0;
+    unsigned int data_idx = 0;
+    if (reader.readHeader (path, blob, origin, orientation, version, data_type, data_idx) < 0)
+    {
+      error = "'" + path + "' is not a PCD file (malformed or missing header)";
+      return false;
+    }
+    if (blob.fields.empty ())
+    {
+      error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
+      return false;
+    }
   }
   if (static_cast<std::size_t> (blob.width) * blob.height == 0)
   {
     error = "'" + path + "' has no points (empty cloud)";
     return false;
   }
+  // x y z are checked on the PCD header, before the (possibly large) data are read.
   int idx[3];
   const char* names[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i)
@@ -140,7 +198,7 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
     idx[i] = pcl::getFieldIndex (blob, names[i]);
     if (idx[i] < 0)
     {
-      error = "'" + path + "' has no '" + names[i] + "' field (a PCD input needs x y z)";
+      error = "'" + path + "' has no '" + names[i] + "' field (a " + format + " input needs x y z)";
       return false;
     }
     if (fieldSize (blob.fields[idx[i]].datatype) == 0)
@@ -149,10 +207,15 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
       return false;
     }
   }
-  if (reader.read (path, blob, origin, orientation, version) < 0)
+  if (!ply)
   {
-    error = "'" + path + "' is truncated or corrupt (PCD data could not be read)";
-    return false;
+    pcl::PCDReader reader;
+    int version = 0;
+    if (reader.read (path, blob, origin, orientation, version) < 0)
+    {
+      error = "'" + path + "' is truncated or corrupt (PCD data could not be read)";
+      return false;
+    }
   }
   const std::size_t n = static_cast<std::size_t> (blob.width) * blob.height;
   if (n == 0)

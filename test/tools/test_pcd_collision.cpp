@@ -525,6 +525,60 @@ TEST_F (PcdCollisionTool, OrganizedCloudWithNansAndDoubleFields)
   EXPECT_EQ (v[0]["verdict"].text, "free");  // 0.5 m above the table
 }
 
+// A PLY without faces is a point cloud (noise, covariances, "kind":"cloud"); with faces, a mesh.
+TEST_F (PcdCollisionTool, PlyWithoutFacesIsACloud)
+{
+  // A 10 x 10 grid at 1/64 m, 0.5 m above the table, exact in float and in six decimals: ascii
+  // (doubles), ascii with "element face 0", and binary (floats) hold the same points.
+  std::string ascii, binary;
+  for (int i = 0; i < 100; ++i)
+  {
+    const float p[3] = {static_cast<float> (i % 10) / 64, static_cast<float> (i / 10) / 64, 0.5f};
+    ascii += std::to_string (p[0]) + " " + std::to_string (p[1]) + " " + std::to_string (p[2]) + "\n";
+    binary.append (reinterpret_cast<const char*> (p), sizeof (p));  // x86-64: little-endian
+  }
+  const std::string vertex = "element vertex 100\n";
+  writeFile (dir_ / "grid.ply", "ply\nformat ascii 1.0\ncomment a scan\n" + vertex +
+                                    "property double x\nproperty double y\nproperty double z\nend_header\n" + ascii);
+  writeFile (dir_ / "grid_face0.PLY", "ply\nformat ascii 1.0\n" + vertex + "property float x\nproperty float y\n"
+                                          "property float z\nelement face 0\nproperty list uchar int vertex_indices\n"
+                                          "end_header\n" + ascii);
+  writeFile (dir_ / "grid_binary.ply", "ply\nformat binary_little_endian 1.0\n" + vertex +
+                                           "property float x\nproperty float y\nproperty float z\nend_header\n" + binary);
+  std::string probability;
+  for (const char* name : {"grid.ply", "grid_face0.PLY", "grid_binary.ply"})
+  {
+    SCOPED_TRACE (name);
+    const auto v = runJson ({(dir_ / name).string (), kScene.string (), "-pose", "0,0,-0.49,0,0,0"});
+    ASSERT_EQ (v.size (), 1u);
+    const Value& a = v[0]["inputs"]["a"];
+    EXPECT_EQ (a["kind"].text, "cloud");
+    EXPECT_EQ (a["points"].number, 100.0);
+    EXPECT_EQ (a["finite"].number, 100.0);
+    EXPECT_EQ (a["width"].number, 100.0);
+    EXPECT_EQ (a["height"].number, 1.0);
+    EXPECT_EQ (v[0]["parameters"]["sigma_a"].number, 0.005);  // a cloud gets the sensor noise
+    if (probability.empty ())
+      probability = v[0]["probability"].text;
+    EXPECT_EQ (v[0]["probability"].text, probability);
+  }
+  // The grid as the other cloud: a mesh's spacing follows it.
+  writeFile (dir_ / "quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                "0 0 0\n0.1 0 0\n0.1 0.1 0\n0 0.1 0\n4 0 1 2 3\n");
+  const auto mesh = runJson ({(dir_ / "quad.ply").string (), (dir_ / "grid.ply").string ()});
+  ASSERT_EQ (mesh.size (), 1u);
+  EXPECT_EQ (mesh[0]["inputs"]["a"]["kind"].text, "mesh");
+  EXPECT_EQ (mesh[0]["inputs"]["b"]["kind"].text, "cloud");
+  EXPECT_EQ (mesh[0]["inputs"]["a"]["spacing"].number, 1.0 / 64);
+  // Cut short, or without x y z: one error naming the file.
+  writeFile (dir_ / "short.ply", "ply\nformat binary_little_endian 1.0\n" + vertex +
+                                     "property float x\nproperty float y\nproperty float z\nend_header\n" + binary.substr (0, 500));
+  expectFailure ({(dir_ / "short.ply").string (), kScene.string ()}, 1, "short.ply", {dir_ / "short.ply"});
+  writeFile (dir_ / "noxyz.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float intensity\nend_header\n1\n2\n");
+  expectFailure ({(dir_ / "noxyz.ply").string (), kScene.string ()}, 1, "noxyz.ply", {dir_ / "noxyz.ply"});
+}
+
 TEST_F (PcdCollisionTool, MeshFormatsAndDensity)
 {
   writeFile (dir_ / "quad.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
