@@ -51,6 +51,9 @@ msSince (std::chrono::steady_clock::time_point start)
 // ---------------------------------------------------------------------------------------------
 /** \brief Sizes (bounding-box diagonals) differing by more than this get a units warning. */
 constexpr double kScaleWarningRatio = 100.0;
+/** \brief Fewest finite points of a cloud whose extent the units warning judges. A handful of
+  * points (a probe, two points 1 mm apart) has no telling size; a scan has thousands. */
+constexpr std::size_t kScaleWarningMinPoints = 50;
 
 struct Input
 {
@@ -385,10 +388,14 @@ inputDiagonal (const Input& in)
 
 /** \brief Both inputs must be in the same units (docs/CLI.md). A millimetre scan against a metre
   * mesh makes sizes differ by 1000x: warn on stderr when they differ by more than 100x. A warning,
-  * not an error: a screw against a room is legitimate. */
+  * not an error: a screw against a room is legitimate. Clouds under kScaleWarningMinPoints are not
+  * judged (a mesh always is: its vertices span the whole object). */
 void
 warnIfScalesDiffer (const Input& a, const Input& b)
 {
+  for (const Input* in : {&a, &b})
+    if (in->kind == InputKind::Cloud && in->finite < kScaleWarningMinPoints)
+      return;
   const double da = inputDiagonal (a), db = inputDiagonal (b);
   if (!(da > 0.0 && db > 0.0 && std::isfinite (da) && std::isfinite (db)))
     return;

@@ -334,6 +334,26 @@ TEST_F (CliReliability, MillimetresAgainstMetresWarnsOnStderr)
   EXPECT_EQ (same.err.find ("warning"), std::string::npos) << same.err;
 }
 
+// A few points have no telling extent: a two-point probe 1 mm long against the 0.74 m scene
+// (740x) is legitimate. From 50 finite points on (docs/CLI.md) the extent is judged.
+TEST_F (CliReliability, UnitsWarningNeedsEnoughPoints)
+{
+  auto probe = [] (int n) {
+    Cloud c;
+    for (int i = 0; i < n; ++i)
+      c.push_back (pcl::PointXYZ (0.001f * static_cast<float> (i) / static_cast<float> (n - 1), 0.f, 0.3f));
+    return c;
+  };
+  for (const int n : {2, 49, 50})
+  {
+    SCOPED_TRACE (n);
+    const Run r = run ({save ("probe" + std::to_string (n) + ".pcd", probe (n)), kScene.string ()});
+    EXPECT_EQ (r.status, 0) << r.err;
+    ASSERT_EQ (r.json.size (), 1u);
+    EXPECT_EQ (r.err.find ("warning") != std::string::npos, n >= 50) << r.err;
+  }
+}
+
 TEST_F (CliReliability, MeshesWithDegenerateDuplicateAndOpenTriangles)
 {
   // An open box (no lid): open boundary. Duplicate faces, zero-area faces (repeated index and
