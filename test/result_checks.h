@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Checks of a CollisionResult shared by the tests of collide() / collideBatch() (test_collide)
-// and of ProbabilisticCollision (test_probabilistic_collision).
+// Checks shared by several test files: of a CollisionResult (the tests of collide() and of
+// ProbabilisticCollision), and a classification expected to succeed (the classifier's tests).
 #pragma once
 
 #include <pcl_probcollision/collision.h>
 #include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/collision_result.h>
+#include <pcl_probcollision/robust_classifier.h>
 
 #include <gtest/gtest.h>
+
+#include "scenes.h"
 
 #include <cmath>
 #include <cstring>
@@ -114,5 +117,15 @@ verdictCounts (const std::vector<pcl_probcollision::CollisionResult>& results)
   for (const pcl_probcollision::CollisionResult& r : results)
     ++counts[static_cast<int> (r.verdict)];
   return counts;
+}
+
+/** \brief RobustClassifier (params).classify (a, b), expected to succeed. */
+inline pcl_probcollision::ClassifierResult
+classify (const pcl_probcollision::ClassifierParams& params, const ClassifierCloud& a, const ClassifierCloud& b)
+{
+  pcl_probcollision::ClassifierResult r;
+  const pcl_probcollision::RobustClassifier classifier (params);
+  EXPECT_TRUE (classifier.classify (a.view (), b.view (), r)) << r.message;
+  return r;
 }
 } // namespace pcl_probcollision_test

@@ -206,6 +206,84 @@ poseSweep (int n, unsigned seed)
   return poses;
 }
 
+Eigen::Matrix3d
+iso (double sigma)
+{
+  return sigma * sigma * Eigen::Matrix3d::Identity ();
+}
+
+std::vector<Eigen::Vector3d>
+fibonacci (int n)
+{
+  const double kPi = 3.14159265358979323846;
+  std::vector<Eigen::Vector3d> p;
+  const double golden = kPi * (3.0 - std::sqrt (5.0));
+  for (int k = 0; k < n; ++k)
+  {
+    const double t = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt (1.0 - t * t), a = k * golden;
+    p.emplace_back (t, r * std::cos (a), r * std::sin (a));
+  }
+  return p;
+}
+
+Eigen::Matrix3d
+randomCovariance (std::mt19937_64& rng, double lo, double hi)
+{
+  const double kPi = 3.14159265358979323846;
+  std::uniform_real_distribution<double> u (lo, hi);
+  const Eigen::Vector3d s = draw3 (u, rng);  // one draw per statement: seeded_draws.h
+  std::uniform_real_distribution<double> angle (0.0, 2.0 * kPi);
+  const Eigen::Vector3d zyx = draw3 (angle, rng);
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd (zyx (0), Eigen::Vector3d::UnitZ ()) *
+                             Eigen::AngleAxisd (zyx (1), Eigen::Vector3d::UnitY ()) *
+                             Eigen::AngleAxisd (zyx (2), Eigen::Vector3d::UnitX ()))
+                                .toRotationMatrix ();
+  return r * s.cwiseAbs2 ().asDiagonal () * r.transpose ();
+}
+
+void
+genericPatches (ClassifierCloud& a, ClassifierCloud& b, std::uint64_t seed)
+{
+  std::mt19937_64 rng (seed);
+  std::uniform_real_distribution<double> u (0.0, 1.0);
+  a = ClassifierCloud ();
+  b = ClassifierCloud ();
+  for (int k = 0; k < 150; ++k)
+  {
+    const double x = u (rng), y = u (rng);
+    const double z = 0.1 * x - 0.05 * y + 0.01 * u (rng);
+    a.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
+  }
+  for (int k = 0; k < 90; ++k)
+  {
+    const double x = u (rng), y = u (rng);
+    const double z = 0.1 * x - 0.05 * y + 0.06 + 0.01 * u (rng);
+    b.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
+  }
+}
+
+void
+bowl (int n, double sigma, ClassifierCloud& ball, ClassifierCloud& cup)
+{
+  ball = ClassifierCloud ();
+  cup = ClassifierCloud ();
+  for (const Eigen::Vector3d& u : fibonacci (n))
+    ball.add (0.3 * Eigen::Vector3d (u.y (), u.z (), u.x ()), iso (sigma));
+  for (const Eigen::Vector3d& u : fibonacci (2 * n))
+    if (u.x () < 0.0)
+      cup.add (0.4 * Eigen::Vector3d (u.y (), u.z (), u.x ()), iso (sigma));
+}
+
+pcl_probcollision::ClassifierParams
+oracle (pcl_probcollision::TrainingMode training)
+{
+  pcl_probcollision::ClassifierParams p;
+  p.kernel = pcl_probcollision::KernelMode::Linear;
+  p.training = training;
+  p.C = 1e6;
+  return p;
+}
+
 double
 Phi (double z)
 {

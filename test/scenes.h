@@ -7,6 +7,7 @@
 // test that needs another scene gets another builder, under its own name.
 #pragma once
 
+#include <pcl_probcollision/robust_classifier.h>
 #include <pcl_probcollision/uncertain_points.h>
 
 #include <pcl/point_cloud.h>
@@ -87,6 +88,56 @@ shapeCloud (Shape shape, std::size_t n, std::uint64_t seed, double sigma = 0.002
   * kept. */
 pcl_probcollision::UncertainCloud
 transformCloud (const pcl_probcollision::UncertainCloud& cloud, const Eigen::Isometry3d& T);
+
+// ---------------------------------------------------------------------------------------------
+// Gaussian point sets for RobustClassifier (METHOD.md 11's configurations)
+
+/** \brief Points as the classifier takes them: means and covariances, index-aligned. */
+struct ClassifierCloud
+{
+  std::vector<Eigen::Vector3d> means;
+  std::vector<Eigen::Matrix3d> covariances;
+
+  pcl_probcollision::PointSetView view () const { return pcl_probcollision::PointSetView (means, covariances); }
+  void add (const Eigen::Vector3d& m, const Eigen::Matrix3d& c)
+  {
+    means.push_back (m);
+    covariances.push_back (c);
+  }
+  std::size_t size () const { return means.size (); }
+};
+
+/** \brief sigma^2 I. */
+Eigen::Matrix3d
+iso (double sigma);
+
+/** \brief n Fibonacci points on the unit sphere around the x axis: the first coordinate runs
+  * from 1 to -1 (1 - 2 (k + 1/2) / n), the angle about x steps by pi (3 - sqrt 5). */
+std::vector<Eigen::Vector3d>
+fibonacci (int n);
+
+/** \brief A random SPD covariance with standard deviations uniform in [lo, hi], rotated by
+  * Euler angles (z, y, x) uniform in [0, 2 pi). */
+Eigen::Matrix3d
+randomCovariance (std::mt19937_64& rng, double lo, double hi);
+
+/** \brief Two tilted, noisy patches over [0, 1]^2 with random anisotropic covariances
+  * (standard deviations in [0.002, 0.02]): A, 150 points on z = 0.1 x - 0.05 y + U(0, 0.01);
+  * B, 90 points 0.06 above. A generic configuration without symmetry, about 0.05 apart
+  * (std::mt19937_64 seeded with `seed`). */
+void
+genericPatches (ClassifierCloud& a, ClassifierCloud& b, std::uint64_t seed = 7);
+
+/** \brief A ball of radius 0.3 (n Fibonacci points) inside the lower half of a sphere of
+  * radius 0.4 (a bowl: the points of fibonacci (2 n) below its equator), both about the
+  * origin with the Fibonacci axis along z, gap 0.1; covariances sigma^2 I. */
+void
+bowl (int n, double sigma, ClassifierCloud& ball, ClassifierCloud& cup);
+
+/** \brief The oracle configuration of METHOD.md 11: kernel Linear, C = 1e6, the given
+  * training, other parameters at their defaults. */
+pcl_probcollision::ClassifierParams
+oracle (pcl_probcollision::TrainingMode training);
 
 // ---------------------------------------------------------------------------------------------
 // Poses

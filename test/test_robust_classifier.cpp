@@ -1,18 +1,21 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Tests of RobustClassifier against the analytic oracles of METHOD.md 11 (11.0-11.7).
+// RobustClassifier and ClassifierParams (robust_classifier.h) against the analytic oracles of
+// METHOD.md 11 (11.0-11.7): the whole classification and its ladder of rungs, invariances, bad
+// input and threads. Its parts have test files of their own: the rung fits
+// (test_separator_fit.cpp), the per-point probabilities (test_point_probabilities.cpp), the
+// random Fourier features (test_rff_features.cpp) and the SIMD kernels (test_kernels.cpp).
 //
 // Unless a test says otherwise it uses the oracle configuration of METHOD.md 11: kernel Linear,
 // C = 1e6, covariances given explicitly, points exactly at their means. Reference values are
 // computed here from std::erfc, independently of normalCdf.
 #include <pcl_probcollision/robust_classifier.h>
 
-#include <pcl_probcollision/detail/rff_features.h>
-#include <pcl_probcollision/detail/kernels.h>
-
 #include <pcl/exceptions.h>
 
 #include <gtest/gtest.h>
 
+#include "result_checks.h"
+#include "scenes.h"
 #include "seeded_draws.h"
 
 #include <Eigen/Geometry>
@@ -27,40 +30,19 @@
 #include <thread>
 #include <vector>
 
+using namespace pcl_probcollision;
+using Cloud = pcl_probcollision_test::ClassifierCloud;
+using pcl_probcollision_test::bowl;
+using pcl_probcollision_test::classify;
+using pcl_probcollision_test::draw3;
+using pcl_probcollision_test::fibonacci;
+using pcl_probcollision_test::genericPatches;
+using pcl_probcollision_test::iso;
+using pcl_probcollision_test::oracle;
+using pcl_probcollision_test::Phi;
+
 namespace
 {
-using namespace pcl_probcollision;
-using pcl_probcollision_test::draw3;
-
-const double kPi = 3.14159265358979323846;
-
-/** \brief The standard normal CDF from std::erfc (the reference for every oracle). */
-double
-phi (double z)
-{
-  return 0.5 * std::erfc (-z / std::sqrt (2.0));
-}
-
-struct Cloud
-{
-  std::vector<Eigen::Vector3d> means;
-  std::vector<Eigen::Matrix3d> covariances;
-
-  PointSetView view () const { return PointSetView (means, covariances); }
-  void add (const Eigen::Vector3d& m, const Eigen::Matrix3d& c)
-  {
-    means.push_back (m);
-    covariances.push_back (c);
-  }
-  std::size_t size () const { return means.size (); }
-};
-
-Eigen::Matrix3d
-iso (double sigma)
-{
-  return sigma * sigma * Eigen::Matrix3d::Identity ();
-}
-
 /** \brief The 21 x 21 grid over [0,1]^2 of METHOD.md 11.1, lifted onto z = height(x). */
 template <typename Height>
 Cloud
@@ -82,40 +64,6 @@ plane (double z, double sigma)
   return grid ([z] (double) { return z; }, sigma);
 }
 
-ClassifierParams
-oracle (TrainingMode training)
-{
-  ClassifierParams p;
-  p.kernel = KernelMode::Linear;
-  p.training = training;
-  p.C = 1e6;
-  return p;
-}
-
-ClassifierResult
-classify (const ClassifierParams& params, const Cloud& a, const Cloud& b)
-{
-  ClassifierResult r;
-  const RobustClassifier classifier (params);
-  EXPECT_TRUE (classifier.classify (a.view (), b.view (), r)) << r.message;
-  return r;
-}
-
-/** \brief Fibonacci points on the unit sphere around the x axis: the first coordinate runs
-  * from 1 to -1. */
-std::vector<Eigen::Vector3d>
-fibonacci (int n)
-{
-  std::vector<Eigen::Vector3d> p;
-  const double golden = kPi * (3.0 - std::sqrt (5.0));
-  for (int k = 0; k < n; ++k)
-  {
-    const double t = 1.0 - 2.0 * (k + 0.5) / n, r = std::sqrt (1.0 - t * t), a = k * golden;
-    p.emplace_back (t, r * std::cos (a), r * std::sin (a));
-  }
-  return p;
-}
-
 /** \brief METHOD.md 11.4: spheres of radius 0.1 on the x axis at gap g, about 2000 Fibonacci
   * points each plus the pole facing the other sphere. B is the mirror image of A (x -> -x), so
   * the configuration is symmetric about x = 0 and the separator is exactly the mid-plane. */
@@ -131,44 +79,6 @@ spheres (double gap, double sigma, Cloud& a, Cloud& b)
   {
     a.add (Eigen::Vector3d (-c + r * u.x (), r * u.y (), r * u.z ()), iso (sigma));
     b.add (Eigen::Vector3d (c - r * u.x (), r * u.y (), r * u.z ()), iso (sigma));
-  }
-}
-
-/** \brief A random SPD covariance with standard deviations in [lo, hi]. */
-Eigen::Matrix3d
-randomCovariance (std::mt19937_64& rng, double lo, double hi)
-{
-  std::uniform_real_distribution<double> u (lo, hi);
-  const Eigen::Vector3d s = draw3 (u, rng);  // one draw per statement: seeded_draws.h
-  std::uniform_real_distribution<double> angle (0.0, 2.0 * kPi);
-  const Eigen::Vector3d zyx = draw3 (angle, rng);
-  const Eigen::Matrix3d r = (Eigen::AngleAxisd (zyx (0), Eigen::Vector3d::UnitZ ()) *
-                             Eigen::AngleAxisd (zyx (1), Eigen::Vector3d::UnitY ()) *
-                             Eigen::AngleAxisd (zyx (2), Eigen::Vector3d::UnitX ()))
-                                .toRotationMatrix ();
-  return r * s.cwiseAbs2 ().asDiagonal () * r.transpose ();
-}
-
-/** \brief Two tilted, noisy patches with anisotropic covariances: a generic configuration
-  * without symmetry, separated by about 0.05 with sigma up to 0.02. */
-void
-genericPatches (Cloud& a, Cloud& b, std::uint64_t seed = 7)
-{
-  std::mt19937_64 rng (seed);
-  std::uniform_real_distribution<double> u (0.0, 1.0);
-  a = Cloud ();
-  b = Cloud ();
-  for (int k = 0; k < 150; ++k)
-  {
-    const double x = u (rng), y = u (rng);
-    const double z = 0.1 * x - 0.05 * y + 0.01 * u (rng);
-    a.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
-  }
-  for (int k = 0; k < 90; ++k)
-  {
-    const double x = u (rng), y = u (rng);
-    const double z = 0.1 * x - 0.05 * y + 0.06 + 0.01 * u (rng);
-    b.add (Eigen::Vector3d (x, y, z), randomCovariance (rng, 0.002, 0.02));
   }
 }
 
@@ -194,54 +104,13 @@ maxOf (const std::vector<double>& v)
 {
   return *std::max_element (v.begin (), v.end ());
 }
+
 double
 minOf (const std::vector<double>& v)
 {
   return *std::min_element (v.begin (), v.end ());
 }
 } // namespace
-
-// ---------------------------------------------------------------------------------------------
-// normalCdf and normalQuantile
-// ---------------------------------------------------------------------------------------------
-
-TEST (NormalFunctions, CdfMatchesErfcAndTails)
-{
-  EXPECT_EQ (normalCdf (0.0), 0.5);
-  // references to 17 digits; erfc is good to a few ulp, hence 1e-15 relative
-  EXPECT_NEAR (normalCdf (-1.0) / 0.15865525393145705, 1.0, 1e-15);
-  EXPECT_NEAR (normalCdf (-2.0) / 0.022750131948179207, 1.0, 1e-15);
-  EXPECT_NEAR (normalCdf (1.0) + normalCdf (-1.0), 1.0, 1e-16);
-  // the lower tail keeps its relative precision (1 - Phi(z) would round to 0)
-  EXPECT_NEAR (normalCdf (-10.0) / 7.6198530241604696e-24, 1.0, 1e-14);
-  EXPECT_NEAR (normalCdf (-30.0) / 4.906713927148187e-198, 1.0, 1e-13);
-  EXPECT_EQ (normalCdf (std::numeric_limits<double>::infinity ()), 1.0);
-  EXPECT_EQ (normalCdf (-std::numeric_limits<double>::infinity ()), 0.0);
-}
-
-TEST (NormalFunctions, QuantileInvertsCdf)
-{
-  // reference: Phi^-1(0.9) = 1.2815515655446004 (gamma of the default confidence)
-  EXPECT_NEAR (normalQuantile (0.9), 1.2815515655446004, 1e-15);
-  EXPECT_EQ (normalQuantile (0.5), 0.0);
-  for (double p : {1e-300, 1e-100, 1e-20, 1e-9, 1e-3, 0.02425, 0.1, 0.3, 0.5, 0.7, 0.97575, 0.999, 1.0 - 1e-12})
-  {
-    const double x = normalQuantile (p);
-    // relative accuracy on the smaller tail probability; 1e-13 covers erfc's and one ulp of x
-    const double tail = p < 0.5 ? p : 1.0 - p;
-    const double back = p < 0.5 ? normalCdf (x) : normalCdf (-x);
-    EXPECT_NEAR (back / tail, 1.0, 1e-13) << "p = " << p;
-    if (1.0 - (1.0 - p) == p)  // symmetry, where 1 - p is exact
-    {
-      EXPECT_NEAR (normalQuantile (1.0 - p), -x, 1e-13 * std::max (1.0, std::abs (x))) << "p = " << p;
-    }
-  }
-  EXPECT_EQ (normalQuantile (0.0), -std::numeric_limits<double>::infinity ());
-  EXPECT_EQ (normalQuantile (1.0), std::numeric_limits<double>::infinity ());
-  EXPECT_TRUE (std::isnan (normalQuantile (1.5)));
-  EXPECT_TRUE (std::isnan (normalQuantile (-0.1)));
-  EXPECT_TRUE (std::isnan (normalQuantile (std::numeric_limits<double>::quiet_NaN ())));
-}
 
 // ---------------------------------------------------------------------------------------------
 // 11.1 Parallel planes, equal noise
@@ -254,17 +123,17 @@ TEST (RobustClassifier, ParallelPlanesEqualNoise)
     {
       const ClassifierResult r = classify (oracle (mode), plane (0.0, sigma), plane (0.02, sigma));
       const double expected = sigma == 0.01 ? 0.158655 : 0.022750;
-      ASSERT_NEAR (phi (-0.02 / (2.0 * sigma)), expected, 5e-7);
+      ASSERT_NEAR (Phi (-0.02 / (2.0 * sigma)), expected, 5e-7);
       EXPECT_EQ (r.rung, Rung::Linear);
       EXPECT_TRUE (r.converged);
       EXPECT_FALSE (r.degenerate);
-      EXPECT_NEAR (r.probability, phi (-0.02 / (2.0 * sigma)), 1e-6);
+      EXPECT_NEAR (r.probability, Phi (-0.02 / (2.0 * sigma)), 1e-6);
       // every point, both sides: the separator is the mid-plane
       for (const std::vector<double>* side : {&r.probabilities_a, &r.probabilities_b})
       {
         ASSERT_EQ (side->size (), 441u);
-        EXPECT_NEAR (minOf (*side), phi (-0.02 / (2.0 * sigma)), 1e-6);
-        EXPECT_NEAR (maxOf (*side), phi (-0.02 / (2.0 * sigma)), 1e-6);
+        EXPECT_NEAR (minOf (*side), Phi (-0.02 / (2.0 * sigma)), 1e-6);
+        EXPECT_NEAR (maxOf (*side), Phi (-0.02 / (2.0 * sigma)), 1e-6);
       }
       // the witness: unit normal toward A (A is at z = 0, so -z), distance d / 2
       EXPECT_NEAR (r.witness_normal.z (), -1.0, 1e-9);
@@ -292,7 +161,7 @@ TEST (RobustClassifier, ParallelPlanesSigmaSweepIsMonotone)
     for (std::size_t k = 0; k < sigmas.size (); ++k)
     {
       const double p = classify (oracle (mode), plane (0.0, sigmas[k]), plane (0.02, sigmas[k])).probability;
-      EXPECT_NEAR (p, phi (-0.01 / sigmas[k]), 1e-6) << "sigma " << sigmas[k];
+      EXPECT_NEAR (p, Phi (-0.01 / sigmas[k]), 1e-6) << "sigma " << sigmas[k];
       EXPECT_NEAR (p, approx[k], 0.5e-2 * approx[k] + 1e-7) << "METHOD.md's rounded value";
       EXPECT_GT (p, previous);
       EXPECT_LT (p, 0.5);
@@ -338,7 +207,7 @@ TEST (RobustClassifier, LightlyPenetratingEdgeCrossing)
     std::cout << "[ edge crossing ] sigma " << sigmas[k] << ": delta_max " << depth << ", P "
               << r.probability << " (METHOD.md: about " << approx[k] << ")\n";
     EXPECT_NEAR (depth, first_depth, 1e-12) << "the Standard plane must not depend on sigma";
-    EXPECT_NEAR (r.probability, phi (depth / sigmas[k]), 1e-9);
+    EXPECT_NEAR (r.probability, Phi (depth / sigmas[k]), 1e-9);
     EXPECT_GT (r.probability, 0.5);
     EXPECT_LT (r.probability, previous);
     EXPECT_FALSE (r.degenerate);
@@ -367,137 +236,6 @@ TEST (RobustClassifier, SymmetricMidCrossingCollapses)
 }
 
 // ---------------------------------------------------------------------------------------------
-// The linear solver and the robust procedure (METHOD.md 5.2, 5.3), checked from the definition
-// ---------------------------------------------------------------------------------------------
-
-namespace
-{
-/** \brief J(w, b) of METHOD.md 5.3 (squared hinge), written out independently of the library:
-  * Uniform normalisation, class-balanced C_i, eps_s = 1e-12, eta_b = 1e-10. */
-struct LinearObjective
-{
-  std::vector<Eigen::Vector3d> x;
-  std::vector<Eigen::Matrix3d> sigma;
-  std::vector<double> label, weight;
-  double gamma = 0.0;
-
-  LinearObjective (const Cloud& a, const Cloud& b, double c, double gamma_)
-    : gamma (gamma_)
-  {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
-    for (const Cloud* side : {&a, &b})
-      for (const Eigen::Vector3d& m : side->means)
-        centroid += m;
-    const double n = static_cast<double> (a.size () + b.size ());
-    centroid /= n;
-    double r = 0.0;
-    for (const Cloud* side : {&a, &b})
-      for (const Eigen::Vector3d& m : side->means)
-        r = std::max (r, (m - centroid).norm ());
-    const double scale = 0.5 / r;
-    for (const Cloud* side : {&a, &b})
-      for (std::size_t i = 0; i < side->size (); ++i)
-      {
-        x.push_back (scale * (side->means[i] - centroid) + Eigen::Vector3d::Constant (0.5));
-        sigma.push_back (scale * scale * side->covariances[i]);
-        label.push_back (side == &a ? 1.0 : -1.0);
-        weight.push_back (c * n / (2.0 * static_cast<double> (side->size ())));
-      }
-  }
-
-  double operator() (const Eigen::Vector4d& theta) const
-  {
-    const Eigen::Vector3d w = theta.head<3> ();
-    double j = 0.5 * w.squaredNorm () + 0.5 * 1e-10 * theta (3) * theta (3);
-    for (std::size_t i = 0; i < x.size (); ++i)
-    {
-      const double v = 1.0 - label[i] * (w.dot (x[i]) + theta (3)) + gamma * std::sqrt (w.dot (sigma[i] * w) + 1e-24);
-      j += weight[i] * 0.5 * std::max (v, 0.0) * std::max (v, 0.0);
-    }
-    return j;
-  }
-};
-
-Eigen::Vector4d
-theta (const ClassifierResult& r)
-{
-  Eigen::Vector4d t;
-  t << r.separator.weights, r.separator.bias;
-  return t;
-}
-} // namespace
-
-TEST (RobustClassifier, LinearSolutionMinimisesTheObjective)
-{
-  // The returned (w, b) must be the minimiser of J: J is convex, so a point where no
-  // direction decreases J (beyond rounding, ~1e-13 |J|) and the central-difference slope
-  // vanishes (the solver stops at |grad J| <= 1e-10 max(1, |J|)) is the global minimum.
-  Cloud a, b;
-  genericPatches (a, b);
-  std::mt19937_64 rng (17);
-  std::normal_distribution<double> z (0.0, 1.0);
-  for (TrainingMode mode : {TrainingMode::Standard, TrainingMode::Robust})
-  {
-    ClassifierParams p = oracle (mode);
-    p.C = 10.0;
-    const ClassifierResult r = classify (p, a, b);
-    ASSERT_TRUE (r.converged);
-    const LinearObjective objective (a, b, p.C, r.gamma_effective);
-    const Eigen::Vector4d t = theta (r);
-    const double j0 = objective (t);
-    EXPECT_NEAR (j0, r.objective, 1e-12 * j0);
-    for (int k = 0; k < 100; ++k)
-    {
-      const double d0 = z (rng);
-      const Eigen::Vector3d d123 = draw3 (z, rng);
-      const Eigen::Vector4d dir = Eigen::Vector4d (d0, d123 (0), d123 (1), d123 (2)).normalized ();
-      const double h = 1e-4 * t.norm ();
-      EXPECT_GE (objective (t + h * dir) - j0, -1e-13 * j0);
-      // J is piecewise quadratic, so the central difference has no truncation error away from
-      // the hinges; its rounding error is at most n eps |J| / step (n summed terms)
-      const double step = 1e-5;
-      const double slope = (objective (t + step * dir) - objective (t - step * dir)) / (2.0 * step);
-      const double rounding = static_cast<double> (objective.x.size ()) * 1.1e-16 * j0 / step;
-      EXPECT_LT (std::abs (slope), 1e-10 * std::max (1.0, j0) + rounding);
-    }
-  }
-}
-
-TEST (RobustClassifier, RobustGammaFollowsTheStandardSolution)
-{
-  // METHOD.md 5.2: t_hat = min c_i f_i / s_i over s_i > 0 on the Standard solution,
-  // gamma_eff = min(gamma, 0.9 max(0, t_hat)).
-  Cloud a, b;
-  genericPatches (a, b);
-  for (double scale : {0.5, 2.0, 8.0})
-  {
-    Cloud na = a, nb = b;
-    for (Eigen::Matrix3d& c : na.covariances)
-      c *= scale * scale;
-    for (Eigen::Matrix3d& c : nb.covariances)
-      c *= scale * scale;
-    ClassifierParams p = oracle (TrainingMode::Standard);
-    p.C = 10.0;
-    const ClassifierResult standard = classify (p, na, nb);
-    const LinearObjective o (na, nb, p.C, 0.0);
-    const Eigen::Vector4d t = theta (standard);
-    double t_hat = std::numeric_limits<double>::infinity ();
-    for (std::size_t i = 0; i < o.x.size (); ++i)
-    {
-      const double s = std::sqrt (t.head<3> ().dot (o.sigma[i] * t.head<3> ()));
-      if (s > 0.0)
-        t_hat = std::min (t_hat, o.label[i] * (t.head<3> ().dot (o.x[i]) + t (3)) / s);
-    }
-    p.training = TrainingMode::Robust;
-    const ClassifierResult robust = classify (p, na, nb);
-    const double expected = std::min (normalQuantile (0.9), 0.9 * std::max (0.0, t_hat));
-    std::cout << "[ robust gamma ] noise x" << scale << ": t_hat " << t_hat << ", gamma_eff "
-              << robust.gamma_effective << "\n";
-    EXPECT_NEAR (robust.gamma_effective, expected, 1e-12 * std::max (1.0, expected));
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
 // 11.2 Parallel planes, unequal noise; 11.3 plane against a single point
 // ---------------------------------------------------------------------------------------------
 
@@ -505,7 +243,7 @@ TEST (RobustClassifier, ParallelPlanesUnequalNoise)
 {
   const Cloud a = plane (0.0, 0.01), b = plane (0.06, 0.02);
   const ClassifierResult standard = classify (oracle (TrainingMode::Standard), a, b);
-  EXPECT_NEAR (standard.probability, phi (-1.5), 1e-6);
+  EXPECT_NEAR (standard.probability, Phi (-1.5), 1e-6);
   EXPECT_NEAR (standard.probability, 0.066807, 5e-7);
 
   const ClassifierResult robust = classify (oracle (TrainingMode::Robust), a, b);
@@ -515,9 +253,9 @@ TEST (RobustClassifier, ParallelPlanesUnequalNoise)
   const double gamma = normalQuantile (0.9), gap = 0.06 / 2.0 + gamma * (0.01 - 0.02) / 2.0;
   EXPECT_NEAR (gap, 0.023592, 5e-7);
   for (double p : robust.probabilities_a)
-    EXPECT_NEAR (p, phi (-gap / 0.01), 1e-4);
+    EXPECT_NEAR (p, Phi (-gap / 0.01), 1e-4);
   for (double p : robust.probabilities_b)
-    EXPECT_NEAR (p, phi (-(0.06 - gap) / 0.02), 1e-4);
+    EXPECT_NEAR (p, Phi (-(0.06 - gap) / 0.02), 1e-4);
   EXPECT_NEAR (maxOf (robust.probabilities_a), 0.009157, 1e-4);
   EXPECT_NEAR (robust.probability, 0.034350, 1e-4);
   EXPECT_EQ (robust.witness_side, -1);
@@ -535,7 +273,7 @@ TEST (RobustClassifier, PlaneAgainstSinglePoint)
   const ClassifierResult standard = classify (oracle (TrainingMode::Standard), a, b);
   EXPECT_NEAR (standard.probability, 0.066807, 1e-6);
   const ClassifierResult robust = classify (oracle (TrainingMode::Robust), a, b);
-  EXPECT_NEAR (robust.probability, phi (-(3.0 + normalQuantile (0.9)) / 2.0), 1e-4);
+  EXPECT_NEAR (robust.probability, Phi (-(3.0 + normalQuantile (0.9)) / 2.0), 1e-4);
   EXPECT_NEAR (robust.probability, 0.016146, 1e-4);
   for (const ClassifierResult* r : {&standard, &robust})
   {
@@ -567,7 +305,7 @@ TEST (RobustClassifier, TwoSpheresSeparated)
   {
     spheres (gap, 0.01, a, b);
     const double p = classify (oracle (TrainingMode::Standard), a, b).probability;
-    EXPECT_NEAR (p, phi (-gap / 0.02), 1e-3) << "gap " << gap;
+    EXPECT_NEAR (p, Phi (-gap / 0.02), 1e-3) << "gap " << gap;
     EXPECT_GT (p, previous);
     EXPECT_LT (p, 0.5);
     previous = p;
@@ -590,14 +328,14 @@ TEST (RobustClassifier, TwoSpheresPenetrating)
     {
       const ClassifierResult r = classify (oracle (mode), a, b);
       EXPECT_NEAR (r.probability, gap == -0.01 ? 0.6915 : 0.8413, 2e-3);
-      EXPECT_NEAR (r.probability, phi (-gap / 0.02), 2e-3);
+      EXPECT_NEAR (r.probability, Phi (-gap / 0.02), 2e-3);
       EXPECT_GT (r.probability, previous);
       if (mode == TrainingMode::Robust)
       {
         EXPECT_EQ (r.gamma_effective, 0.0);
       }
     }
-    previous = phi (-gap / 0.02) - 2e-3;
+    previous = Phi (-gap / 0.02) - 2e-3;
   }
 }
 
@@ -875,23 +613,6 @@ TEST (RobustClassifier, MoreNoisyPointsNearContactRaiseTheMaximum)
 // The kernel rung and the ladder
 // ---------------------------------------------------------------------------------------------
 
-namespace
-{
-/** \brief A ball of radius 0.3 (n points) inside the lower half of a sphere of radius 0.4
-  * (a bowl, about n points), gap 0.1 = 10 sigma. */
-void
-bowl (int n, double sigma, Cloud& ball, Cloud& cup)
-{
-  ball = Cloud ();
-  cup = Cloud ();
-  for (const Eigen::Vector3d& u : fibonacci (n))
-    ball.add (0.3 * Eigen::Vector3d (u.y (), u.z (), u.x ()), iso (sigma));
-  for (const Eigen::Vector3d& u : fibonacci (2 * n))
-    if (u.x () < 0.0)
-      cup.add (0.4 * Eigen::Vector3d (u.y (), u.z (), u.x ()), iso (sigma));
-}
-} // namespace
-
 TEST (RobustClassifier, CurvedBowlNeedsTheKernelRung)
 {
   Cloud ball, cup;
@@ -967,191 +688,6 @@ TEST (RobustClassifier, LadderKeepsThePlaneWhenItIsEnough)
   EXPECT_EQ (r.separator.weights.size (), 3);
 }
 
-TEST (RobustClassifier, MonteCarloLinear)
-{
-  // METHOD.md 11.7: the fraction of samples x ~ N(mean_i, Sigma_i) with c_i f(x) < 0 matches
-  // P_i within 3 standard errors; for a linear f at any noise level.
-  Cloud a, b;
-  genericPatches (a, b);
-  for (Eigen::Matrix3d& c : a.covariances)
-    c *= 4.0;  // larger noise: P_i in a range where the comparison has power
-  ClassifierParams p;
-  p.kernel = KernelMode::Linear;
-  const RobustClassifier classifier (p);
-  ClassifierResult r;
-  ASSERT_TRUE (classifier.classify (a.view (), b.view (), r));
-  std::mt19937_64 rng (2024);
-  std::normal_distribution<double> z (0.0, 1.0);
-  const int samples = 100000;
-  int tested = 0;
-  for (int side = 0; side < 2; ++side)
-  {
-    const Cloud& cloud = side == 0 ? a : b;
-    const std::vector<double>& probabilities = side == 0 ? r.probabilities_a : r.probabilities_b;
-    const double c = side == 0 ? 1.0 : -1.0;
-    for (std::size_t i = 0; i < cloud.size () && tested < 6; i += 7)
-    {
-      if (probabilities[i] < 0.01)
-        continue;
-      const Eigen::Matrix3d l = cloud.covariances[i].llt ().matrixL ();
-      int crossed = 0;
-      for (int s = 0; s < samples; ++s)
-      {
-        const Eigen::Vector3d x = cloud.means[i] + l * draw3 (z, rng);
-        crossed += c * classifier.evaluate (r.separator, x) < 0.0;
-      }
-      const double pi = probabilities[i], se = std::sqrt (pi * (1.0 - pi) / samples);
-      EXPECT_NEAR (static_cast<double> (crossed) / samples, pi, 3.0 * se) << "side " << side << " point " << i;
-      ++tested;
-    }
-  }
-  EXPECT_GE (tested, 4);
-}
-
-TEST (RobustClassifier, MonteCarloRff)
-{
-  // For a curved f the linearisation is first order. Second-order Taylor: f(x_i + e) = f_i +
-  // g^T e + e^T H e / 2 + O(|e|^3), and e^T H e / 2 has mean tr(H Sigma) / 2 and standard
-  // deviation sqrt(tr((H Sigma)^2) / 2). The documented error bound on P_i is the density
-  // bound 1/sqrt(2 pi) times (|tr(H Sigma)| / 2 + sqrt(tr((H Sigma)^2) / 2)) / s_i, plus 3
-  // standard errors, with H from central differences of the gradient.
-  Cloud ball, cup;
-  bowl (200, 0.02, ball, cup);
-  ClassifierParams p;
-  p.kernel = KernelMode::RFF;
-  const RobustClassifier classifier (p);
-  ClassifierResult r;
-  ASSERT_TRUE (classifier.classify (ball.view (), cup.view (), r));
-  std::mt19937_64 rng (99);
-  std::normal_distribution<double> z (0.0, 1.0);
-  const int samples = 100000;
-  // the points with the largest P on each side
-  for (int side = 0; side < 2; ++side)
-  {
-    const Cloud& cloud = side == 0 ? ball : cup;
-    const std::vector<double>& probabilities = side == 0 ? r.probabilities_a : r.probabilities_b;
-    const std::size_t i = static_cast<std::size_t> (
-        std::max_element (probabilities.begin (), probabilities.end ()) - probabilities.begin ());
-    const double c = side == 0 ? 1.0 : -1.0;
-    const Eigen::Vector3d& x0 = cloud.means[i];
-    const Eigen::Matrix3d& sigma = cloud.covariances[i];
-    Eigen::Vector3d g;
-    classifier.evaluate (r.separator, x0, &g);
-    Eigen::Matrix3d h;
-    const double step = 1e-5;
-    for (int k = 0; k < 3; ++k)
-    {
-      Eigen::Vector3d gp, gm;
-      classifier.evaluate (r.separator, x0 + step * Eigen::Vector3d::Unit (k), &gp);
-      classifier.evaluate (r.separator, x0 - step * Eigen::Vector3d::Unit (k), &gm);
-      h.col (k) = (gp - gm) / (2.0 * step);
-    }
-    const Eigen::Matrix3d hs = h * sigma;
-    const double s = std::sqrt (g.dot (sigma * g));
-    const double bias = (0.5 * std::abs (hs.trace ()) + std::sqrt (0.5 * (hs * hs).trace ())) / s / std::sqrt (2.0 * kPi);
-    const Eigen::Matrix3d l = sigma.llt ().matrixL ();
-    int crossed = 0;
-    for (int k = 0; k < samples; ++k)
-      crossed += c * classifier.evaluate (r.separator, x0 + l * draw3 (z, rng)) < 0.0;
-    const double pi = probabilities[i], se = std::sqrt (std::max (pi * (1.0 - pi), 1.0 / samples) / samples);
-    const double observed = static_cast<double> (crossed) / samples;
-    std::cout << "[ RFF Monte Carlo ] side " << side << " point " << i << ": P_i " << pi
-              << ", sampled " << observed << ", bound " << 3.0 * se + bias << "\n";
-    EXPECT_NEAR (observed, pi, 3.0 * se + bias);
-  }
-}
-
-TEST (RobustClassifier, RffJacobianMatchesCentralDifferences)
-{
-  Eigen::MatrixXd omega;
-  Eigen::VectorXd beta;
-  const int features = 256;
-  detail::drawRandomFourierFeatures (12345, features, 1.0, omega, beta);
-  std::mt19937_64 rng (5);
-  std::uniform_real_distribution<double> u (0.0, 1.0);
-  for (int trial = 0; trial < 20; ++trial)
-  {
-    const Eigen::Vector3d x = draw3 (u, rng);
-    Eigen::VectorXd phi0;
-    Eigen::MatrixXd jacobian;
-    detail::rffFeatures (omega, beta, features, x, phi0, &jacobian);
-    Eigen::MatrixXd numeric (features, 3);
-    const double step = 1e-6;
-    for (int k = 0; k < 3; ++k)
-    {
-      Eigen::VectorXd plus, minus;
-      detail::rffFeatures (omega, beta, features, x + step * Eigen::Vector3d::Unit (k), plus);
-      detail::rffFeatures (omega, beta, features, x - step * Eigen::Vector3d::Unit (k), minus);
-      numeric.col (k) = (plus - minus) / (2.0 * step);
-    }
-    EXPECT_LT ((numeric - jacobian).norm () / jacobian.norm (), 1e-6);
-  }
-}
-
-TEST (RobustClassifier, RffApproximatesTheRbfKernel)
-{
-  std::mt19937_64 rng (8);
-  std::uniform_real_distribution<double> u (0.0, 1.0);
-  for (int features : {256, 4096})
-    for (double gamma_k : {1.0, 10.0})
-    {
-      Eigen::MatrixXd omega;
-      Eigen::VectorXd beta;
-      detail::drawRandomFourierFeatures (12345, features, gamma_k, omega, beta);
-      double error = 0.0;
-      const int pairs = 2000;
-      for (int k = 0; k < pairs; ++k)
-      {
-        const Eigen::Vector3d x = draw3 (u, rng);
-        const Eigen::Vector3d y = draw3 (u, rng);
-        Eigen::VectorXd px, py;
-        detail::rffFeatures (omega, beta, features, x, px);
-        detail::rffFeatures (omega, beta, features, y, py);
-        error += std::abs (px.dot (py) - std::exp (-gamma_k * (x - y).squaredNorm ()));
-      }
-      EXPECT_LE (error / pairs, 3.0 / std::sqrt (static_cast<double> (features)))
-          << "D " << features << " gamma_k " << gamma_k;
-    }
-}
-
-TEST (RobustClassifier, RffDrawIsReproducibleAndHasTheRightMoments)
-{
-  Eigen::MatrixXd o1, o2, o3;
-  Eigen::VectorXd b1, b2, b3;
-  detail::drawRandomFourierFeatures (12345, 4096, 2.5, o1, b1);
-  detail::drawRandomFourierFeatures (12345, 4096, 2.5, o2, b2);
-  detail::drawRandomFourierFeatures (12345, 256, 2.5, o3, b3);
-  EXPECT_EQ (o1, o2);
-  EXPECT_EQ (b1, b2);
-  EXPECT_EQ (o1.topRows (256), o3);  // the small rung is a prefix of the large one
-  EXPECT_EQ (b1.head (256), b3);
-  // omega_k ~ N(0, 2 gamma_k I): 12288 draws, variance 5; 5 standard errors
-  const double n = static_cast<double> (o1.size ());
-  const double mean = o1.mean (), var = (o1.array () - mean).square ().sum () / (n - 1.0);
-  EXPECT_NEAR (mean, 0.0, 5.0 * std::sqrt (5.0 / n));
-  EXPECT_NEAR (var, 5.0, 5.0 * 5.0 * std::sqrt (2.0 / n));
-  // beta ~ U[0, 2 pi)
-  EXPECT_GE (b1.minCoeff (), 0.0);
-  EXPECT_LT (b1.maxCoeff (), 2.0 * kPi);
-  EXPECT_NEAR (b1.mean (), kPi, 5.0 * 2.0 * kPi / std::sqrt (12.0 * 4096.0));
-}
-
-TEST (RobustClassifier, VectorisedSinCosMatchesTheLibrary)
-{
-  std::vector<double> z, s, c;
-  for (int k = -200000; k <= 200000; ++k)
-    z.push_back (k * 1e-3 + 1e-7 * k);  // |z| up to ~200, covers many quadrants
-  z.push_back (3e5);                      // beyond the reduction range: library path
-  z.push_back (-1e6);
-  s.resize (z.size ());
-  c.resize (z.size ());
-  detail::sinCos (z.data (), s.data (), c.data (), z.size ());
-  double worst = 0.0;
-  for (std::size_t i = 0; i < z.size (); ++i)
-    worst = std::max ({worst, std::abs (s[i] - std::sin (z[i])), std::abs (c[i] - std::cos (z[i]))});
-  EXPECT_LT (worst, 4.5e-16);  // a few ulp of numbers below 1
-}
-
 // ---------------------------------------------------------------------------------------------
 // Bad input and parameters
 // ---------------------------------------------------------------------------------------------
@@ -1201,8 +737,8 @@ TEST (RobustClassifier, SinglePointPerSideIsThePerpendicularBisector)
       p.training = mode;
       const ClassifierResult r = classify (p, a, b);
       EXPECT_EQ (r.rung, Rung::Linear);
-      EXPECT_NEAR (r.probabilities_a[0], phi (-half / 0.1), 1e-9);
-      EXPECT_NEAR (r.probabilities_b[0], phi (-half / 0.1), 1e-9);
+      EXPECT_NEAR (r.probabilities_a[0], Phi (-half / 0.1), 1e-9);
+      EXPECT_NEAR (r.probabilities_b[0], Phi (-half / 0.1), 1e-9);
       EXPECT_NEAR ((r.witness_normal - Eigen::Vector3d (-half, -half, 0.0)).norm (), 0.0, 1e-9);
       EXPECT_NEAR (r.witness_distance, half, 1e-9);
     }
