@@ -8,10 +8,10 @@
 #include "mesh_sampling.h"
 #include "pcd_files.h"
 
+#include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
 #include <pcl/console/print.h>
-#include <pcl/exceptions.h>
 
 #include <unistd.h>
 
@@ -135,7 +135,7 @@ sampleInput (Input& in, double spacing, const std::string& source, FILE* log)
   }
   catch (const std::runtime_error& e)
   {
-    throw Failure{kRuntimeFailure, "mesh '" + in.path + "': " + e.what ()};
+    throw Failure{kRuntimeFailure, "mesh '" + in.path + "': " + pcl_probcollision::errorMessage (e)};
   }
   in.finite = in.cloud->size ();
   in.spacing = spacing;
@@ -598,19 +598,9 @@ main (int argc, char** argv)
     std::fprintf (stderr, "pcd_collision: error: %s\n", f.message.c_str ());
     return f.status;
   }
-  catch (const pcl::PCLException& e)
-  {
-    // what() is "function in file @ line : description"; keep the description.
-    std::string message = e.what ();
-    const std::size_t sep = message.find (": ");
-    if (sep != std::string::npos)
-      message = message.substr (sep + 2);
-    std::fprintf (stderr, "pcd_collision: error: %s\n", message.c_str ());
-    return 1;
-  }
   catch (const std::exception& e)
   {
-    std::fprintf (stderr, "pcd_collision: error: %s\n", e.what ());
+    std::fprintf (stderr, "pcd_collision: error: %s\n", pcl_probcollision::errorMessage (e).c_str ());
     return 1;
   }
   catch (...)

@@ -501,6 +501,29 @@ TEST_F (PcdCollisionTool, UnknownFlagAndWrongCounts)
   expectFailure ({}, 2, "two input files");
 }
 
+// Errors name the user's file or flag, never our sources: PCL_THROW_EXCEPTION puts the source
+// file into what(), and the tool prints pcl_probcollision::errorMessage instead.
+TEST_F (PcdCollisionTool, ErrorMessagesCarryNoSourcePaths)
+{
+  writeFile (dir_ / "far.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\n"
+                               "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n1e16 0 0\n0 0 0\n");
+  const std::string a = kGripper.string (), b = kScene.string ();
+  const std::vector<std::vector<std::string>> runs = {
+    {b, b, "-sigma", "1e200"},                   // rejected by the library (non-finite covariance)
+    {(dir_ / "far.pcd").string (), b},           // rejected by the library (coordinate range)
+    {a, b, "-mesh_density", "1e-9"},             // rejected by the mesh sampler
+    {a, b, "-sigma", "-1"}, {a, b, "-k", "0"}, {a, b, "-epsilon", "0.5"}};  // rejected by the parser
+  for (const auto& args : runs)
+  {
+    const ToolRun r = run (args);
+    EXPECT_NE (r.status, 0) << args.back ();
+    const std::string err = r.err.substr (std::min (r.err.find ("pcd_collision: error: "), r.err.size ()));
+    ASSERT_FALSE (err.empty ()) << r.err;
+    for (const char* leak : {".cpp", ".hpp", ".h ", ".h:", " @ ", "/src/", "/include/", "/impl/"})
+      EXPECT_EQ (err.find (leak), std::string::npos) << leak << " in: " << err;
+  }
+}
+
 TEST_F (PcdCollisionTool, OutputIntoMissingDirectory)
 {
   const std::string out = (dir_ / "no_such_dir" / "out.pcd").string ();
