@@ -166,6 +166,19 @@ protected:
   fs::path dir_, io_;
 };
 
+/** \brief Every object key in v, nested ones as "parent.key" (array elements add nothing). */
+void
+collectKeys (const Value& v, const std::string& prefix, std::set<std::string>& keys)
+{
+  for (const auto& [k, child] : v.object)
+  {
+    keys.insert (prefix + k);
+    collectKeys (child, prefix + k + ".", keys);
+  }
+  for (const auto& child : v.array)
+    collectKeys (child, prefix, keys);
+}
+
 std::string
 poseArg (const Value& pose)
 {
@@ -257,6 +270,51 @@ TEST_F (PcdCollisionTool, JsonFieldsAndTypes)
   EXPECT_EQ (j["parameters"]["thresholds"][0].number, 0.1);
   EXPECT_EQ (j["parameters"]["sigma_b"].number, 0.005);
   EXPECT_EQ (j["parameters"]["sigma_a"].type, T::Null);  // a mesh gets no noise
+}
+
+// docs/CLI.md documents every key -json writes: each one appears in the key table of the
+// -json section, as `key` or "key", and the example line there has the keys of a real run.
+TEST_F (PcdCollisionTool, JsonKeysAreDocumented)
+{
+  const std::string doc = readFile (CLI_DOC);
+  const std::size_t begin = doc.find ("**`-json`**"), end = doc.find ("**`-o FILE.pcd`**");
+  ASSERT_NE (begin, std::string::npos);
+  ASSERT_NE (end, std::string::npos);
+  std::string table, example;
+  for (const auto& l : lines (doc.substr (begin, end - begin)))
+  {
+    if (l.rfind ("|", 0) == 0)
+      table += l + "\n";
+    else if (l.rfind ("{\"pose\"", 0) == 0)
+      example = l;
+  }
+
+  // Every branch: batch (pose_index), -o (output, write), a mesh and a cloud, a witness.
+  writeFile (dir_ / "poses.txt", "-0.15,0.05,-0.02,0,0,0\n");
+  const auto batch = runJson ({kGripper.string (), kScene.string (), "-poses", (dir_ / "poses.txt").string ()});
+  const auto written = runJson ({kScene.string (), kGripper.string (), "-pose", "0.15,-0.05,0.02,0,0,0", "-o",
+                                 (dir_ / "out.pcd").string ()});
+  ASSERT_EQ (batch.size (), 1u);
+  ASSERT_EQ (written.size (), 1u);
+  ASSERT_EQ (batch[0]["witness"].type, Value::Type::Object);
+  std::set<std::string> keys;
+  collectKeys (batch[0], "", keys);
+  collectKeys (written[0], "", keys);
+  for (const std::string& path : keys)
+  {
+    const std::string key = path.substr (path.rfind ('.') + 1);
+    EXPECT_TRUE (table.find ("`" + key + "`") != std::string::npos || table.find ("\"" + key + "\"") != std::string::npos)
+        << "-json writes '" << path << "' but docs/CLI.md does not document it";
+  }
+
+  // The documented example, run again, has exactly the documented keys.
+  ASSERT_FALSE (example.empty ());
+  std::set<std::string> documented, actual;
+  collectKeys (mini_json::parse (example), "", documented);
+  const auto now = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0"});
+  ASSERT_EQ (now.size (), 1u);
+  collectKeys (now[0], "", actual);
+  EXPECT_EQ (documented, actual);
 }
 
 TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
