@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-#include <pcl_probcollision/robust_classifier.h>
+#include <pcl_probcollision/classifier_params.h>
 
 #include <cstdint>
 
@@ -21,15 +21,6 @@ enum class TraversalMode
     * overlapping pairs opened (the reference code's inflated boxes). Deterministic. */
   ExpandedBV
 };
-
-/** \brief ClassifierParams as CollisionRequest uses them by default (C = 1000). */
-inline ClassifierParams
-collisionClassifierDefaults ()
-{
-  ClassifierParams params;
-  params.C = 1000.0;
-  return params;
-}
 
 /** \brief What a collision query computes and how: only what a query needs (how each cloud is
   * modelled is in CloudModelParams, fixed when its CloudModel is built). Every member has a
@@ -70,12 +61,8 @@ struct CollisionRequest
     * P of those poses costs ranking accuracy (docs/PERFORMANCE.md). */
   bool defer_kernel_fits = false;
 
-  /** \brief The separator fitted at each leaf pair: ClassifierParams' defaults (Ladder,
-    * Robust, kappa = 0.9) except C = 1000. A leaf pair's points span far more than the gap
-    * between them, and with the reference code's C = 10 the soft margin preferred a separator
-    * tilted between side-by-side patches that leaves a few points on the wrong side: free
-    * poses 4-7 sigma from contact read P = 1 (docs/RESULTS.md). */
-  ClassifierParams classifier = collisionClassifierDefaults ();
+  /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
+  ClassifierParams classifier;
 
   void validate () const;
   bool operator== (const CollisionRequest& o) const;
