@@ -3,7 +3,8 @@
 // pose at a time or many on several threads. Most models are built from UncertainCloud directly
 // (scenes.h: no FLANN, no OpenMP), so that ThreadSanitizer sees only our code; every model is
 // built before any thread starts. Tests named *Concurrent* run under ThreadSanitizer in CI
-// (scripts/ci-reliability.sh). verdictFor() is checked on every answer by expectSane().
+// (scripts/ci-reliability.sh). verdictFor() has its boundary table at the end, and is checked on
+// every answer by expectSane().
 #include <pcl_probcollision/collision.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
@@ -390,4 +391,62 @@ TEST (CollideBatch, InvalidRequestOrPoseFailsEveryPoseLikeCollide)
       expectSameResult (single, batch[i], "pose " + std::to_string (i));
     }
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// verdictFor()
+
+TEST (VerdictFor, ThresholdsAreStrictSoTheBoundariesReadContact)
+{
+  // collision_request.h: P < free_below is Free, P > collision_above InCollision, and
+  // free_below <= P <= collision_above InContact (both boundaries included in contact).
+  const double nan = std::numeric_limits<double>::quiet_NaN ();
+  struct Case
+  {
+    double free_below, collision_above, p;
+    Verdict expected;
+  };
+  const Case cases[] = {
+      {0.1, 0.9, nan, Verdict::Unknown},
+      {0.1, 0.9, 0.0, Verdict::Free},
+      {0.1, 0.9, std::nextafter (0.1, 0.0), Verdict::Free},
+      {0.1, 0.9, 0.1, Verdict::InContact},
+      {0.1, 0.9, 0.5, Verdict::InContact},
+      {0.1, 0.9, 0.9, Verdict::InContact},
+      {0.1, 0.9, std::nextafter (0.9, 1.0), Verdict::InCollision},
+      {0.1, 0.9, 1.0, Verdict::InCollision},
+      // Other thresholds move the boundaries with them.
+      {0.2, 0.6, nan, Verdict::Unknown},
+      {0.2, 0.6, 0.15, Verdict::Free},
+      {0.2, 0.6, 0.2, Verdict::InContact},
+      {0.2, 0.6, 0.6, Verdict::InContact},
+      {0.2, 0.6, 0.65, Verdict::InCollision},
+      // The range ends: free_below = 0 leaves nothing Free, collision_above = 1 nothing InCollision.
+      {0.0, 1.0, 0.0, Verdict::InContact},
+      {0.0, 1.0, 1.0, Verdict::InContact},
+      // A single threshold: only P = 0.5 itself is contact.
+      {0.5, 0.5, std::nextafter (0.5, 0.0), Verdict::Free},
+      {0.5, 0.5, 0.5, Verdict::InContact},
+      {0.5, 0.5, std::nextafter (0.5, 1.0), Verdict::InCollision},
+  };
+  for (const Case& c : cases)
+  {
+    CollisionRequest request;
+    request.free_below = c.free_below;
+    request.collision_above = c.collision_above;
+    ASSERT_NO_THROW (request.validate ());
+    EXPECT_EQ (verdictFor (c.p, request), c.expected)
+        << "P = " << c.p << " with free_below " << c.free_below << ", collision_above " << c.collision_above
+        << ": got " << verdictName (verdictFor (c.p, request)) << ", expected " << verdictName (c.expected);
+  }
+}
+
+TEST (VerdictFor, DefaultRequestGivesTheDocumentedBands)
+{
+  const CollisionRequest request;  // free below 0.1, collision above 0.9
+  EXPECT_EQ (verdictFor (0.05, request), Verdict::Free);
+  EXPECT_EQ (verdictFor (0.1, request), Verdict::InContact);
+  EXPECT_EQ (verdictFor (0.9, request), Verdict::InContact);
+  EXPECT_EQ (verdictFor (0.95, request), Verdict::InCollision);
+  EXPECT_EQ (verdictFor (-std::numeric_limits<double>::quiet_NaN (), request), Verdict::Unknown);
 }

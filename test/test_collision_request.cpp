@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// CollisionRequest (collision_request.h): the documented defaults, validate() naming the member
+// out of range, and operator== over every member.
+#include <pcl_probcollision/collision_request.h>
+
+#include <pcl/exceptions.h>
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+using namespace pcl_probcollision;
+
+namespace
+{
+/** \brief A named change to a request: what validate() must name, or what operator== must see. */
+struct Change
+{
+  std::string name;
+  std::function<void (CollisionRequest&)> apply;
+};
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN ();
+constexpr double kInf = std::numeric_limits<double>::infinity ();
+} // namespace
+
+TEST (CollisionRequest, DefaultsAreTheDocumentedOnes)
+{
+  const CollisionRequest r;
+  EXPECT_EQ (r.free_below, 0.1);       // METHOD.md 7, A = 0.9
+  EXPECT_EQ (r.collision_above, 0.9);  // B = 0.1
+  EXPECT_FALSE (r.exhaustive);
+  EXPECT_FALSE (r.per_point);
+  EXPECT_FALSE (r.enable_timings);
+  EXPECT_EQ (r.traversal, TraversalMode::ExpectedWeight);
+  EXPECT_EQ (r.rho_min, 1e-3);
+  EXPECT_EQ (r.seed, 1u);
+  EXPECT_EQ (r.expanded_k_sigma, 3.0);
+  EXPECT_FALSE (r.defer_kernel_fits);
+  // The leaf-pair classifier: Ladder, Robust, kappa = 0.9, C = 1000 (README, "Defaults").
+  EXPECT_EQ (r.classifier.kernel, KernelMode::Ladder);
+  EXPECT_EQ (r.classifier.training, TrainingMode::Robust);
+  EXPECT_EQ (r.classifier.confidence, 0.9);
+  EXPECT_EQ (r.classifier.C, 1000.0);
+  EXPECT_NO_THROW (r.validate ());
+}
+
+TEST (CollisionRequest, ValidateNamesTheMemberOutOfRangeAndItsValue)
+{
+  const std::vector<Change> cases = {
+      {"free_below -0.1", [] (CollisionRequest& r) { r.free_below = -0.1; }},
+      {"free_below 0.6", [] (CollisionRequest& r) { r.free_below = 0.6; }},
+      {"free_below nan", [] (CollisionRequest& r) { r.free_below = kNaN; }},
+      {"collision_above 0.4", [] (CollisionRequest& r) { r.collision_above = 0.4; }},
+      {"collision_above 1.1", [] (CollisionRequest& r) { r.collision_above = 1.1; }},
+      {"collision_above nan", [] (CollisionRequest& r) { r.collision_above = kNaN; }},
+      {"rho_min -0.5", [] (CollisionRequest& r) { r.rho_min = -0.5; }},
+      {"rho_min 2", [] (CollisionRequest& r) { r.rho_min = 2.0; }},
+      {"rho_min nan", [] (CollisionRequest& r) { r.rho_min = kNaN; }},
+      {"expanded_k_sigma -1", [] (CollisionRequest& r) { r.expanded_k_sigma = -1.0; }},
+      {"expanded_k_sigma inf", [] (CollisionRequest& r) { r.expanded_k_sigma = kInf; }},
+      {"expanded_k_sigma nan", [] (CollisionRequest& r) { r.expanded_k_sigma = kNaN; }},
+      {"traversal mode 7", [] (CollisionRequest& r) { r.traversal = static_cast<TraversalMode> (7); }},
+      // The classifier's own check runs too, and names its parameter.
+      {"C 0", [] (CollisionRequest& r) { r.classifier.C = 0.0; }},
+      {"confidence 0.4", [] (CollisionRequest& r) { r.classifier.confidence = 0.4; }},
+  };
+  for (const Change& c : cases)
+  {
+    CollisionRequest r;
+    c.apply (r);
+    try
+    {
+      r.validate ();
+      ADD_FAILURE () << c.name << " did not throw";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find (c.name), std::string::npos) << c.name << ": " << e.what ();
+    }
+  }
+}
+
+TEST (CollisionRequest, ValidateMessageCarriesTheMethodPrefix)
+{
+  CollisionRequest r;
+  r.rho_min = 2.0;
+  try
+  {
+    r.validate ();
+    FAIL () << "rho_min 2 did not throw";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("[pcl_probcollision::CollisionRequest::validate] rho_min 2"),
+               std::string::npos)
+        << e.what ();
+  }
+}
+
+TEST (CollisionRequest, ValidateNamesTheFirstMemberOutOfRange)
+{
+  CollisionRequest r;
+  r.free_below = 0.7;   // checked first
+  r.rho_min = -1.0;     // checked later
+  try
+  {
+    r.validate ();
+    FAIL () << "did not throw";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    const std::string what = e.what ();
+    EXPECT_NE (what.find ("free_below 0.7"), std::string::npos) << what;
+    EXPECT_EQ (what.find ("rho_min"), std::string::npos) << what;
+  }
+}
+
+TEST (CollisionRequest, ValidateAcceptsTheClosedRangeEnds)
+{
+  const std::vector<Change> cases = {
+      {"free_below 0", [] (CollisionRequest& r) { r.free_below = 0.0; }},
+      {"free_below 0.5", [] (CollisionRequest& r) { r.free_below = 0.5; }},
+      {"collision_above 0.5", [] (CollisionRequest& r) { r.collision_above = 0.5; }},
+      {"collision_above 1", [] (CollisionRequest& r) { r.collision_above = 1.0; }},
+      {"free_below = collision_above = 0.5",
+       [] (CollisionRequest& r) { r.free_below = r.collision_above = 0.5; }},
+      {"rho_min 0", [] (CollisionRequest& r) { r.rho_min = 0.0; }},
+      {"rho_min 1", [] (CollisionRequest& r) { r.rho_min = 1.0; }},
+      {"expanded_k_sigma 0", [] (CollisionRequest& r) { r.expanded_k_sigma = 0.0; }},
+      {"traversal Stochastic", [] (CollisionRequest& r) { r.traversal = TraversalMode::Stochastic; }},
+      {"traversal ExpandedBV", [] (CollisionRequest& r) { r.traversal = TraversalMode::ExpandedBV; }},
+  };
+  for (const Change& c : cases)
+  {
+    CollisionRequest r;
+    c.apply (r);
+    EXPECT_NO_THROW (r.validate ()) << c.name;
+  }
+}
+
+TEST (CollisionRequest, EqualityComparesEveryMember)
+{
+  EXPECT_TRUE (CollisionRequest () == CollisionRequest ());
+  EXPECT_FALSE (CollisionRequest () != CollisionRequest ());
+  const std::vector<Change> cases = {
+      {"free_below", [] (CollisionRequest& r) { r.free_below = 0.2; }},
+      {"collision_above", [] (CollisionRequest& r) { r.collision_above = 0.8; }},
+      {"exhaustive", [] (CollisionRequest& r) { r.exhaustive = true; }},
+      {"per_point", [] (CollisionRequest& r) { r.per_point = true; }},
+      {"enable_timings", [] (CollisionRequest& r) { r.enable_timings = true; }},
+      {"traversal", [] (CollisionRequest& r) { r.traversal = TraversalMode::Stochastic; }},
+      {"rho_min", [] (CollisionRequest& r) { r.rho_min = 1e-4; }},
+      {"seed", [] (CollisionRequest& r) { r.seed = 2; }},
+      {"expanded_k_sigma", [] (CollisionRequest& r) { r.expanded_k_sigma = 2.0; }},
+      {"defer_kernel_fits", [] (CollisionRequest& r) { r.defer_kernel_fits = true; }},
+      {"classifier.C", [] (CollisionRequest& r) { r.classifier.C = 10.0; }},
+      {"classifier.kernel", [] (CollisionRequest& r) { r.classifier.kernel = KernelMode::Linear; }},
+      {"classifier.loss", [] (CollisionRequest& r) { r.classifier.loss = Loss::Huber; }},
+      {"classifier.exact_points_in_maximum",
+       [] (CollisionRequest& r) { r.classifier.exact_points_in_maximum = true; }},
+  };
+  for (const Change& c : cases)
+  {
+    CollisionRequest changed;
+    c.apply (changed);
+    const CollisionRequest copy = changed;
+    EXPECT_FALSE (changed == CollisionRequest ()) << c.name;
+    EXPECT_FALSE (CollisionRequest () == changed) << c.name;
+    EXPECT_TRUE (changed != CollisionRequest ()) << c.name;
+    EXPECT_TRUE (copy == changed) << c.name;
+    EXPECT_FALSE (copy != changed) << c.name;
+  }
+}
