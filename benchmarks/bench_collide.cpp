@@ -35,14 +35,14 @@ Cloud::Ptr
 noisySamples (const std::string& file, std::size_t target_points, double sigma, std::uint64_t seed,
               Eigen::Vector3d* lo = nullptr, Eigen::Vector3d* hi = nullptr)
 {
-  pcd_collision::TriangleMesh mesh;
+  pcl_probcollision::io::TriangleMesh mesh;
   std::string error;
-  if (!pcd_collision::loadTriangleMesh (file, mesh, error))
+  if (!pcl_probcollision::io::loadTriangleMesh (file, mesh, error))
     throw std::runtime_error (error);
   // Every vertex is kept too: aim the area samples at what the vertices leave.
   const double area_points = std::max (0.5 * target_points, static_cast<double> (target_points) - mesh.vertices.size ());
-  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
-  Cloud::Ptr cloud (new Cloud (pcd_collision::sampleMesh (mesh, spacing, seed)));
+  const double spacing = std::sqrt (pcl_probcollision::io::meshArea (mesh) / area_points);
+  Cloud::Ptr cloud (new Cloud (pcl_probcollision::io::sampleMesh (mesh, spacing, seed)));
   std::mt19937_64 rng (seed + 1);
   std::normal_distribution<double> noise (0.0, sigma);
   Eigen::Vector3d l = Eigen::Vector3d::Constant (1e300), h = -l;
@@ -67,11 +67,11 @@ workload ()
   static const Workload w = [] {
     Workload w;
     const std::string dir = std::string (PCL_PROBCOLLISION_SHARED_DATA) + "/meshes/";
-    pcd_collision::TriangleMesh rob;
+    pcl_probcollision::io::TriangleMesh rob;
     std::string error;
-    if (!pcd_collision::loadTriangleMesh (dir + "piano_room_rob.obj", rob, error))
+    if (!pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_rob.obj", rob, error))
       throw std::runtime_error (error);
-    w.sigma = 0.005 * pcd_collision::meshDiagonal (rob);
+    w.sigma = 0.005 * pcl_probcollision::io::meshDiagonal (rob);
     w.piano = noisySamples (dir + "piano_room_rob.obj", 10000, w.sigma, 1);
     w.room = noisySamples (dir + "piano_room_env.obj", 10000, w.sigma, 2, &w.room_lo, &w.room_hi);
     std::mt19937_64 rng (3);

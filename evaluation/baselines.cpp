@@ -317,7 +317,7 @@ reconstructMesh (const CloudXYZ& cloud, const ReconstructionParams& params, doub
 
   const double radius = params.search_radius > 0.0
                             ? params.search_radius
-                            : params.radius_factor * pcd_collision::medianSpacing (*points);
+                            : params.radius_factor * pcl_probcollision::io::medianSpacing (*points);
   if (used_search_radius)
     *used_search_radius = radius;
   TriangleMesh mesh;

@@ -82,8 +82,8 @@ meshes ()
     Meshes m;
     const std::string dir = dataDir () + "/meshes/";
     std::string error;
-    if (!pcd_collision::loadTriangleMesh (dir + "piano_room_rob.obj", m.rob_mesh, error) ||
-        !pcd_collision::loadTriangleMesh (dir + "piano_room_env.obj", m.env_mesh, error))
+    if (!pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_rob.obj", m.rob_mesh, error) ||
+        !pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_env.obj", m.env_mesh, error))
       throw std::runtime_error (error);
     m.exact.reset (new ExactMeshPair (m.rob_mesh, m.env_mesh));
     m.diagonal = m.exact->robotDiagonal ();

@@ -125,8 +125,8 @@ loadPianoRoom (const Options& o)
   PianoRoom w;
   std::string error;
   const std::string dir = o.data_dir + "/meshes/";
-  if (!pcd_collision::loadTriangleMesh (dir + "piano_room_rob.obj", w.rob_mesh, error) ||
-      !pcd_collision::loadTriangleMesh (dir + "piano_room_env.obj", w.env_mesh, error))
+  if (!pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_rob.obj", w.rob_mesh, error) ||
+      !pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_env.obj", w.env_mesh, error))
     throw std::runtime_error (error);
   w.exact.reset (new ExactMeshPair (w.rob_mesh, w.env_mesh));
   w.diagonal = w.exact->robotDiagonal ();

@@ -22,7 +22,7 @@
 
 namespace pcl_probcollision_eval
 {
-using pcd_collision::TriangleMesh;
+using pcl_probcollision::io::TriangleMesh;
 
 /** \brief Exact queries between a robot mesh and an env mesh, each an FCL BVHModel<OBBRSS>
   * (OBBRSS, not AABB: FCL refits AABB models on every query, hundreds of times slower).

@@ -91,8 +91,8 @@ pianoRoom ()
     std::unique_ptr<ExactMeshPair> p;
     TriangleMesh rob, env;
     std::string error;
-    if (pcd_collision::loadTriangleMesh (kMeshes + "piano_room_rob.obj", rob, error) &&
-        pcd_collision::loadTriangleMesh (kMeshes + "piano_room_env.obj", env, error))
+    if (pcl_probcollision::io::loadTriangleMesh (kMeshes + "piano_room_rob.obj", rob, error) &&
+        pcl_probcollision::io::loadTriangleMesh (kMeshes + "piano_room_env.obj", env, error))
       p = std::make_unique<ExactMeshPair> (rob, env);
     return p;
   }();

@@ -94,8 +94,8 @@ sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed)
 {
   // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
   const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
-  const double spacing = std::sqrt (pcd_collision::meshArea (mesh) / area_points);
-  return CloudXYZ::Ptr (new CloudXYZ (pcd_collision::sampleMesh (mesh, spacing, seed)));
+  const double spacing = std::sqrt (pcl_probcollision::io::meshArea (mesh) / area_points);
+  return CloudXYZ::Ptr (new CloudXYZ (pcl_probcollision::io::sampleMesh (mesh, spacing, seed)));
 }
 
 CloudXYZ::Ptr

@@ -75,7 +75,7 @@ PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& 
 void evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& right, int& total);
 
 /** \brief The mesh sampled uniformly by area plus every vertex, aiming at `target` points in all
-  * (pcd_collision::sampleMesh; deterministic for a seed). */
+  * (pcl_probcollision::io::sampleMesh; deterministic for a seed). */
 CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed);
 
 /** \brief Gaussian noise of standard deviation sigma on every coordinate (deterministic). */

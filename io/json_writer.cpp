@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 void
 JsonWriter::beforeValue ()
@@ -152,4 +152,4 @@ JsonWriter::quoted (const std::string& s)
   }
   out_ << '"';
 }
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

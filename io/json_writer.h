@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 /** \brief Writes one JSON value, usually an object, into a string without whitespace. Commas are
   * placed by the writer; the caller only nests begin/end pairs correctly and calls key() before
@@ -57,4 +57,4 @@ private:
   bool need_comma_ = false;
   bool after_key_ = false;
 };
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

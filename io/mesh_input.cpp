@@ -17,7 +17,7 @@
 #include <cmath>
 #include <mutex>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 namespace
 {
@@ -145,4 +145,4 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
   }
   return true;
 }
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

@@ -3,13 +3,13 @@
 
 // Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. Loading goes
 // through PCL's VTK readers (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its
-// headers are heavy. The namespace is still the tool's, where this code started.
+// headers are heavy.
 
 #include <array>
 #include <string>
 #include <vector>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 struct TriangleMesh
 {
@@ -29,4 +29,4 @@ bool loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string&
 /** \brief Shows (true) or silences (false, the default) the messages of VTK and of PCL's VTK
   * bridge, process-wide, for every later load (pcd_collision -v shows them). */
 void setVtkMessages (bool enabled);
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 namespace
 {
@@ -134,4 +134,4 @@ medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_quer
   std::nth_element (d.begin (), d.begin () + static_cast<std::ptrdiff_t> (d.size () / 2), d.end ());
   return d[d.size () / 2];
 }
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

@@ -12,7 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace pcd_collision
+namespace pcl_probcollision::io
 {
 /** \brief Samples the surface: each triangle gets floor(area / spacing^2 + u) points (u uniform
   * in [0, 1)), uniform over the triangle, and every vertex used by a triangle is added once;
@@ -32,4 +32,4 @@ double meshDiagonal (const TriangleMesh& mesh);
   * distance to the nearest other finite point; 0 when there are fewer than two points or
   * they all coincide. */
 double medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_queries = 20000);
-} // namespace pcd_collision
+} // namespace pcl_probcollision::io

@@ -31,6 +31,14 @@ namespace
 {
 namespace fs = std::filesystem;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+// The file formats around the library (io/).
+using pcl_probcollision::io::JsonWriter;
+using pcl_probcollision::io::loadTriangleMesh;
+using pcl_probcollision::io::meshDiagonal;
+using pcl_probcollision::io::medianSpacing;
+using pcl_probcollision::io::sampleMesh;
+using pcl_probcollision::io::setVtkMessages;
+using pcl_probcollision::io::TriangleMesh;
 
 /** \brief A failure with its exit status; main prints "pcd_collision: error: <what>". */
 struct Failure

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <limits>
 
-using pcd_collision::JsonWriter;
+using pcl_probcollision::io::JsonWriter;
 
 TEST (JsonWriter, CommasAndNesting)
 {

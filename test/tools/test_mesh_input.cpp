@@ -16,7 +16,7 @@
 #include <string>
 
 namespace fs = std::filesystem;
-using pcd_collision::TriangleMesh;
+using pcl_probcollision::io::TriangleMesh;
 
 namespace
 {
@@ -71,7 +71,9 @@ TEST_F (MeshInput, VtkPrintsNothing)
     TriangleMesh mesh;
     std::string error;
     bool ok = false;
-    const std::string err = captureStderr (dir_ / "stderr", [&] { ok = pcd_collision::loadTriangleMesh ((dir_ / name).string (), mesh, error); });
+    const std::string err = captureStderr (dir_ / "stderr", [&] {
+      ok = pcl_probcollision::io::loadTriangleMesh ((dir_ / name).string (), mesh, error);
+    });
     EXPECT_EQ (ok, std::string (name) == "quad.obj") << error;
     EXPECT_EQ (lowercase (err).find ("vtk"), std::string::npos) << err;
     EXPECT_EQ (lowercase (err).find ("warn"), std::string::npos) << err;
