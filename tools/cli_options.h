@@ -3,7 +3,10 @@
 
 // Command line of pcd_collision: a pure function from argv to Options or a usage error, and
 // the parser of -poses files. No PCL and no file-system access here, so it can be unit-tested
-// and fuzzed on its own.
+// and fuzzed on its own; the library's defaults come from its plain-data headers (Eigen only).
+
+#include <pcl_probcollision/cloud_model_params.h>
+#include <pcl_probcollision/collision_request.h>
 
 #include <array>
 #include <cstdint>
@@ -18,20 +21,32 @@ namespace pcd_collision
   * p' = Rz(yaw) Ry(pitch) Rx(roll) p + t. */
 using Pose = std::array<double, 6>;
 
-/** \brief Defaults, shown by printHelp(). */
+/** \brief The defaults of the options, shown by helpText(). The library's settings are read
+  * from the structs that own them (CloudModelParams, BVHParams, CollisionRequest); only what
+  * the tool decides itself is written here. */
 struct Defaults
 {
+  /** \brief The tool's own choice, not the library's (none): its inputs are files of unknown
+    * origin, mostly scans, where assuming no noise would make near-contact answers
+    * overconfident (README, "Which noise model"). */
   static constexpr const char* sensor = "isotropic";
-  static constexpr double sigma = 0.005;
-  static constexpr int k = 10;
-  static constexpr double free_below = 0.1;
-  static constexpr double collision_above = 0.9;
-  static constexpr std::uint64_t seed = 1;
-  static constexpr int n_max = 20;
-  static constexpr int n_min = 8;
-  static constexpr double sigma_max = 0.05;
-  static constexpr double epsilon = 0.02;
-  static constexpr const char* split = "pca";
+  static constexpr double sigma = pcl_probcollision::SensorNoiseModel::kDefaultIsotropicSigma;
+  /** \brief The library's defaults. */
+  static inline const pcl_probcollision::CloudModelParams model {};
+  static inline const pcl_probcollision::CollisionRequest request {};
+  static inline const int k = model.k;
+  static inline const double free_below = request.free_below;
+  static inline const double collision_above = request.collision_above;
+  static inline const std::uint64_t seed = request.seed;
+  static inline const bool stochastic = request.traversal == pcl_probcollision::TraversalMode::Stochastic;
+  static inline const bool exhaustive = request.exhaustive;
+  static inline const bool measured = !model.surface_projection;
+  static inline const int n_max = model.hierarchy.n_max;
+  static inline const int n_min = model.hierarchy.n_min;
+  static inline const double sigma_max = model.hierarchy.sigma_max;
+  static inline const double epsilon = model.hierarchy.epsilon;
+  static inline const char* const split =
+      model.hierarchy.split_style == pcl_probcollision::BVHParams::SplitStyle::Octree ? "octree" : "pca";
   /** \brief Mesh spacing when both inputs are meshes: this fraction of the larger bounding-box
     * diagonal. */
   static constexpr double mesh_spacing_fraction = 0.01;
@@ -66,10 +81,10 @@ struct Options
   double sigma_max = Defaults::sigma_max;
   double epsilon = Defaults::epsilon;
   std::string split = Defaults::split;
-  bool stochastic = false;
-  /** \brief -measured: surface projection off (ProbabilisticCollision::setSurfaceProjection). */
-  bool measured = false;
-  bool exhaustive = false;
+  bool stochastic = Defaults::stochastic;
+  /** \brief -measured: surface projection off (CloudModelParams::surface_projection). */
+  bool measured = Defaults::measured;
+  bool exhaustive = Defaults::exhaustive;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

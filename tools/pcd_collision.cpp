@@ -564,7 +564,7 @@ run (int argc, char** argv)
       const Eigen::Quaternionf orientation =
           b.kind == InputKind::Cloud ? b.cloud->sensor_orientation_ : Eigen::Quaternionf::Identity ();
       std::string error;
-      if (!writeResultCloud (*o.output, sides, o.free_below, o.collision_above, origin, orientation, written, error))
+      if (!writeResultCloud (*o.output, sides, requestFor (o), origin, orientation, written, error))
         throw Failure{kRuntimeFailure, error};
       write_ms = msSince (start);
     }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "pcd_files.h"
 
+#include <pcl_probcollision/collision.h>
+
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
 #include <pcl/conversions.h>
@@ -275,20 +277,21 @@ installInterruptCleanup ()
 }
 
 std::uint32_t
-verdictColour (float probability, double free_below, double collision_above)
+verdictColour (pcl_probcollision::Verdict verdict)
 {
-  if (!std::isfinite (probability))
-    return 0x808080u;  // not evaluated: grey
-  if (probability < free_below)
-    return 0x00c000u;  // free: green
-  if (probability > collision_above)
-    return 0xff0000u;  // collision: red
-  return 0xffff00u;    // contact: yellow
+  switch (verdict)
+  {
+    case pcl_probcollision::Verdict::Free: return 0x00c000u;         // green
+    case pcl_probcollision::Verdict::InContact: return 0xffff00u;    // yellow
+    case pcl_probcollision::Verdict::InCollision: return 0xff0000u;  // red
+    case pcl_probcollision::Verdict::Unknown: break;
+  }
+  return 0x808080u;  // not evaluated: grey
 }
 
 bool
-writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides, double free_below,
-                  double collision_above, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides,
+                  const pcl_probcollision::CollisionRequest& request, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
                   std::size_t& points_written, std::string& error)
 {
   pcl::PCLPointCloud2 blob;
@@ -324,7 +327,7 @@ writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sid
       const auto& p = (*s.cloud)[i];
       const float prob = (s.probabilities && i < s.probabilities->size ()) ? (*s.probabilities)[i]
                                                                            : std::numeric_limits<float>::quiet_NaN ();
-      const std::uint32_t rgb = verdictColour (prob, free_below, collision_above);
+      const std::uint32_t rgb = verdictColour (pcl_probcollision::verdictFor (prob, request));
       std::memcpy (out + 0, &p.x, 4);
       std::memcpy (out + 4, &p.y, 4);
       std::memcpy (out + 8, &p.z, 4);

@@ -4,6 +4,9 @@
 // Point-cloud files of pcd_collision: PCD and face-less PLY input, the PCD result output
 // (pcl/io/pcd_io.h and ply_io.h stay in pcd_files.cpp).
 
+#include <pcl_probcollision/collision_request.h>
+#include <pcl_probcollision/collision_result.h>
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -33,10 +36,10 @@ struct LabelledCloud
 };
 
 /** \brief Writes the sides one after the other as a binary PCD with fields x y z intensity
-  * (probability) rgb (verdict colour under the thresholds) label, atomically: a temporary file
+  * (probability) rgb (verdict colour under the request's thresholds, verdictFor()) label, atomically: a temporary file
   * in the target directory, then rename (removed on failure). False with a reason on failure. */
-bool writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides, double free_below,
-                       double collision_above, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
+bool writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sides,
+                       const pcl_probcollision::CollisionRequest& request, const Eigen::Vector4f& origin, const Eigen::Quaternionf& orientation,
                        std::size_t& points_written, std::string& error);
 
 /** \brief Installs handlers for SIGINT, SIGTERM and SIGHUP that remove the temporary file of a
@@ -44,6 +47,7 @@ bool writeResultCloud (const std::string& path, const std::vector<LabelledCloud>
   * shell). Signals that were ignored at start stay ignored. */
 void installInterruptCleanup ();
 
-/** \brief The verdict colour of one probability, packed as PCL's rgb (0x00RRGGBB). */
-std::uint32_t verdictColour (float probability, double free_below, double collision_above);
+/** \brief The colour of a verdict, packed as PCL's rgb (0x00RRGGBB): free green, contact
+  * yellow, collision red, Unknown (not evaluated) grey. */
+std::uint32_t verdictColour (pcl_probcollision::Verdict verdict);
 } // namespace pcd_collision

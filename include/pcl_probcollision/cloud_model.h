@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
+#include <pcl_probcollision/cloud_model_params.h>
 #include <pcl_probcollision/point_types.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
-#include <pcl_probcollision/sensor_noise.h>
 #include <pcl_probcollision/uncertain_points.h>
 
 #include <pcl/point_cloud.h>
@@ -17,36 +17,6 @@
 
 namespace pcl_probcollision
 {
-/** \brief How a CloudModel is built from a point cloud: the per-cloud settings, with their
-  * defaults. The query's settings are in CollisionRequest.
-  *
-  * Which noise model to choose: the library's default is none, so that covariances come from
-  * the sampling alone (the k-nearest-neighbour spread) and a cloud whose points are exact
-  * (a mesh sample, a CAD model) stays exact. Sensor data needs its sensor's model:
-  * SensorNoiseModel::kinect(), stereo() or lidar() when the cloud carries its viewpoint
-  * (sensor_origin_), isotropic(sigma) with the sensor's depth noise otherwise. pcd_collision
-  * defaults to isotropic 5 mm instead because its inputs are files of unknown origin, mostly
-  * scans, where assuming no noise would make near-contact answers overconfident (docs/CLI.md).
-  */
-struct CloudModelParams
-{
-  /** \brief Neighbours of the covariance estimation (Pauly et al.), >= 1. Default 10. */
-  int k = 10;
-  /** \brief Sensor noise added to the estimated covariances. Default none (see above). */
-  SensorNoiseModel noise;
-  /** \brief Locally denoised point positions (CovarianceEstimation::setSurfaceProjection).
-    * Default on, chosen by the evaluation (docs/RESULTS.md). Off gives the paper's model:
-    * every point at its measured position with its full noise and discretisation spread,
-    * whose maximum over many points near contact drifts toward 1. No effect without a noise
-    * model or with covariances given by the caller. */
-  bool surface_projection = true;
-  /** \brief The hierarchy built over the points (BVHParams' defaults). */
-  BVHParams hierarchy;
-
-  /** \brief Throws pcl::BadArgumentException naming the first member out of range. */
-  void validate () const;
-};
-
 class CloudModel;
 
 /** \brief Builds the model of the object sampled by a PCL cloud: covariances estimated

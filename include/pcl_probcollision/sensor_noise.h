@@ -91,9 +91,11 @@ public:
   static SensorNoiseModel kinect (const KinectParams& params = KinectParams ());
   static SensorNoiseModel stereo (const StereoParams& params = StereoParams ());
   static SensorNoiseModel lidar (const LidarParams& params = LidarParams ());
+  /** \brief The sigma fromName() gives "isotropic" when none is given (data units). */
+  static constexpr double kDefaultIsotropicSigma = 0.005;
   /** \brief Parses "none", "isotropic", "kinect", "stereo" or "lidar" with default parameters
     * (isotropic uses sigma); throws pcl::BadArgumentException naming the value otherwise. */
-  static SensorNoiseModel fromName (const std::string& name, double sigma = 0.005);
+  static SensorNoiseModel fromName (const std::string& name, double sigma = kDefaultIsotropicSigma);
 
   Type type () const { return type_; }
   const char* name () const;
