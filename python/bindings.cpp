@@ -1,0 +1,660 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Python bindings (issue #18): the per-cloud model, the query and its batch, with the C++ structs'
+// own defaults. numpy points become a pcl::PointCloud<pcl::PointXYZ> once and go through
+// buildCloudModel<pcl::PointXYZ>, so a Python model is exactly the C++ model of the same floats.
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/cloud_model_params.h>
+#include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/collision_request.h>
+#include <pcl_probcollision/collision_result.h>
+#include <pcl_probcollision/error_message.h>
+#include <pcl_probcollision/sensor_noise.h>
+
+#include <pcl/exceptions.h>
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+using namespace pcl_probcollision;
+
+namespace
+{
+using ModelPtr = std::shared_ptr<CloudModel>;
+
+std::string
+shapeOf (const py::array& a)
+{
+  std::ostringstream s;
+  s << '(';
+  for (py::ssize_t i = 0; i < a.ndim (); ++i)
+    s << (i ? ", " : "") << a.shape (i);
+  s << (a.ndim () == 1 ? ",)" : ")");
+  return s.str ();
+}
+
+std::string
+typeName (const py::handle& h)
+{
+  return py::str (py::type::handle_of (h).attr ("__name__"));
+}
+
+/** The array behind a float32 / float64 argument of the given rank and trailing dims, or
+  * TypeError / ValueError naming the argument. */
+py::array
+floatArray (const py::object& obj, const char* arg, int ndim, const char* expected)
+{
+  if (!py::isinstance<py::array> (obj))
+    throw py::type_error (std::string (arg) + ": expected a numpy array of shape " + expected +
+                          ", float32 or float64, got " + typeName (obj));
+  py::array a = py::reinterpret_borrow<py::array> (obj);
+  if (!py::isinstance<py::array_t<float>> (a) && !py::isinstance<py::array_t<double>> (a))
+    throw py::type_error (std::string (arg) + ": expected dtype float32 or float64 (native byte order), got " +
+                          std::string (py::str (a.dtype ())));
+  bool ok = a.ndim () == ndim;
+  for (int d = 1; ok && d < ndim; ++d)
+    ok = a.shape (d) == 3;
+  if (!ok)
+    throw py::value_error (std::string (arg) + ": expected shape " + expected + ", got " + shapeOf (a));
+  return a;
+}
+
+template <typename T>
+void
+fillPoints (const py::array& arr, pcl::PointCloud<pcl::PointXYZ>& cloud)
+{
+  const auto a = arr.unchecked<T, 2> ();
+  cloud.resize (static_cast<std::size_t> (a.shape (0)));
+  cloud.width = static_cast<std::uint32_t> (a.shape (0));
+  cloud.height = 1;
+  cloud.is_dense = false;
+  for (py::ssize_t i = 0; i < a.shape (0); ++i)
+  {
+    pcl::PointXYZ& p = cloud[static_cast<std::size_t> (i)];
+    p.x = static_cast<float> (a (i, 0));
+    p.y = static_cast<float> (a (i, 1));
+    p.z = static_cast<float> (a (i, 2));
+    // float64 finite in double but beyond float: it would silently become Inf and be skipped.
+    if (!std::is_same<T, float>::value)
+      for (int d = 0; d < 3; ++d)
+        if (std::isfinite (static_cast<double> (a (i, d))) && !std::isfinite (p.data[d]))
+          throw py::value_error ("points: row " + std::to_string (i) +
+                                 " has a coordinate beyond the float range (points are stored as float32)");
+  }
+}
+
+template <typename T>
+void
+fillCovariances (const py::array& arr, pcl::PointCloud<Covariance>& covs)
+{
+  const auto a = arr.unchecked<T, 3> ();
+  covs.resize (static_cast<std::size_t> (a.shape (0)));
+  covs.width = static_cast<std::uint32_t> (a.shape (0));
+  covs.height = 1;
+  for (py::ssize_t i = 0; i < a.shape (0); ++i)
+  {
+    Eigen::Matrix3d m;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        m (r, c) = static_cast<double> (a (i, r, c));
+    if (m.allFinite ())
+      for (int r = 0; r < 3; ++r)
+        for (int c = r + 1; c < 3; ++c)
+          if (std::abs (m (r, c) - m (c, r)) > 1e-6 * (std::abs (m (r, c)) + std::abs (m (c, r))) + 1e-30)
+            throw py::value_error ("covariances: matrix " + std::to_string (i) + " is not symmetric");
+    covs[static_cast<std::size_t> (i)] = m.allFinite () ? Covariance (m) : Covariance::nan ();
+  }
+}
+
+std::shared_ptr<const CloudModel>
+buildModel (const py::object& points, const py::object& covariances, const py::object& params_obj,
+            const std::string& name)
+{
+  const py::array pts = floatArray (points, "points", 2, "(N, 3)");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  if (py::isinstance<py::array_t<float>> (pts))
+    fillPoints<float> (pts, cloud);
+  else
+    fillPoints<double> (pts, cloud);
+
+  pcl::PointCloud<Covariance> covs;
+  const bool have_covs = !covariances.is_none ();
+  if (have_covs)
+  {
+    const py::array c = floatArray (covariances, "covariances", 3, "(N, 3, 3)");
+    if (c.shape (0) != pts.shape (0))
+      throw py::value_error ("covariances: " + std::to_string (c.shape (0)) + " matrices for " +
+                             std::to_string (pts.shape (0)) + " points");
+    if (py::isinstance<py::array_t<float>> (c))
+      fillCovariances<float> (c, covs);
+    else
+      fillCovariances<double> (c, covs);
+  }
+  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
+
+  py::gil_scoped_release release;
+  return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name);
+}
+
+std::shared_ptr<const CloudModel>
+loadModel (const std::filesystem::path& path, const py::object& params_obj, const py::object& name_obj)
+{
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file (path, ec))
+  {
+    py::object err = py::module_::import ("builtins").attr ("FileNotFoundError") (
+        2, std::string ("No such file"), path.string ());
+    PyErr_SetObject (PyExc_FileNotFoundError, err.ptr ());
+    throw py::error_already_set ();
+  }
+  std::string ext = path.extension ().string ();
+  for (char& ch : ext)
+    ch = static_cast<char> (std::tolower (static_cast<unsigned char> (ch)));
+  if (ext != ".pcd")
+    throw py::value_error ("path: only .pcd files are read, got '" + path.string () + "'");
+  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
+  const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
+
+  // The header is checked before the data are read: PCL 1.13's PCDReader::read crashes on a file
+  // without FIELDS (the checks of tools/pcd_files.cpp).
+  const std::string file = path.string ();
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  {
+    py::gil_scoped_release release;
+    pcl::PCLPointCloud2 blob;
+    Eigen::Vector4f origin = Eigen::Vector4f::Zero ();
+    Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity ();
+    pcl::PCDReader reader;
+    int version = 0, data_type = 0;
+    unsigned int data_idx = 0;
+    std::string error;
+    if (reader.readHeader (file, blob, origin, orientation, version, data_type, data_idx) < 0 || blob.fields.empty ())
+      error = "path: '" + file + "' is not a PCD file (malformed or missing header)";
+    else if (static_cast<std::size_t> (blob.width) * blob.height == 0)
+      error = "path: '" + file + "' has no points (empty cloud)";
+    for (const char* f : {"x", "y", "z"})
+    {
+      const int i = error.empty () ? pcl::getFieldIndex (blob, f) : 0;
+      if (error.empty () && (i < 0 || blob.fields[static_cast<std::size_t> (i)].datatype != pcl::PCLPointField::FLOAT32 ||
+                             blob.fields[static_cast<std::size_t> (i)].count != 1))
+        error = "path: '" + file + "' has no float32 field '" + f + "' (load_model needs x y z; read other files into numpy)";
+    }
+    if (error.empty () && reader.read (file, blob, origin, orientation, version) < 0)
+      error = "path: '" + file + "' is truncated or corrupt (PCD data could not be read)";
+    if (error.empty () && blob.data.size () < static_cast<std::size_t> (blob.width) * blob.height * blob.point_step)
+      error = "path: '" + file + "' is truncated (fewer data bytes than its header announces)";
+    if (!error.empty ())
+    {
+      py::gil_scoped_acquire acquire;
+      throw py::value_error (error);
+    }
+    pcl::fromPCLPointCloud2 (blob, cloud);
+    cloud.sensor_origin_ = origin;
+    cloud.sensor_orientation_ = orientation;
+  }
+  py::gil_scoped_release release;
+  return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
+}
+
+/** A 4x4 rigid transform from a 4x4 array or (R, t). */
+Eigen::Isometry3d
+toPose (const py::object& obj, const char* arg)
+{
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity ();
+  const std::string expected = std::string (arg) + ": expected a 4x4 matrix or a pair (R, t), R 3x3 and t of 3";
+  if (py::isinstance<py::tuple> (obj) || py::isinstance<py::list> (obj))
+  {
+    py::sequence seq = py::reinterpret_borrow<py::sequence> (obj);
+    if (seq.size () != 2)
+      throw py::value_error (expected + ", got a sequence of " + std::to_string (seq.size ()));
+    auto R = py::array_t<double, py::array::forcecast>::ensure (seq[0]);
+    auto t = py::array_t<double, py::array::forcecast>::ensure (seq[1]);
+    if (!R || !t)
+    {
+      PyErr_Clear ();
+      throw py::type_error (expected + ", got non-numeric entries");
+    }
+    if (R.ndim () != 2 || R.shape (0) != 3 || R.shape (1) != 3 || t.size () != 3)
+      throw py::value_error (expected + ", got R " + shapeOf (R) + " and t " + shapeOf (t));
+    const auto r = R.unchecked<2> ();
+    for (int i = 0; i < 3; ++i)
+    {
+      for (int j = 0; j < 3; ++j)
+        m (i, j) = r (i, j);
+      m (i, 3) = t.data ()[i * (t.strides (t.ndim () - 1) / static_cast<py::ssize_t> (sizeof (double)))];
+    }
+  }
+  else
+  {
+    auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
+    if (!a)
+    {
+      PyErr_Clear ();
+      throw py::type_error (expected + ", got " + typeName (obj));
+    }
+    if (a.ndim () != 2 || a.shape (0) != 4 || a.shape (1) != 4)
+      throw py::value_error (expected + ", got shape " + shapeOf (a));
+    const auto r = a.unchecked<2> ();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        m (i, j) = r (i, j);
+    if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
+      throw py::value_error (std::string (arg) + ": the last row of a 4x4 pose must be [0, 0, 0, 1]");
+  }
+  Eigen::Isometry3d T;
+  T.matrix () = m;
+  return T;
+}
+
+CollisionRequest
+requestOf (const py::object& obj)
+{
+  CollisionRequest request = obj.is_none () ? CollisionRequest () : obj.cast<CollisionRequest> ();
+  request.validate ();
+  return request;
+}
+
+CollisionResult
+collideOne (const ModelPtr& a, const ModelPtr& b, const py::object& pose, const py::object& request_obj)
+{
+  const Eigen::Isometry3d T = toPose (pose, "pose");
+  const CollisionRequest request = requestOf (request_obj);
+  CollisionResult result;
+  {
+    py::gil_scoped_release release;
+    collide (*a, *b, T, request, result);
+  }
+  if (result.status == CollisionResult::Status::InvalidInput)
+    throw py::value_error (result.message);
+  return result;
+}
+
+std::vector<CollisionResult>
+collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
+             int threads)
+{
+  auto poses = py::array_t<double, py::array::forcecast>::ensure (poses_obj);
+  if (!poses)
+  {
+    PyErr_Clear ();
+    throw py::type_error ("poses: expected a numpy array of shape (M, 4, 4), got " + typeName (poses_obj));
+  }
+  if (poses.ndim () != 3 || poses.shape (1) != 4 || poses.shape (2) != 4)
+    throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (poses));
+  if (threads < 0)
+    throw py::value_error ("threads: must be >= 0 (0 = all cores), got " + std::to_string (threads));
+  const CollisionRequest request = requestOf (request_obj);
+  const auto p = poses.unchecked<3> ();
+  std::vector<Eigen::Isometry3d> T (static_cast<std::size_t> (p.shape (0)));
+  for (py::ssize_t k = 0; k < p.shape (0); ++k)
+  {
+    Eigen::Matrix4d m;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        m (i, j) = p (k, i, j);
+    if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
+      throw py::value_error ("poses[" + std::to_string (k) + "]: the last row of a 4x4 pose must be [0, 0, 0, 1]");
+    T[static_cast<std::size_t> (k)].matrix () = m;
+  }
+  std::vector<CollisionResult> results;
+  {
+    py::gil_scoped_release release;
+    collideBatch (*a, *b, T, request, results, threads);
+  }
+  for (std::size_t k = 0; k < results.size (); ++k)
+    if (results[k].status == CollisionResult::Status::InvalidInput)
+      throw py::value_error ("poses[" + std::to_string (k) + "]: " + results[k].message);
+  return results;
+}
+
+py::array_t<double>
+vec3 (const Eigen::Vector3d& v)
+{
+  py::array_t<double> out (3);
+  for (int i = 0; i < 3; ++i)
+    out.mutable_at (i) = v[i];
+  return out;
+}
+
+py::array_t<float>
+floats (const std::vector<float>& v)
+{
+  py::array_t<float> out (static_cast<py::ssize_t> (v.size ()));
+  std::copy (v.begin (), v.end (), out.mutable_data ());
+  return out;
+}
+
+std::string
+num (double v)
+{
+  return py::repr (py::float_ (v));  // Python's shortest round-trip form
+}
+
+const char*
+statusName (CollisionResult::Status s)
+{
+  switch (s)
+  {
+    case CollisionResult::Status::Ok: return "Ok";
+    case CollisionResult::Status::InvalidInput: return "InvalidInput";
+    case CollisionResult::Status::NumericalFailure: return "NumericalFailure";
+  }
+  return "?";
+}
+
+const char*
+verdictEnumName (Verdict v)
+{
+  switch (v)
+  {
+    case Verdict::Unknown: return "Unknown";
+    case Verdict::Free: return "Free";
+    case Verdict::InContact: return "InContact";
+    case Verdict::InCollision: return "InCollision";
+  }
+  return "?";
+}
+
+const char*
+traversalName (TraversalMode t)
+{
+  switch (t)
+  {
+    case TraversalMode::ExpectedWeight: return "ExpectedWeight";
+    case TraversalMode::Stochastic: return "Stochastic";
+    case TraversalMode::ExpandedBV: return "ExpandedBV";
+  }
+  return "?";
+}
+
+const char*
+noiseFactory (const SensorNoiseModel& n)
+{
+  switch (n.type ())
+  {
+    case SensorNoiseModel::Type::None: return "none()";
+    case SensorNoiseModel::Type::Isotropic: return "isotropic(...)";
+    case SensorNoiseModel::Type::Anisotropic: return "anisotropic(...)";
+    case SensorNoiseModel::Type::KinectV1: return "kinect()";
+    case SensorNoiseModel::Type::Stereo: return "stereo()";
+    case SensorNoiseModel::Type::Lidar: return "lidar()";
+  }
+  return "?";
+}
+} // namespace
+
+PYBIND11_MODULE (_core, m)
+{
+  m.doc () = "Probabilistic collision checking between noisy point clouds (pcl_probcollision's C++ core).\n\n"
+             "Build a CloudModel per cloud once (build_model from numpy, load_model from a .pcd file), then\n"
+             "query pairs with collide(a, b, pose) or collide_batch(a, b, poses). Defaults are the C++ ones.";
+
+  py::register_exception_translator ([] (std::exception_ptr p) {
+    try
+    {
+      if (p)
+        std::rethrow_exception (p);
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      PyErr_SetString (PyExc_ValueError, errorMessage (e).c_str ());
+    }
+    catch (const pcl::IOException& e)
+    {
+      PyErr_SetString (PyExc_OSError, errorMessage (e).c_str ());
+    }
+    catch (const pcl::PCLException& e)
+    {
+      PyErr_SetString (PyExc_RuntimeError, errorMessage (e).c_str ());
+    }
+  });
+
+  py::enum_<Verdict> (m, "Verdict", "The three-way decision: P < free_below is Free, P > collision_above InCollision, "
+                                    "anything between InContact; Unknown when the query failed.")
+      .value ("Unknown", Verdict::Unknown)
+      .value ("Free", Verdict::Free)
+      .value ("InContact", Verdict::InContact)
+      .value ("InCollision", Verdict::InCollision);
+
+  py::enum_<TraversalMode> (m, "TraversalMode", "How the traversal treats node pairs whose boxes are disjoint.")
+      .value ("ExpectedWeight", TraversalMode::ExpectedWeight)
+      .value ("Stochastic", TraversalMode::Stochastic)
+      .value ("ExpandedBV", TraversalMode::ExpandedBV);
+
+  // --- SensorNoiseModel -------------------------------------------------------------------------
+  py::class_<SensorNoiseModel> noise (m, "SensorNoiseModel",
+      "Sensor (position) noise added to the estimated covariances. Build with none(), isotropic(sigma), "
+      "kinect(), stereo() or lidar() (default parameters), or from_name(name, sigma).");
+  noise.def (py::init<> (), "No sensor noise (the default).")
+      .def_static ("none", [] { return SensorNoiseModel (); }, "No sensor noise (the default).")
+      .def_static ("isotropic", &SensorNoiseModel::isotropic, py::arg ("sigma"),
+                   "sigma^2 I, sigma >= 0 in data units (ValueError otherwise).")
+      .def_static ("kinect", [] { return SensorNoiseModel::kinect (); }, "Kinect v1 (Nguyen et al. 2012), metres; "
+                   "needs the sensor pose (a numpy cloud's viewpoint is the origin looking along +z).")
+      .def_static ("stereo", [] { return SensorNoiseModel::stereo (); }, "Stereo triangulation (PR2-like defaults), metres.")
+      .def_static ("lidar", [] { return SensorNoiseModel::lidar (); }, "Lidar: range and angular sigma, metres.")
+      .def_static ("from_name", &SensorNoiseModel::fromName, py::arg ("name"),
+                   py::arg ("sigma") = SensorNoiseModel::kDefaultIsotropicSigma,
+                   "'none', 'isotropic', 'kinect', 'stereo' or 'lidar' with default parameters (isotropic uses sigma).")
+      .def_property_readonly ("name", [] (const SensorNoiseModel& n) { return std::string (n.name ()); })
+      .def_property_readonly ("uses_sensor_pose", &SensorNoiseModel::usesSensorPose)
+      .def ("__repr__", [] (const SensorNoiseModel& n) {
+        return std::string ("SensorNoiseModel.") + noiseFactory (n);
+      });
+
+  // --- CloudModelParams ---------------------------------------------------------------------------
+  const CloudModelParams dp;
+  py::class_<CloudModelParams> (m, "CloudModelParams",
+      "How a CloudModel is built from a point cloud (the per-cloud settings).\n\n"
+      "k: neighbours of the covariance estimation (>= 1); noise: SensorNoiseModel added to the covariances;\n"
+      "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma: the hierarchy.")
+      .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, int n_min,
+                          double sigma_max, double epsilon, double k_sigma) {
+              CloudModelParams p;
+              p.k = k;
+              p.noise = noise;
+              p.surface_projection = surface_projection;
+              p.hierarchy.n_max = n_max;
+              p.hierarchy.n_min = n_min;
+              p.hierarchy.sigma_max = sigma_max;
+              p.hierarchy.epsilon = epsilon;
+              p.hierarchy.k_sigma = k_sigma;
+              return p;
+            }),
+            py::kw_only (), py::arg ("k") = dp.k, py::arg_v ("noise", dp.noise, "SensorNoiseModel.none()"),
+            py::arg ("surface_projection") = dp.surface_projection, py::arg ("n_max") = dp.hierarchy.n_max,
+            py::arg ("n_min") = dp.hierarchy.n_min, py::arg ("sigma_max") = dp.hierarchy.sigma_max,
+            py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
+            "Every argument defaults to the C++ CloudModelParams default.")
+      .def_readwrite ("k", &CloudModelParams::k)
+      .def_readwrite ("noise", &CloudModelParams::noise)
+      .def_readwrite ("surface_projection", &CloudModelParams::surface_projection)
+      .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
+                     [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
+      .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },
+                     [] (CloudModelParams& p, int v) { p.hierarchy.n_min = v; })
+      .def_property ("sigma_max", [] (const CloudModelParams& p) { return p.hierarchy.sigma_max; },
+                     [] (CloudModelParams& p, double v) { p.hierarchy.sigma_max = v; })
+      .def_property ("epsilon", [] (const CloudModelParams& p) { return p.hierarchy.epsilon; },
+                     [] (CloudModelParams& p, double v) { p.hierarchy.epsilon = v; })
+      .def_property ("k_sigma", [] (const CloudModelParams& p) { return p.hierarchy.k_sigma; },
+                     [] (CloudModelParams& p, double v) { p.hierarchy.k_sigma = v; })
+      .def ("validate", &CloudModelParams::validate, "Raises ValueError naming the first member out of range.")
+      .def ("__repr__", [] (const CloudModelParams& p) {
+        return "CloudModelParams(k=" + std::to_string (p.k) + ", noise=SensorNoiseModel." + noiseFactory (p.noise) +
+               ", surface_projection=" + (p.surface_projection ? "True" : "False") +
+               ", n_max=" + std::to_string (p.hierarchy.n_max) + ", n_min=" + std::to_string (p.hierarchy.n_min) +
+               ", sigma_max=" + num (p.hierarchy.sigma_max) + ", epsilon=" + num (p.hierarchy.epsilon) +
+               ", k_sigma=" + num (p.hierarchy.k_sigma) + ")";
+      });
+
+  // --- CollisionRequest ---------------------------------------------------------------------------
+  const CollisionRequest dr;
+  py::class_<CollisionRequest> (m, "CollisionRequest",
+      "What a collision query computes and how. P < free_below is Free, P > collision_above InCollision.\n\n"
+      "exhaustive: visit every reachable leaf pair instead of stopping once P > collision_above;\n"
+      "per_point: fill probabilities_a/_b; enable_timings: fill build_ms/query_ms; traversal, rho_min, seed,\n"
+      "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier.")
+      .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
+                          bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
+                          double expanded_k_sigma, bool defer_kernel_fits) {
+              CollisionRequest r;
+              r.free_below = free_below;
+              r.collision_above = collision_above;
+              r.exhaustive = exhaustive;
+              r.per_point = per_point;
+              r.enable_timings = enable_timings;
+              r.traversal = traversal;
+              r.rho_min = rho_min;
+              r.seed = seed;
+              r.expanded_k_sigma = expanded_k_sigma;
+              r.defer_kernel_fits = defer_kernel_fits;
+              return r;
+            }),
+            py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
+            py::arg ("exhaustive") = dr.exhaustive, py::arg ("per_point") = dr.per_point,
+            py::arg ("enable_timings") = dr.enable_timings, py::arg ("traversal") = dr.traversal,
+            py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
+            py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
+            "Every argument defaults to the C++ CollisionRequest default.")
+      .def_readwrite ("free_below", &CollisionRequest::free_below)
+      .def_readwrite ("collision_above", &CollisionRequest::collision_above)
+      .def_readwrite ("exhaustive", &CollisionRequest::exhaustive)
+      .def_readwrite ("per_point", &CollisionRequest::per_point)
+      .def_readwrite ("enable_timings", &CollisionRequest::enable_timings)
+      .def_readwrite ("traversal", &CollisionRequest::traversal)
+      .def_readwrite ("rho_min", &CollisionRequest::rho_min)
+      .def_readwrite ("seed", &CollisionRequest::seed)
+      .def_readwrite ("expanded_k_sigma", &CollisionRequest::expanded_k_sigma)
+      .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
+      .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
+      .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
+      .def ("__repr__", [] (const CollisionRequest& r) {
+        return "CollisionRequest(free_below=" + num (r.free_below) + ", collision_above=" + num (r.collision_above) +
+               ", exhaustive=" + (r.exhaustive ? "True" : "False") + ", per_point=" + (r.per_point ? "True" : "False") +
+               ", enable_timings=" + (r.enable_timings ? "True" : "False") + ", traversal=TraversalMode." +
+               traversalName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
+               ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
+               ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") + ")";
+      });
+
+  // --- CollisionResult ----------------------------------------------------------------------------
+  py::class_<CollisionResult> res (m, "CollisionResult",
+      "Outcome of a query; anything not computed is NaN or Unknown. witness_point/normal are in A's frame.\n"
+      "probabilities_a/_b (float32, request.per_point) are index-aligned with the clouds the models were built from.");
+  py::enum_<CollisionResult::Status> (res, "Status")
+      .value ("Ok", CollisionResult::Status::Ok)
+      .value ("InvalidInput", CollisionResult::Status::InvalidInput)
+      .value ("NumericalFailure", CollisionResult::Status::NumericalFailure);
+  res.def (py::init<> (), "An empty result (status InvalidInput, probability NaN), as in C++.")
+      .def_readonly ("status", &CollisionResult::status)
+      .def_readonly ("message", &CollisionResult::message)
+      .def_readonly ("verdict", &CollisionResult::verdict)
+      .def_readonly ("probability", &CollisionResult::probability)
+      .def_readonly ("lower_bound", &CollisionResult::lower_bound)
+      .def_readonly ("no_leaf_tested", &CollisionResult::no_leaf_tested)
+      .def_readonly ("witness_side", &CollisionResult::witness_side)
+      .def_readonly ("witness_index", &CollisionResult::witness_index)
+      .def_property_readonly ("witness_point", [] (const CollisionResult& r) { return vec3 (r.witness_point); })
+      .def_property_readonly ("witness_normal", [] (const CollisionResult& r) { return vec3 (r.witness_normal); })
+      .def_readonly ("points_a", &CollisionResult::points_a)
+      .def_readonly ("points_b", &CollisionResult::points_b)
+      .def_readonly ("points_skipped_nonfinite", &CollisionResult::points_skipped_nonfinite)
+      .def_readonly ("bv_tests", &CollisionResult::bv_tests)
+      .def_readonly ("leaf_pairs_tested", &CollisionResult::leaf_pairs_tested)
+      .def_readonly ("kernel_leaf_pairs", &CollisionResult::kernel_leaf_pairs)
+      .def_readonly ("degenerate_leaf_pairs", &CollisionResult::degenerate_leaf_pairs)
+      .def_readonly ("classifier_iterations", &CollisionResult::classifier_iterations)
+      .def_readonly ("build_ms", &CollisionResult::build_ms)
+      .def_readonly ("query_ms", &CollisionResult::query_ms)
+      .def_property_readonly ("probabilities_a", [] (const CollisionResult& r) { return floats (r.probabilities_a); })
+      .def_property_readonly ("probabilities_b", [] (const CollisionResult& r) { return floats (r.probabilities_b); })
+      .def_property_readonly ("ok", &CollisionResult::ok)
+      .def ("__repr__", [] (const CollisionResult& r) {
+        std::string s = std::string ("CollisionResult(status=") + statusName (r.status) + ", verdict=Verdict." +
+                        verdictEnumName (r.verdict) + ", probability=" + num (r.probability) +
+                        ", lower_bound=" + (r.lower_bound ? "True" : "False") +
+                        ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
+                        ", witness_side=" + std::to_string (r.witness_side) +
+                        ", witness_index=" + std::to_string (r.witness_index) +
+                        ", points_a=" + std::to_string (r.points_a) + ", points_b=" + std::to_string (r.points_b) +
+                        ", leaf_pairs_tested=" + std::to_string (r.leaf_pairs_tested) +
+                        ", bv_tests=" + std::to_string (r.bv_tests);
+        if (!r.message.empty ())
+          s += ", message=" + std::string (py::repr (py::str (r.message)));
+        return s + ")";
+      });
+
+  // --- CloudModel ---------------------------------------------------------------------------------
+  py::class_<CloudModel, ModelPtr> (m, "CloudModel",
+      "The immutable model of one object known from a point cloud (uncertain points and their hierarchy).\n"
+      "Build it with build_model() or load_model(); it never sees the points again, so moved points need a new model.\n"
+      "Any number of queries and threads may share it.")
+      .def_property_readonly ("size", &CloudModel::size, "Points in the model (finite rows).")
+      .def_property_readonly ("source_size", &CloudModel::sourceSize, "Rows of the input (per-point results align with it).")
+      .def_property_readonly ("skipped_points", &CloudModel::skippedPoints, "Rows left out as non-finite (NaN / Inf).")
+      .def_property_readonly ("origin", [] (const CloudModel& c) { return vec3 (c.origin ()); },
+                              "Local frame origin (the centroid), in the cloud's frame.")
+      .def_property_readonly ("warning", &CloudModel::warning, "A precision warning about the input, '' when none.")
+      .def_property_readonly ("build_ms", &CloudModel::buildMilliseconds, "Wall time of the build, ms.")
+      .def_property_readonly ("bytes", &CloudModel::bytes, "Memory held, bytes.")
+      .def_property_readonly ("precision_ratio", &CloudModel::precisionRatio)
+      .def_property_readonly ("params", &CloudModel::params, "The CloudModelParams it was built with.")
+      .def ("__len__", &CloudModel::size)
+      .def ("__repr__", [] (const CloudModel& c) {
+        return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +
+               ", origin=[" + num (c.origin ().x ()) + ", " + num (c.origin ().y ()) + ", " + num (c.origin ().z ()) +
+               "], build_ms=" + num (c.buildMilliseconds ()) +
+               (c.warning ().empty () ? std::string () : ", warning=" + std::string (py::repr (py::str (c.warning ())))) + ")";
+      });
+
+  // --- functions ----------------------------------------------------------------------------------
+  m.def ("build_model",
+         [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name) {
+           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name));
+         },
+         py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
+         py::arg ("name") = "cloud",
+         "Builds the CloudModel of a cloud given as a numpy array.\n\n"
+         "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
+         "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
+         "covariances: optional (N, 3, 3) float32/float64, symmetric; estimated from the k nearest neighbours when None.\n"
+         "params: CloudModelParams (None = CloudModelParams()).\n"
+         "name: what error messages call the cloud.\n"
+         "Releases the GIL while building.");
+  m.def ("load_model",
+         [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
+           return std::const_pointer_cast<CloudModel> (loadModel (path, params, name));
+         },
+         py::arg ("path"), py::arg ("params") = py::none (), py::arg ("name") = py::none (),
+         "Builds the CloudModel of a .pcd file (x y z fields; its VIEWPOINT is the sensor pose).\n\n"
+         "params: CloudModelParams (None = defaults); name: defaults to the file name.\n"
+         "FileNotFoundError for a missing file, ValueError for a file PCL cannot read.");
+  m.def ("collide", &collideOne, py::arg ("a"), py::arg ("b"), py::arg ("pose"), py::arg ("request") = py::none (),
+         "Probability that the objects of models a and b collide, b placed in a's frame by pose = T_a_b\n"
+         "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide().\n\n"
+         "request: CollisionRequest (None = CollisionRequest()). Returns a CollisionResult.\n"
+         "ValueError (with the C++ message) for a non-rigid or non-finite pose or an invalid request.");
+  m.def ("collide_batch", &collideMany, py::arg ("a"), py::arg ("b"), py::arg ("poses"),
+         py::arg ("request") = py::none (), py::arg ("threads") = 0,
+         "collide() for each pose of an (M, 4, 4) array, on `threads` threads (0 = all cores), GIL released.\n\n"
+         "Returns a list of M CollisionResult in pose order, each equal to collide(a, b, poses[i], request)\n"
+         "(timings aside). ValueError naming the first invalid pose.");
+  m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
+         "The verdict of a probability under a request's thresholds (Unknown for NaN).");
+}

@@ -1,0 +1,41 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""pcl_probcollision: probabilistic collision checking between noisy point clouds.
+
+Build a model per cloud once, then query pairs of models under poses::
+
+    import numpy as np, pcl_probcollision as pc
+    a = pc.build_model(points_a, params=pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005)))
+    r = pc.collide(a, b, np.eye(4))       # b placed in a's frame by T_a_b
+    print(r.verdict, r.probability)
+
+The compiled core is pcl_probcollision._core; everything public is re-exported here.
+"""
+from ._core import (  # noqa: F401
+    CloudModel,
+    CloudModelParams,
+    CollisionRequest,
+    CollisionResult,
+    SensorNoiseModel,
+    TraversalMode,
+    Verdict,
+    build_model,
+    collide,
+    collide_batch,
+    load_model,
+    verdict_for,
+)
+
+__all__ = [
+    "CloudModel",
+    "CloudModelParams",
+    "CollisionRequest",
+    "CollisionResult",
+    "SensorNoiseModel",
+    "TraversalMode",
+    "Verdict",
+    "build_model",
+    "collide",
+    "collide_batch",
+    "load_model",
+    "verdict_for",
+]
