@@ -2,6 +2,8 @@
 // Python bindings (issue #18): the per-cloud model, the query and its batch, with the C++ structs'
 // own defaults. numpy points become a pcl::PointCloud<pcl::PointXYZ> once and go through
 // buildCloudModel<pcl::PointXYZ>, so a Python model is exactly the C++ model of the same floats.
+#include "cloud_input.h"
+
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/cloud_model_params.h>
 #include <pcl_probcollision/collision.h>
@@ -11,9 +13,6 @@
 #include <pcl_probcollision/sensor_noise.h>
 
 #include <pcl/exceptions.h>
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/conversions.h>
-#include <pcl/io/pcd_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -170,43 +169,17 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
   const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
 
-  // The header is checked before the data are read: PCL 1.13's PCDReader::read crashes on a file
-  // without FIELDS (the checks of tools/pcd_files.cpp).
-  const std::string file = path.string ();
+  // io::loadCloud is pcd_collision's reader: every check a file of unknown origin needs (PCL
+  // 1.13's PCDReader crashes on a header without FIELDS), messages naming the file.
   pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::string error;
+  bool loaded = false;
   {
     py::gil_scoped_release release;
-    pcl::PCLPointCloud2 blob;
-    Eigen::Vector4f origin = Eigen::Vector4f::Zero ();
-    Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity ();
-    pcl::PCDReader reader;
-    int version = 0, data_type = 0;
-    unsigned int data_idx = 0;
-    std::string error;
-    if (reader.readHeader (file, blob, origin, orientation, version, data_type, data_idx) < 0 || blob.fields.empty ())
-      error = "path: '" + file + "' is not a PCD file (malformed or missing header)";
-    else if (static_cast<std::size_t> (blob.width) * blob.height == 0)
-      error = "path: '" + file + "' has no points (empty cloud)";
-    for (const char* f : {"x", "y", "z"})
-    {
-      const int i = error.empty () ? pcl::getFieldIndex (blob, f) : 0;
-      if (error.empty () && (i < 0 || blob.fields[static_cast<std::size_t> (i)].datatype != pcl::PCLPointField::FLOAT32 ||
-                             blob.fields[static_cast<std::size_t> (i)].count != 1))
-        error = "path: '" + file + "' has no float32 field '" + f + "' (load_model needs x y z; read other files into numpy)";
-    }
-    if (error.empty () && reader.read (file, blob, origin, orientation, version) < 0)
-      error = "path: '" + file + "' is truncated or corrupt (PCD data could not be read)";
-    if (error.empty () && blob.data.size () < static_cast<std::size_t> (blob.width) * blob.height * blob.point_step)
-      error = "path: '" + file + "' is truncated (fewer data bytes than its header announces)";
-    if (!error.empty ())
-    {
-      py::gil_scoped_acquire acquire;
-      throw py::value_error (error);
-    }
-    pcl::fromPCLPointCloud2 (blob, cloud);
-    cloud.sensor_origin_ = origin;
-    cloud.sensor_orientation_ = orientation;
+    loaded = pcl_probcollision::io::loadCloud (path.string (), cloud, error);
   }
+  if (!loaded)
+    throw py::value_error ("path: " + error);
   py::gil_scoped_release release;
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
 }

@@ -37,12 +37,7 @@ bool
 collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
               const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
 {
-  if (a.empty () || b.empty ())
-  {
-    fail (result, CollisionResult::Status::InvalidInput,
-          a.empty () ? "hierarchy A is empty (no finite point)" : "hierarchy B is empty (no finite point)");
-    return false;
-  }
+  // Neither hierarchy is empty: a CloudModel always holds at least one point.
   // The caller's classifier carries the random-feature draw; without one, draw it here.
   std::optional<RobustClassifier> own;
   if (!classifier)

@@ -3,6 +3,7 @@
 // The contract is in docs/CLI.md and `pcd_collision -h`.
 
 #include "cli_options.h"
+#include "cloud_input.h"
 #include "json_writer.h"
 #include "mesh_input.h"
 #include "mesh_sampling.h"
@@ -32,7 +33,9 @@ namespace
 namespace fs = std::filesystem;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 // The file formats around the library (io/).
+using pcl_probcollision::io::isFacelessPly;
 using pcl_probcollision::io::JsonWriter;
+using pcl_probcollision::io::loadCloud;
 using pcl_probcollision::io::loadTriangleMesh;
 using pcl_probcollision::io::meshDiagonal;
 using pcl_probcollision::io::medianSpacing;

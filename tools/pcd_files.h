@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-// Point-cloud files of pcd_collision: PCD and face-less PLY input, the PCD result output
-// (pcl/io/pcd_io.h and ply_io.h stay in pcd_files.cpp).
+// The PCD result output of pcd_collision (pcl/io/pcd_io.h stays in pcd_files.cpp); point-cloud
+// input is io/cloud_input.h.
 
 #include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/collision_result.h>
@@ -15,18 +15,6 @@
 
 namespace pcd_collision
 {
-/** \brief Loads any PCD with x y z fields into PointXYZ, keeping width/height (organization),
-  * NaN points and the VIEWPOINT (sensor_origin_, sensor_orientation_); a .ply (extension
-  * case-insensitive) goes through PCL's PLY reader, its camera element giving the viewpoint. x y z
-  * of any numeric type are converted. False with a reason naming the file when the file is
-  * unreadable, malformed or truncated, has no x y z, or has no points. */
-bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error);
-
-/** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
-  * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,
-  * which reports it. Reads the header only. */
-bool isFacelessPly (const std::string& path);
-
 /** \brief One side of the -o output. */
 struct LabelledCloud
 {
