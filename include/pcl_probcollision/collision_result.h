@@ -37,6 +37,14 @@ struct CollisionResult
   Verdict verdict = Verdict::Unknown;
   /** \brief P(A, B) in [0, 1]: the largest reach-weighted leaf-pair probability. */
   double probability = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief Signed distance between the two surfaces in data units (METHOD.md 10a, the
+    * surface layer): > 0 the gap, < 0 minus the penetration depth. NaN when not computed: the
+    * surface layer is off (CollisionRequest::surface) or the query never came within reach of
+    * both surfaces (no_leaf_tested without a far-field inside answer). */
+  double signed_distance = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
+    * surfaces' own uncertainty and the discretisation between samples); NaN with it. */
+  double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
   /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
     * InCollision and final). */
   bool lower_bound = false;
