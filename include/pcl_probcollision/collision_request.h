@@ -61,6 +61,11 @@ struct CollisionRequest
     * P of those poses costs ranking accuracy (docs/PERFORMANCE.md). */
   bool defer_kernel_fits = false;
 
+  /** \brief The surface layer (METHOD.md 10a): besides the classifier, test each object's
+    * points against the other's oriented surface (a local signed distance near contact, a
+    * winding-number inside test far from it) and fill signed_distance. Default on. false gives
+    * the separators alone, the paper's method. */
+  bool surface = true;
   /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
   ClassifierParams classifier;
 
