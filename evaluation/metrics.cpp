@@ -178,6 +178,78 @@ flipRate (const std::vector<std::vector<bool>>& is_free)
 }
 
 double
+anyFlipRate (const std::vector<std::vector<bool>>& is_free)
+{
+  double sum = 0.0;
+  std::size_t poses = 0;
+  for (const std::vector<bool>& verdicts : is_free)
+  {
+    if (verdicts.size () < 2)
+      continue;
+    const bool all_same = std::all_of (verdicts.begin (), verdicts.end (), [&] (bool v) { return v == verdicts.front (); });
+    sum += all_same ? 0.0 : 1.0;
+    ++poses;
+  }
+  return poses > 0 ? sum / static_cast<double> (poses) : kNaN;
+}
+
+HiddenCollisions
+hiddenCollisions (const std::vector<bool>& answered_free, const std::vector<bool>& collides)
+{
+  requireSameSize (answered_free.size (), collides.size (), "hiddenCollisions");
+  HiddenCollisions h;
+  for (std::size_t i = 0; i < answered_free.size (); ++i)
+    if (answered_free[i])
+    {
+      ++h.free_answers;
+      h.hidden += collides[i] ? 1 : 0;
+    }
+  h.rate = h.free_answers > 0 ? static_cast<double> (h.hidden) / static_cast<double> (h.free_answers) : kNaN;
+  return h;
+}
+
+double
+reliabilityTolerance (double mean_predicted, std::size_t count, double floor, double k)
+{
+  if (count == 0 || std::isnan (mean_predicted))
+    return kNaN;
+  const double p = std::clamp (mean_predicted, 0.0, 1.0);
+  return std::max (floor, k * std::sqrt (p * (1.0 - p) / static_cast<double> (count)));
+}
+
+bool
+reliabilityBinWithin (const ReliabilityBin& bin, double floor, double k)
+{
+  const double tolerance = reliabilityTolerance (bin.mean_predicted, bin.count, floor, k);
+  return !std::isnan (tolerance) && !std::isnan (bin.observed) &&
+         std::abs (bin.observed - bin.mean_predicted) <= tolerance;
+}
+
+DistanceErrors
+signedDistanceErrors (const std::vector<double>& estimate, const std::vector<double>& std,
+                      const std::vector<double>& truth, const std::vector<double>& scale, double k)
+{
+  requireSameSize (estimate.size (), std.size (), "signedDistanceErrors");
+  requireSameSize (estimate.size (), truth.size (), "signedDistanceErrors");
+  requireSameSize (estimate.size (), scale.size (), "signedDistanceErrors");
+  DistanceErrors out;
+  std::vector<double> errors;
+  std::size_t covered = 0;
+  for (std::size_t i = 0; i < estimate.size (); ++i)
+  {
+    if (!std::isfinite (estimate[i]))
+      continue;
+    const double e = std::abs (estimate[i] - truth[i]);
+    errors.push_back (e / scale[i]);
+    covered += (std::isfinite (std[i]) && e <= k * std[i]) ? 1 : 0;
+  }
+  out.count = errors.size ();
+  out.median_abs_error = percentile (errors, 50.0);
+  out.coverage = out.count > 0 ? static_cast<double> (covered) / static_cast<double> (out.count) : kNaN;
+  return out;
+}
+
+double
 meanGroupStd (const std::vector<std::vector<double>>& groups)
 {
   double sum = 0.0;

@@ -81,6 +81,47 @@ MeanStd meanStd (const std::vector<double>& values);
   * re-sample. 0 means perfectly stable, 1/2 is the worst possible. NaN when no pose has any. */
 double flipRate (const std::vector<std::vector<bool>>& is_free);
 
+/** \brief Any-flip rate under re-scans (issue #16): per pose, 1 when its free / not-free
+  * verdicts are not all the same across the draws, else 0; the mean over the poses with at least
+  * two draws. Stricter than flipRate(): one dissenting draw out of n flips the pose. NaN when no
+  * pose has two draws. */
+double anyFlipRate (const std::vector<std::vector<bool>>& is_free);
+
+/** \brief Hidden collisions: among the answers that said "free", those whose pose collides. */
+struct HiddenCollisions
+{
+  std::size_t free_answers = 0;  ///< answers "free"
+  std::size_t hidden = 0;        ///< of which collide
+  double rate = 0.0;             ///< hidden / free_answers; NaN when there is no free answer
+};
+
+/** \brief Counts hidden collisions over paired answers (answered_free[i], collides[i]). */
+HiddenCollisions hiddenCollisions (const std::vector<bool>& answered_free, const std::vector<bool>& collides);
+
+/** \brief Tolerance of the reliability check of issue #16 for a bin: the larger of `floor`
+  * (0.1) and k (2) binomial standard errors sqrt(p (1 - p) / n) at p = the bin's mean predicted
+  * probability. NaN when count is 0 or mean_predicted is NaN. */
+double reliabilityTolerance (double mean_predicted, std::size_t count, double floor = 0.1, double k = 2.0);
+
+/** \brief The check itself: |observed - mean_predicted| <= reliabilityTolerance(); false for
+  * an empty bin. Which bins are judged (issue #16: those holding at least 30) is the caller's. */
+bool reliabilityBinWithin (const ReliabilityBin& bin, double floor = 0.1, double k = 2.0);
+
+/** \brief Error of a signed-distance estimate against the truth. */
+struct DistanceErrors
+{
+  std::size_t count = 0;           ///< pairs with a finite estimate (the others are skipped)
+  double median_abs_error = 0.0;   ///< median |estimate - truth| / scale; NaN when count is 0
+  double coverage = 0.0;           ///< share with |estimate - truth| <= k std (a NaN std never covers); NaN when count is 0
+};
+
+/** \brief Errors of `estimate` (NaN = not computed, skipped) with standard deviations `std`
+  * against `truth`, in units of `scale` (per pair, e.g. sigma_eff); coverage of the +-k std
+  * interval. Throws std::invalid_argument when the sizes differ. */
+DistanceErrors signedDistanceErrors (const std::vector<double>& estimate, const std::vector<double>& std,
+                                     const std::vector<double>& truth, const std::vector<double>& scale,
+                                     double k = 2.0);
+
 /** \brief Mean over groups of the sample standard deviation within each group (groups with
   * fewer than two values are skipped): e.g. the spread of our probability over the noise
   * re-samples of one pose, averaged over poses. NaN when no group has two values. */

@@ -194,6 +194,70 @@ TEST (FlipRate, MinorityShareAveragedOverPoses)
   EXPECT_TRUE (std::isnan (ev::flipRate ({{}})));
 }
 
+TEST (AnyFlipRate, OneDissentFlipsThePose)
+{
+  // One dissent of four; unanimous; a tie; single draws and empty poses are skipped.
+  EXPECT_DOUBLE_EQ (ev::anyFlipRate ({{true, true, true, false}, {false, false, false}, {true, false}, {true}, {}}),
+                    2.0 / 3.0);
+  EXPECT_DOUBLE_EQ (ev::anyFlipRate ({{false, false}, {true, true, true}}), 0.0);
+  EXPECT_TRUE (std::isnan (ev::anyFlipRate ({{true}, {}})));
+}
+
+TEST (HiddenCollisions, ShareOfFreeAnswersThatCollide)
+{
+  const auto h = ev::hiddenCollisions ({true, true, true, false, true}, {false, true, false, true, false});
+  EXPECT_EQ (h.free_answers, 4u);
+  EXPECT_EQ (h.hidden, 1u);
+  EXPECT_DOUBLE_EQ (h.rate, 0.25);
+  const auto none = ev::hiddenCollisions ({false, false}, {true, false});
+  EXPECT_EQ (none.free_answers, 0u);
+  EXPECT_TRUE (std::isnan (none.rate));
+  EXPECT_THROW (ev::hiddenCollisions ({true}, {true, false}), std::invalid_argument);
+}
+
+TEST (ReliabilityCheck, TenPointsOrTwoStandardErrorsWhicheverIsWider)
+{
+  // n = 30 at p = 0.5: 2 sqrt(0.25 / 30) = 0.1826 > 0.1.
+  EXPECT_NEAR (ev::reliabilityTolerance (0.5, 30), 2.0 * std::sqrt (0.25 / 30.0), 1e-12);
+  // n = 400 at p = 0.5: 0.05 < 0.1, the floor holds.
+  EXPECT_DOUBLE_EQ (ev::reliabilityTolerance (0.5, 400), 0.1);
+  EXPECT_DOUBLE_EQ (ev::reliabilityTolerance (0.0, 30), 0.1);
+  EXPECT_TRUE (std::isnan (ev::reliabilityTolerance (0.5, 0)));
+  ev::ReliabilityBin bin;
+  bin.count = 30;
+  bin.mean_predicted = 0.5;
+  bin.observed = 0.68;  // 0.18 <= 0.1826
+  EXPECT_TRUE (ev::reliabilityBinWithin (bin));
+  bin.observed = 0.69;
+  EXPECT_FALSE (ev::reliabilityBinWithin (bin));
+  bin.count = 1000;
+  bin.mean_predicted = 0.05;
+  bin.observed = 0.15;  // exactly the floor
+  EXPECT_TRUE (ev::reliabilityBinWithin (bin));
+  bin.observed = 0.151;
+  EXPECT_FALSE (ev::reliabilityBinWithin (bin));
+  bin.count = 0;
+  bin.mean_predicted = kNaN;
+  bin.observed = kNaN;
+  EXPECT_FALSE (ev::reliabilityBinWithin (bin));
+}
+
+TEST (SignedDistanceErrors, MedianInScaleUnitsAndCoverage)
+{
+  // Errors 1, 3, 0.5 (scale 1, 1, 0.5 -> 1, 3, 1); the NaN estimate is skipped.
+  const auto e = ev::signedDistanceErrors ({1.0, -2.0, 0.5, kNaN}, {1.0, 1.0, kNaN, 1.0}, {0.0, 1.0, 0.0, 0.0},
+                                           {1.0, 1.0, 0.5, 1.0});
+  EXPECT_EQ (e.count, 3u);
+  EXPECT_DOUBLE_EQ (e.median_abs_error, 1.0);
+  // Covered: |1| <= 2; not |3| > 2; not a NaN std.
+  EXPECT_DOUBLE_EQ (e.coverage, 1.0 / 3.0);
+  const auto none = ev::signedDistanceErrors ({kNaN}, {1.0}, {0.0}, {1.0});
+  EXPECT_EQ (none.count, 0u);
+  EXPECT_TRUE (std::isnan (none.median_abs_error));
+  EXPECT_TRUE (std::isnan (none.coverage));
+  EXPECT_THROW (ev::signedDistanceErrors ({1.0}, {1.0}, {0.0, 1.0}, {1.0}), std::invalid_argument);
+}
+
 TEST (ParetoFront, HandExample)
 {
   // (time, accuracy); lower time and higher accuracy are better.
