@@ -1,10 +1,24 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// evaluate_collision: the evaluation suite of docs/RESULTS.md (issue 6). Every method answers
-// the same queries; ground truth comes from FCL on the meshes (W1), closed forms (W2) or
-// SCENES.md (W3). Writes queries.csv, builds.csv, summary.csv, reliability.csv, flips.csv and
-// model_size.csv into the output directory; scripts/evaluate.sh renders the charts.
+// evaluate_collision: the evaluation suite of docs/RESULTS.md (issues 6 and 16). Every method
+// answers the same queries; ground truth comes from FCL on the meshes (W1), closed forms (W2) or
+// SCENES.md (W3). W1 runs at two room densities (W1: the room at 50,000 points; W1-sparse: a
+// nominal spacing sqrt(area / N) of at least 10 sigma at 0.5 % noise) and, in the full run, at
+// 0.25, 0.5, 1, 2 and 4 % noise, with poses aimed at issue 16's near band |d| <= 2.8 sigma_eff.
+// Writes into the output directory:
+//   queries.csv      every answer (signed_distance and its std empty when not computed)
+//   summary.csv      per (workload, noise, method, setting): accuracy, AUC, Brier, hidden
+//                    collisions, re-noise and re-scan stability, signed-distance errors, times
+//   reliability.csv  reliability bins per band (near_sigma, near_contact, all) with the
+//                    per-bin check of issue 16 (bins of >= 30 queries)
+//   flips.csv        stability: kind renoise (same samples, new noise; issue 6) and rescan
+//                    (new sample positions and new noise; issue 16)
+//   model_size.csv, densities.csv (the W1 rooms' counts and spacing / sigma), targets.csv
+//                    (issue 16's targets: measured, threshold, met / missed / not measured;
+//                    also printed at the end)
+// scripts/evaluate.sh renders the charts. Nothing is fitted on these workloads.
 //
-//   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N]
+//   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
+//                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only]
 
 #include "baselines.h"
 #include "ground_truth.h"
@@ -39,7 +53,10 @@ struct Options
   std::string out_dir, data_dir;
   bool quick = false;
   std::uint64_t seed = 1;
-  std::size_t poses = 0;          ///< W1 uniform and near-contact poses each (0: 40 quick, 300 full)
+  std::size_t poses = 0;          ///< W1 uniform and +-5 % near-contact poses each (0: 40 quick, 250 full)
+  std::size_t sigma_poses = 0;    ///< W1 poses aimed at |d| <= 2.8 sigma_eff, per noise level (0: 60 quick, 250 full)
+  int rescans = 0;                ///< re-scans of both objects (0: 8 quick, 10 full)
+  std::size_t rescan_poses = 0;   ///< near-band poses re-scanned per cell (0: 20 quick, 100 full)
   bool ours_only = false;         ///< skip the baselines, W2 and W3 (for quick studies)
 };
 
@@ -61,42 +78,77 @@ progress (const std::string& text)
   std::cerr << "[evaluate] " << text << std::endl;
 }
 
+std::string
+fmtShort (double v)
+{
+  std::ostringstream s;
+  s << v;
+  return s.str ();
+}
+
 // ---------------------------------------------------------------------------------------------
 // Collected results. A cell is (workload, noise level, method, setting).
 using CellKey = std::tuple<std::string, double, std::string, std::string>;
+
+/** \brief Half-width of issue #16's near band, in sigma_eff: |d| <= 2.8 sigma_eff. */
+constexpr double kNearSigma = 2.8;
 
 struct Results
 {
   std::vector<QueryRow> queries;
   std::vector<BuildRow> builds;
-  // flips[cell] = per pose, per re-sample: is free / score.
+  // Per pose, per draw: is free / score.
   struct Flip
   {
     std::vector<std::vector<bool>> is_free;
     std::vector<std::vector<double>> scores;
+    void record (std::size_t pose, std::size_t poses, const Answer& a)
+    {
+      is_free.resize (poses);
+      scores.resize (poses);
+      is_free[pose].push_back (a.verdict == "free");
+      scores[pose].push_back (a.score);
+    }
   };
-  std::map<CellKey, Flip> flips;
+  // Re-noise: the same sample positions, the sensor noise re-drawn (the measure of issue 6).
+  std::map<CellKey, Flip> renoise;
+  // Re-scan: both objects sampled anew (new positions) with new noise (issue 16).
+  std::map<CellKey, Flip> rescan;
+  // Lines of densities.csv (the W1 variants: counts, spacing and spacing / sigma).
+  std::vector<std::string> density_rows;
+  int scenes_right = 0, scenes_total = 0;
+};
+
+/** \brief The poses of one W1 cell with their bands. */
+struct CellPoses
+{
+  std::vector<PoseTruth> poses;
+  std::vector<std::string> set;    ///< uniform, near_pct, near_sigma
+  std::vector<bool> near, near_sigma;
 };
 
 // Runs one prebuilt method over a pose list, appending rows.
 // score (optional) replaces the answer's score, computed outside the timed call.
 void
-runQueries (Results& results, const QueryRow& prototype, const std::vector<PoseTruth>& poses,
-            const std::vector<bool>& near, const PoseQuery& query,
+runQueries (Results& results, const QueryRow& prototype, const CellPoses& cell, const PoseQuery& query,
             const std::function<double (const Eigen::Isometry3d&)>& score = nullptr)
 {
-  for (std::size_t i = 0; i < poses.size (); ++i)
+  for (std::size_t i = 0; i < cell.poses.size (); ++i)
   {
     QueryRow row = prototype;
     row.query = std::to_string (i);
-    row.exact_distance = poses[i].signed_distance;
-    row.exact_collision = poses[i].collision;
-    row.near_contact = near[i];
+    row.exact_distance = cell.poses[i].signed_distance;
+    row.exact_collision = cell.poses[i].collision;
+    row.near_contact = cell.near[i];
+    row.near_sigma = cell.near_sigma[i];
+    row.pose_set = cell.set[i];
     const auto start = Clock::now ();
-    const Answer a = query (poses[i].T);
+    const Answer a = query (cell.poses[i].T);
     row.query_us = microsecondsSince (start);
-    row.score = score ? score (poses[i].T) : a.score;
+    row.score = score ? score (cell.poses[i].T) : a.score;
     row.verdict = a.verdict;
+    row.signed_distance = a.signed_distance;
+    row.signed_distance_std = a.signed_distance_std;
     results.queries.push_back (row);
   }
 }
@@ -108,19 +160,37 @@ yesNo (bool collision)
 }
 
 // ---------------------------------------------------------------------------------------------
-// W1: the piano in the room.
+// W1: the piano in the room, at two room densities.
+struct Density
+{
+  std::string name;       ///< dense or sparse
+  std::string workload;   ///< W1 (dense: the room at 50,000 points) or W1-sparse
+  std::size_t rob_points = 0, env_points = 0;
+  CloudXYZ::Ptr rob_clean, env_clean;
+};
+
 struct PianoRoom
 {
   TriangleMesh rob_mesh, env_mesh;
   std::unique_ptr<ExactMeshPair> exact;
-  double diagonal = 0.0;
-  CloudXYZ::Ptr rob_clean, env_clean;
+  double diagonal = 0.0, env_area = 0.0;
+  std::vector<double> noise_pcts;
+  std::vector<Density> densities;
+  // Shared by every cell: uniform poses and near-contact poses within +-5 % of the diagonal.
   std::vector<PoseTruth> poses;
-  std::vector<bool> near;
+  std::vector<std::string> pose_set;
+  // Per noise level: poses targeted at the near band |d| <= 2.8 sigma_eff of that level.
+  std::map<double, std::vector<PoseTruth>> sigma_poses;
 };
 
+double
+sigmaOf (const PianoRoom& w, double pct)
+{
+  return pct / 100.0 * w.diagonal;
+}
+
 PianoRoom
-loadPianoRoom (const Options& o)
+loadPianoRoom (const Options& o, Results& results)
 {
   PianoRoom w;
   std::string error;
@@ -130,71 +200,152 @@ loadPianoRoom (const Options& o)
     throw std::runtime_error (error);
   w.exact.reset (new ExactMeshPair (w.rob_mesh, w.env_mesh));
   w.diagonal = w.exact->robotDiagonal ();
-  w.rob_clean = sampleCount (w.rob_mesh, o.quick ? 3000 : 10000, o.seed * 101 + 1);
-  w.env_clean = sampleCount (w.env_mesh, o.quick ? 12000 : 50000, o.seed * 101 + 2);
+  w.env_area = pcl_probcollision::io::meshArea (w.env_mesh);
+  w.noise_pcts = o.quick ? std::vector<double> {0.5} : std::vector<double> {0.25, 0.5, 1.0, 2.0, 4.0};
+
+  // Densities. The piano keeps 10,000 points. The dense room has 50,000; the sparse room the
+  // issue's 10,000, fewer if needed so that the nominal spacing sqrt(area / N) is at least
+  // 10 sigma at 0.5 % noise.
+  const double sigma05 = sigmaOf (w, 0.5);
+  const auto sparse_max = static_cast<std::size_t> (std::floor (w.env_area / ((10.0 * sigma05) * (10.0 * sigma05))));
+  const std::size_t sparse = std::min<std::size_t> (10000, sparse_max);
+  w.densities.push_back ({"dense", "W1", 10000, 50000, nullptr, nullptr});
+  w.densities.push_back ({"sparse", "W1-sparse", 10000, sparse, nullptr, nullptr});
+  for (std::size_t d = 0; d < w.densities.size (); ++d)
+  {
+    Density& den = w.densities[d];
+    // The dense room keeps the samples of the evaluation before the densities (same seeds).
+    den.rob_clean = sampleCount (w.rob_mesh, den.rob_points, o.seed * 101 + 1);
+    den.env_clean = sampleCount (w.env_mesh, den.env_points, o.seed * 101 + 2 + 10 * d);
+    const double nominal = std::sqrt (w.env_area / static_cast<double> (den.env_clean->size ()));
+    const double area_only =
+      std::sqrt (w.env_area / std::max (1.0, static_cast<double> (den.env_clean->size ()) - w.env_mesh.vertices.size ()));
+    const double median_nn = pcl_probcollision::io::medianSpacing (*den.env_clean);
+    for (const double pct : w.noise_pcts)
+    {
+      const double sigma = sigmaOf (w, pct);
+      std::ostringstream row;
+      row << den.workload << ',' << den.name << ',' << pct << ',' << sigma << ',' << den.rob_clean->size () << ','
+          << den.env_clean->size () << ',' << w.env_area << ',' << nominal << ',' << area_only << ',' << median_nn << ','
+          << nominal / sigma << ',' << area_only / sigma << ',' << median_nn / sigma;
+      results.density_rows.push_back (row.str ());
+    }
+    std::ostringstream msg;
+    msg.precision (3);
+    msg << "W1 " << den.name << ": room " << den.env_clean->size () << " points, spacing sqrt(area/N) " << nominal
+        << " mm = " << nominal / sigma05 << " sigma at 0.5 % (area samples only: " << area_only / sigma05
+        << " sigma; median nearest neighbour " << median_nn / sigma05 << " sigma)";
+    progress (msg.str ());
+  }
 
   const std::size_t uniform = o.poses ? o.poses : o.quick ? 40 : 250, near = uniform;
   const auto start = Clock::now ();
   w.poses = uniformPoseTruths (*w.exact, uniform, o.seed * 101 + 3, 2);
+  w.pose_set.assign (w.poses.size (), "uniform");
   NearContactOptions nc;
   nc.band = 0.05 * w.diagonal;
   nc.threads = 2;
   const auto near_poses = nearContactPoses (*w.exact, near, o.seed * 101 + 4, nc);
   w.poses.insert (w.poses.end (), near_poses.begin (), near_poses.end ());
-  for (const auto& p : w.poses)
-    w.near.push_back (std::abs (p.signed_distance) <= nc.band);
-  progress ("W1 ground truth: " + std::to_string (w.poses.size ()) + " poses in " +
-            std::to_string (millisecondsSince (start) / 1000.0) + " s");
+  w.pose_set.resize (w.poses.size (), "near_pct");
+  // Poses aimed at the near band in noise units, per noise level.
+  const std::size_t per_level = o.sigma_poses ? o.sigma_poses : o.quick ? 60 : 250;
+  for (const double pct : w.noise_pcts)
+  {
+    NearContactOptions ns;
+    ns.band = kNearSigma * std::sqrt (2.0) * sigmaOf (w, pct);
+    ns.threads = 2;
+    w.sigma_poses[pct] =
+      nearContactPoses (*w.exact, per_level, streamSeed (o.seed * 101 + 5, static_cast<std::uint64_t> (pct * 100)), ns);
+  }
+  progress ("W1 ground truth: " + std::to_string (w.poses.size ()) + " shared poses and " + std::to_string (per_level) +
+            " near-band poses per noise level in " + std::to_string (millisecondsSince (start) / 1000.0) + " s");
   return w;
 }
 
-void
-evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
+CellPoses
+cellPoses (const PianoRoom& w, double pct)
 {
-  const std::vector<double> noise_pcts = o.quick ? std::vector<double> {0.5} : std::vector<double> {0.25, 0.5, 1.0, 4.0};
-  for (const double pct : noise_pcts)
+  CellPoses c;
+  c.poses = w.poses;
+  c.set = w.pose_set;
+  const auto& extra = w.sigma_poses.at (pct);
+  c.poses.insert (c.poses.end (), extra.begin (), extra.end ());
+  c.set.resize (c.poses.size (), "near_sigma");
+  const double sigma_eff = std::sqrt (2.0) * sigmaOf (w, pct);
+  for (const auto& p : c.poses)
   {
-    const double sigma = pct / 100.0 * w.diagonal;
-    const double sigma_eff = std::sqrt (2.0) * sigma;
-    const std::uint64_t noise_seed = o.seed * 1000 + static_cast<std::uint64_t> (pct * 100);
-    const CloudXYZ::ConstPtr rob = addNoise (*w.rob_clean, sigma, noise_seed);
-    const CloudXYZ::ConstPtr env = addNoise (*w.env_clean, sigma, noise_seed + 1);
-    QueryRow proto;
-    proto.workload = "W1";
-    proto.noise_pct = pct;
-    proto.sigma_eff = sigma_eff;
-    auto buildRow = [&] (const std::string& method, const std::string& setting) {
-      BuildRow b;
-      b.workload = "W1";
-      b.noise_pct = pct;
-      b.method = method;
-      b.setting = setting;
-      return b;
-    };
+    c.near.push_back (std::abs (p.signed_distance) <= 0.05 * w.diagonal);
+    c.near_sigma.push_back (std::abs (p.signed_distance) <= kNearSigma * sigma_eff);
+  }
+  return c;
+}
 
-    // Ours: the whole sweep at 0.5 %, default and max elsewhere.
-    for (const OursSetting& s : oursSettings (!o.quick && pct == 0.5))
-    {
-      BuildRow b = buildRow ("ours", s.name);
-      double leaf_pairs = 0, kernel = 0, features = 0, n = 0;
-      const PoseQuery q = buildOurs (rob, env, sigma, s, b, [&] (std::size_t lp, std::size_t k, double f) {
-        leaf_pairs += lp;
-        kernel += k;
-        features += f;
-        n += 1;
-      });
-      proto.method = "ours";
-      proto.setting = s.name;
-      runQueries (results, proto, w.poses, w.near, q);
-      b.leaf_pairs_mean = leaf_pairs / n;
-      b.kernel_share = leaf_pairs > 0 ? kernel / leaf_pairs : 0.0;
-      b.features_mean = features / n;
-      results.builds.push_back (b);
-      progress ("W1 " + std::to_string (pct) + "% ours/" + s.name + " done");
-    }
+/** \brief Up to `count` indices of poses in the near band, evenly spread over the list. */
+std::vector<std::size_t>
+spreadNearSigma (const CellPoses& c, std::size_t count)
+{
+  std::vector<std::size_t> all;
+  for (std::size_t i = 0; i < c.poses.size (); ++i)
+    if (c.near_sigma[i])
+      all.push_back (i);
+  if (all.size () <= count)
+    return all;
+  std::vector<std::size_t> out;
+  for (std::size_t k = 0; k < count; ++k)
+    out.push_back (all[k * all.size () / count]);
+  return out;
+}
 
-    if (o.ours_only)
-      continue;
+void
+evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double pct, Results& results)
+{
+  const Density& den = w.densities[density];
+  const bool dense = density == 0;
+  const double sigma = sigmaOf (w, pct);
+  const double sigma_eff = std::sqrt (2.0) * sigma;
+  const std::string tag = den.workload + " " + fmtShort (pct) + "%";
+  // The dense room keeps the noise seeds of the evaluation before the densities.
+  const std::uint64_t noise_seed = o.seed * 1000 + static_cast<std::uint64_t> (pct * 100) + 500000 * density;
+  const CloudXYZ::ConstPtr rob = addNoise (*den.rob_clean, sigma, noise_seed);
+  const CloudXYZ::ConstPtr env = addNoise (*den.env_clean, sigma, noise_seed + 1);
+  const CellPoses cell = cellPoses (w, pct);
+  QueryRow proto;
+  proto.workload = den.workload;
+  proto.noise_pct = pct;
+  proto.sigma_eff = sigma_eff;
+  auto buildRow = [&] (const std::string& method, const std::string& setting) {
+    BuildRow b;
+    b.workload = den.workload;
+    b.noise_pct = pct;
+    b.method = method;
+    b.setting = setting;
+    return b;
+  };
+
+  // Ours: the whole sweep on the dense room at 0.5 %, default, classifier and max elsewhere.
+  for (const OursSetting& s : oursSettings (!o.quick && dense && pct == 0.5))
+  {
+    BuildRow b = buildRow ("ours", s.name);
+    double leaf_pairs = 0, kernel = 0, features = 0, n = 0;
+    const PoseQuery q = buildOurs (rob, env, sigma, s, b, [&] (std::size_t lp, std::size_t k, double f) {
+      leaf_pairs += lp;
+      kernel += k;
+      features += f;
+      n += 1;
+    });
+    proto.method = "ours";
+    proto.setting = s.name;
+    runQueries (results, proto, cell, q);
+    b.leaf_pairs_mean = leaf_pairs / n;
+    b.kernel_share = leaf_pairs > 0 ? kernel / leaf_pairs : 0.0;
+    b.features_mean = features / n;
+    results.builds.push_back (b);
+  }
+  progress (tag + " ours done");
+
+  if (!o.ours_only)
+  {
     // FCL on the exact meshes: the ground truth itself, timed as the exact-data reference.
     {
       BuildRow b = buildRow ("fcl_mesh", "exact");
@@ -205,7 +356,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
       results.builds.push_back (b);
       proto.method = "fcl_mesh";
       proto.setting = "exact";
-      runQueries (results, proto, w.poses, w.near, [&] (const Eigen::Isometry3d& T) { return yesNo (meshes.collide (T)); });
+      runQueries (results, proto, cell, [&] (const Eigen::Isometry3d& T) { return yesNo (meshes.collide (T)); });
     }
 
     // Collision maps: the env cloud in an octomap at 1, 2 and 4 sigma, against the piano mesh;
@@ -223,7 +374,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
       results.builds.push_back (b);
       proto.method = name;
       proto.setting = "mesh";
-      runQueries (results, proto, w.poses, w.near, [&] (const Eigen::Isometry3d& T) { return yesNo (map.collideMesh (T)); });
+      runQueries (results, proto, cell, [&] (const Eigen::Isometry3d& T) { return yesNo (map.collideMesh (T)); });
       if (factor == 2)
       {
         BuildRow c = buildRow (name, "cloud");
@@ -233,7 +384,7 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
         c.memory_bytes = static_cast<double> (map.envMemoryBytes () + map.robotCloudMemoryBytes ());
         results.builds.push_back (c);
         proto.setting = "cloud";
-        runQueries (results, proto, w.poses, w.near, [&] (const Eigen::Isometry3d& T) { return yesNo (map.collideCloud (T)); });
+        runQueries (results, proto, cell, [&] (const Eigen::Isometry3d& T) { return yesNo (map.collideCloud (T)); });
       }
     }
 
@@ -256,13 +407,14 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
         proto.method = name;
         proto.setting = "kdtree";
         runQueries (
-          results, proto, w.poses, w.near,
-          [&] (const Eigen::Isometry3d& T) { return yesNo (nn.within (T, r)); },
+          results, proto, cell, [&] (const Eigen::Isometry3d& T) { return yesNo (nn.within (T, r)); },
           [&] (const Eigen::Isometry3d& T) { return std::exp (-nn.minDistance (T, 0.05 * w.diagonal) / r); });
       }
     }
 
-    // Reconstruct (greedy projection triangulation) then FCL.
+    // Reconstruct (greedy projection triangulation) then FCL. A reconstruction without any
+    // triangle (possible on a sparse room) is reported, not hidden: the method gets no rows.
+    try
     {
       BuildRow b = buildRow ("reconstruct", "gp3");
       ReconstructBaseline rec;
@@ -273,35 +425,52 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
       results.builds.push_back (b);
       proto.method = "reconstruct";
       proto.setting = "gp3";
-      runQueries (results, proto, w.poses, w.near, [&] (const Eigen::Isometry3d& T) { return yesNo (rec.collide (T)); });
+      runQueries (results, proto, cell, [&] (const Eigen::Isometry3d& T) { return yesNo (rec.collide (T)); });
     }
-    progress ("W1 " + std::to_string (pct) + "% baselines done");
+    catch (const std::runtime_error& e)
+    {
+      progress (tag + " reconstruct FAILED: " + e.what ());
+    }
+    progress (tag + " baselines done");
+  }
 
-    // Stability: near-contact poses with |d| < sigma_eff, the sensor noise re-sampled.
+  // Stability by re-noise (issue 6's measure, dense room only): poses with |d| < sigma_eff, the
+  // sensor noise re-drawn at the same sample positions.
+  if (dense)
+  {
     std::vector<std::size_t> flip_poses;
-    for (std::size_t i = 0; i < w.poses.size () && flip_poses.size () < (o.quick ? 10u : 50u); ++i)
-      if (std::abs (w.poses[i].signed_distance) < sigma_eff)
+    for (std::size_t i = 0; i < cell.poses.size () && flip_poses.size () < (o.quick ? 10u : 50u); ++i)
+      if (std::abs (cell.poses[i].signed_distance) < sigma_eff)
         flip_poses.push_back (i);
     const int resamples = o.quick ? 5 : 20;
     auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
-      auto& f = results.flips[{"W1", pct, method, setting}];
-      f.is_free.resize (flip_poses.size ());
-      f.scores.resize (flip_poses.size ());
-      f.is_free[k].push_back (a.verdict == "free");
-      f.scores[k].push_back (a.score);
+      results.renoise[{den.workload, pct, method, setting}].record (k, flip_poses.size (), a);
     };
     for (int r = 0; r < resamples; ++r)
     {
       const std::uint64_t seed = noise_seed + 7919 * (r + 1);
-      const CloudXYZ::ConstPtr rob_r = addNoise (*w.rob_clean, sigma, seed);
-      const CloudXYZ::ConstPtr env_r = addNoise (*w.env_clean, sigma, seed + 1);
+      const CloudXYZ::ConstPtr rob_r = addNoise (*den.rob_clean, sigma, seed);
+      const CloudXYZ::ConstPtr env_r = addNoise (*den.env_clean, sigma, seed + 1);
       for (const OursSetting& s : oursSettings (false))
       {
+        if (s.name == "classifier")
+          continue;  // its models are the default's: below, on the same build
         BuildRow unused;
-        const PoseQuery q = buildOurs (rob_r, env_r, sigma, s, unused, nullptr);
+        const OursModels m = buildOursModels (rob_r, env_r, sigma, s.model, unused);
+        const PoseQuery q = oursQuery (m, s.request, nullptr);
         for (std::size_t k = 0; k < flip_poses.size (); ++k)
-          record ("ours", s.name, k, q (w.poses[flip_poses[k]].T));
+          record ("ours", s.name, k, q (cell.poses[flip_poses[k]].T));
+        if (s.name == "default")
+        {
+          pcl_probcollision::CollisionRequest req = s.request;
+          req.surface = false;
+          const PoseQuery qc = oursQuery (m, req, nullptr);
+          for (std::size_t k = 0; k < flip_poses.size (); ++k)
+            record ("ours", "classifier", k, qc (cell.poses[flip_poses[k]].T));
+        }
       }
+      if (o.ours_only)
+        continue;
       for (const int factor : {1, 2, 4})
       {
         OctomapBaseline map;
@@ -309,21 +478,71 @@ evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
         map.setRobotMesh (w.rob_mesh);
         for (std::size_t k = 0; k < flip_poses.size (); ++k)
           record ("octomap_" + std::to_string (factor) + "x", "mesh", k,
-                  yesNo (map.collideMesh (w.poses[flip_poses[k]].T)));
+                  yesNo (map.collideMesh (cell.poses[flip_poses[k]].T)));
       }
       NearestNeighbourBaseline nn;
       nn.build (*env_r, *rob_r);
       for (std::size_t k = 0; k < flip_poses.size (); ++k)
       {
-        const double d = nn.minDistance (w.poses[flip_poses[k]].T, 0.05 * w.diagonal);
+        const double d = nn.minDistance (cell.poses[flip_poses[k]].T, 0.05 * w.diagonal);
         for (const int m : {1, 2, 3})
           record ("nn_" + std::to_string (m) + "sigma", "kdtree", k,
                   Answer {std::exp (-d / (m * sigma_eff)), d < m * sigma_eff ? "collision" : "free"});
       }
     }
-    progress ("W1 " + std::to_string (pct) + "% stability: " + std::to_string (flip_poses.size ()) + " poses x " +
-              std::to_string (resamples) + " re-samples");
+    progress (tag + " re-noise: " + std::to_string (flip_poses.size ()) + " poses x " + std::to_string (resamples) +
+              " noise draws");
   }
+
+  // Stability by re-scan (issue 16): near-band poses; each re-scan samples both meshes anew
+  // (new sample positions, same counts) and draws new noise; ours default and classifier on one
+  // build, the 2-sigma collision map on the same re-scanned room.
+  {
+    const std::vector<std::size_t> scan_poses = spreadNearSigma (cell, o.rescan_poses ? o.rescan_poses : o.quick ? 20 : 100);
+    const int rescans = o.rescans ? o.rescans : o.quick ? 8 : 10;
+    auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
+      results.rescan[{den.workload, pct, method, setting}].record (k, scan_poses.size (), a);
+    };
+    const OursSetting defaults;
+    pcl_probcollision::CollisionRequest classifier = defaults.request;
+    classifier.surface = false;
+    for (int r = 0; r < rescans; ++r)
+    {
+      // Sampling seeds depend on the density and the re-scan, not the noise level (as the main
+      // clouds); noise seeds on all three. None equals a seed of the main clouds.
+      const std::uint64_t sample_seed = streamSeed (o.seed * 104729 + density, 1000 + r);
+      const std::uint64_t scan_noise = streamSeed (sample_seed, static_cast<std::uint64_t> (pct * 100));
+      const CloudXYZ::ConstPtr rob_r = addNoise (*sampleCount (w.rob_mesh, den.rob_points, sample_seed), sigma, scan_noise);
+      const CloudXYZ::ConstPtr env_r =
+        addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1), sigma, scan_noise + 1);
+      BuildRow unused;
+      const OursModels m = buildOursModels (rob_r, env_r, sigma, defaults.model, unused);
+      const PoseQuery qd = oursQuery (m, defaults.request, nullptr);
+      const PoseQuery qc = oursQuery (m, classifier, nullptr);
+      for (std::size_t k = 0; k < scan_poses.size (); ++k)
+      {
+        record ("ours", "default", k, qd (cell.poses[scan_poses[k]].T));
+        record ("ours", "classifier", k, qc (cell.poses[scan_poses[k]].T));
+      }
+      if (o.ours_only)
+        continue;
+      OctomapBaseline map;
+      map.buildEnv (*env_r, 2.0 * sigma);
+      map.setRobotMesh (w.rob_mesh);
+      for (std::size_t k = 0; k < scan_poses.size (); ++k)
+        record ("octomap_2x", "mesh", k, yesNo (map.collideMesh (cell.poses[scan_poses[k]].T)));
+    }
+    progress (tag + " re-scan: " + std::to_string (scan_poses.size ()) + " near-band poses x " + std::to_string (rescans) +
+              " re-scans");
+  }
+}
+
+void
+evaluatePianoRoom (const Options& o, const PianoRoom& w, Results& results)
+{
+  for (const double pct : w.noise_pcts)
+    for (std::size_t d = 0; d < w.densities.size (); ++d)
+      evaluateCell (o, w, d, pct, results);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -345,6 +564,7 @@ evaluatePrimitives (const Options& o, Results& results)
       proto.exact_distance = pq.exact_distance;
       proto.exact_collision = pq.exact_collision;
       proto.near_contact = std::abs (pq.exact_distance) <= 3.0 * proto.sigma_eff;
+      proto.near_sigma = std::abs (pq.exact_distance) <= kNearSigma * proto.sigma_eff;
       const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
       auto push = [&] (const std::string& method, const std::string& setting, const Answer& a, double us) {
         QueryRow row = proto;
@@ -352,6 +572,8 @@ evaluatePrimitives (const Options& o, Results& results)
         row.setting = setting;
         row.score = a.score;
         row.verdict = a.verdict;
+        row.signed_distance = a.signed_distance;
+        row.signed_distance_std = a.signed_distance_std;
         row.query_us = us;
         results.queries.push_back (row);
       };
@@ -422,16 +644,370 @@ easyCorrect (const QueryRow& r)
   return r.exact_collision ? r.verdict == "collision" : r.verdict == "free";
 }
 
+/** \brief A number for a CSV cell, empty when NaN (queries.csv's signed distances). */
+std::string
+fmtOrEmpty (double v)
+{
+  return std::isnan (v) ? std::string () : fmt (v);
+}
+
+/** \brief Reliability bins of one cell and band, with issue 16's check per bin. */
+struct BandReliability
+{
+  std::string band;
+  std::vector<ReliabilityBin> bins;
+  std::size_t judged = 0, outside = 0;  ///< bins holding >= 30 queries; of which outside the tolerance
+  double worst = NAN;                   ///< largest |observed - mean P| - tolerance over judged bins
+};
+
+constexpr std::size_t kJudgedBin = 30;
+
+BandReliability
+bandReliability (const std::string& band, const std::vector<double>& p, const std::vector<bool>& outcome)
+{
+  BandReliability r;
+  r.band = band;
+  r.bins = reliabilityBins (p, outcome, 10);
+  for (const auto& bin : r.bins)
+    if (bin.count >= kJudgedBin)
+    {
+      ++r.judged;
+      r.outside += reliabilityBinWithin (bin) ? 0 : 1;
+      const double excess = std::abs (bin.observed - bin.mean_predicted) - reliabilityTolerance (bin.mean_predicted, bin.count);
+      r.worst = std::isnan (r.worst) ? excess : std::max (r.worst, excess);
+    }
+  return r;
+}
+
+struct Summary
+{
+  CellKey key;
+  std::size_t queries = 0, easy = 0, easy_right = 0;
+  double easy_accuracy = NAN, auc = NAN, brier = NAN;
+  // Re-noise (issue 6) and re-scan (issue 16) stability.
+  double renoise_flip = NAN, renoise_p_std = NAN;
+  std::size_t rescan_poses = 0, rescans = 0;
+  double rescan_any_flip = NAN, rescan_flip = NAN, rescan_p_std = NAN;
+  // The near band |d| <= 2.8 sigma_eff.
+  std::size_t near_sigma = 0, colliding_near_sigma = 0, missed_near_sigma = 0;
+  double brier_near_sigma = NAN, auc_near_sigma = NAN;
+  HiddenCollisions hidden_near_sigma, hidden_all;
+  DistanceErrors sd_near_sigma, sd_all;
+  std::vector<BandReliability> reliability;
+  TimeSummary t;
+  double build_ms = NAN, memory = NAN;
+};
+
+Summary
+summarize (const CellKey& k, const std::vector<const QueryRow*>& rows)
+{
+  Summary s;
+  s.key = k;
+  s.queries = rows.size ();
+  const bool ours = std::get<2> (k) == "ours";
+  const bool w3 = std::get<0> (k) == "W3";
+  std::vector<double> scores, times, near_scores, ns_scores;
+  std::vector<bool> outcomes, near_outcomes, ns_outcomes, free_all, free_ns, ns_collide;
+  std::vector<double> sd, sd_std, truth, scale, ns_sd, ns_sd_std, ns_truth, ns_scale;
+  for (const QueryRow* r : rows)
+  {
+    scores.push_back (r->score);
+    outcomes.push_back (r->exact_collision);
+    times.push_back (r->query_us);
+    free_all.push_back (r->verdict == "free");
+    if (isEasy (*r))
+    {
+      ++s.easy;
+      s.easy_right += easyCorrect (*r) ? 1 : 0;
+    }
+    if (r->near_contact)
+    {
+      near_scores.push_back (r->score);
+      near_outcomes.push_back (r->exact_collision);
+    }
+    if (!w3)
+    {
+      sd.push_back (r->signed_distance);
+      sd_std.push_back (r->signed_distance_std);
+      truth.push_back (r->exact_distance);
+      scale.push_back (r->sigma_eff);
+    }
+    if (r->near_sigma)
+    {
+      ns_scores.push_back (r->score);
+      ns_outcomes.push_back (r->exact_collision);
+      free_ns.push_back (r->verdict == "free");
+      ++s.near_sigma;
+      s.colliding_near_sigma += r->exact_collision ? 1 : 0;
+      s.missed_near_sigma += r->exact_collision && r->verdict == "free" ? 1 : 0;
+      ns_sd.push_back (r->signed_distance);
+      ns_sd_std.push_back (r->signed_distance_std);
+      ns_truth.push_back (r->exact_distance);
+      ns_scale.push_back (r->sigma_eff);
+    }
+  }
+  s.easy_accuracy = s.easy ? static_cast<double> (s.easy_right) / s.easy : NAN;
+  s.auc = rocAuc (scores, outcomes);
+  s.auc_near_sigma = rocAuc (ns_scores, ns_outcomes);
+  s.hidden_all = hiddenCollisions (free_all, outcomes);
+  s.hidden_near_sigma = hiddenCollisions (free_ns, ns_outcomes);
+  s.sd_all = signedDistanceErrors (sd, sd_std, truth, scale);
+  s.sd_near_sigma = signedDistanceErrors (ns_sd, ns_sd_std, ns_truth, ns_scale);
+  if (ours)
+  {
+    // W3's resting queries have no exact outcome (objects touch): no Brier; its reliability is
+    // against "listed as not free" over all 24 queries.
+    if (!w3)
+    {
+      if (!near_scores.empty ())
+      {
+        s.brier = brierScore (near_scores, near_outcomes);
+        s.reliability.push_back (bandReliability ("near_contact", near_scores, near_outcomes));
+      }
+      if (!ns_scores.empty ())
+      {
+        s.brier_near_sigma = brierScore (ns_scores, ns_outcomes);
+        s.reliability.push_back (bandReliability ("near_sigma", ns_scores, ns_outcomes));
+      }
+    }
+    s.reliability.push_back (bandReliability ("all", scores, outcomes));
+  }
+  s.t = summarizeTimes (times);
+  return s;
+}
+
+/** \brief A row of targets.csv: one target of issue 16, measured or not. */
+struct Target
+{
+  std::string target, scope, measured, threshold, status, note;
+};
+
+std::string
+fmtFixed (double v, int digits = 3)
+{
+  if (std::isnan (v))
+    return "nan";
+  std::ostringstream s;
+  s.setf (std::ios::fixed);
+  s.precision (digits);
+  s << v;
+  return s.str ();
+}
+
+std::vector<Target>
+issue16Targets (const Options& o, const std::vector<Summary>& summaries, const Results& results)
+{
+  auto find = [&] (const std::string& wl, double pct, const std::string& method,
+                   const std::string& setting) -> const Summary* {
+    for (const Summary& s : summaries)
+      if (s.key == CellKey {wl, pct, method, setting})
+        return &s;
+    return nullptr;
+  };
+  const std::string not_run = "not measured";
+  const std::string not_run_note = o.quick ? "cell not in the --quick run" : "cell not run";
+  std::vector<Target> t;
+  auto add = [&] (const std::string& target, const std::string& scope, const std::string& measured,
+                  const std::string& threshold, const std::string& status, const std::string& note = "") {
+    t.push_back ({target, scope, measured, threshold, status, note});
+  };
+  auto atMost = [] (double v, double limit) { return std::isnan (v) ? "not measured" : v <= limit ? "met" : "missed"; };
+  auto atLeast = [] (double v, double limit) { return std::isnan (v) ? "not measured" : v >= limit ? "met" : "missed"; };
+  const std::vector<std::pair<std::string, std::string>> densities {{"W1", "dense"}, {"W1-sparse", "sparse"}};
+
+  // Every easy query right: W1 at both densities, 0.25-1 %; W2 at 1 mm; W3 as SCENES.md lists.
+  for (const auto& d : densities)
+    for (const double pct : {0.25, 0.5, 1.0})
+    {
+      const std::string scope = d.first + " (" + d.second + ") " + fmtShort (pct) + "%, ours/default";
+      const Summary* s = find (d.first, pct, "ours", "default");
+      if (!s)
+        add ("every easy query right", scope, not_run, "all", not_run, not_run_note);
+      else
+        add ("every easy query right", scope, std::to_string (s->easy_right) + " of " + std::to_string (s->easy),
+             "all", s->easy > 0 && s->easy_right == s->easy ? "met" : "missed",
+             s->easy > s->easy_right ? "missed by " + std::to_string (s->easy - s->easy_right) : "");
+    }
+  if (const Summary* s = find ("W2", 1.0, "ours", "default"))
+    add ("every easy query right", "W2 1 mm, ours/default", std::to_string (s->easy_right) + " of " + std::to_string (s->easy),
+         "all", s->easy > 0 && s->easy_right == s->easy ? "met" : "missed");
+  else
+    add ("every easy query right", "W2 1 mm, ours/default", not_run, "all", not_run, o.ours_only ? "--ours-only" : "");
+  if (results.scenes_total > 0)
+    add ("every SCENES.md query as listed", "W3, ours/default",
+         std::to_string (results.scenes_right) + " of " + std::to_string (results.scenes_total), "24 of 24",
+         results.scenes_right == results.scenes_total && results.scenes_total == 24 ? "met" : "missed");
+  else
+    add ("every SCENES.md query as listed", "W3, ours/default", not_run, "24 of 24", not_run, "--ours-only");
+  add ("the demo's pose 2 reads collision", "data/demo_poses.txt, pcd_collision", not_run, "collision", not_run,
+       "scripts/evaluate.sh fills this row in with pcd_collision");
+
+  // Near band, both densities, 0.25-1 %: hidden collisions and the distance interval.
+  for (const auto& d : densities)
+    for (const double pct : {0.25, 0.5, 1.0})
+    {
+      const std::string scope = d.first + " (" + d.second + ") " + fmtShort (pct) + "%, near band, ours/default";
+      const Summary* s = find (d.first, pct, "ours", "default");
+      if (!s)
+      {
+        add ("hidden-collision rate <= 5 %", scope, not_run, "0.05", not_run, not_run_note);
+        add ("+-2 std distance interval covers the truth", scope, not_run, ">= 0.90", not_run, not_run_note);
+        continue;
+      }
+      const auto& h = s->hidden_near_sigma;
+      if (h.free_answers == 0)
+        add ("hidden-collision rate <= 5 %", scope, "0 of 0 free answers", "0.05", "met", "no free answer in the band");
+      else
+        add ("hidden-collision rate <= 5 %", scope,
+             fmtFixed (h.rate) + " (" + std::to_string (h.hidden) + " of " + std::to_string (h.free_answers) + ")", "0.05",
+             atMost (h.rate, 0.05));
+      if (s->sd_near_sigma.count == 0)
+        add ("+-2 std distance interval covers the truth", scope, not_run, ">= 0.90", not_run,
+             "no signed_distance in the results (surface layer absent or off)");
+      else
+        add ("+-2 std distance interval covers the truth", scope,
+             fmtFixed (s->sd_near_sigma.coverage) + " of " + std::to_string (s->sd_near_sigma.count), ">= 0.90",
+             atLeast (s->sd_near_sigma.coverage, 0.9));
+    }
+  // Reliability, both densities, 0.25-2 %, near band.
+  for (const auto& d : densities)
+    for (const double pct : {0.25, 0.5, 1.0, 2.0})
+    {
+      const std::string scope = d.first + " (" + d.second + ") " + fmtShort (pct) + "%, near band, ours/default";
+      const std::string what = "reliability: every bin of >= 30 within max(0.1, 2 SE) of its mean P";
+      const Summary* s = find (d.first, pct, "ours", "default");
+      const BandReliability* r = nullptr;
+      if (s)
+        for (const auto& b : s->reliability)
+          if (b.band == "near_sigma")
+            r = &b;
+      if (!r)
+        add (what, scope, not_run, "0 bins outside", not_run, not_run_note);
+      else if (r->judged == 0)
+        add (what, scope, not_run, "0 bins outside", not_run, "no bin holds 30 queries");
+      else
+        add (what, scope,
+             std::to_string (r->outside) + " of " + std::to_string (r->judged) + " bins outside (worst excess " +
+               fmtFixed (r->worst) + ")",
+             "0 bins outside", r->outside == 0 ? "met" : "missed");
+    }
+  // Per density at 0.5 % (the issue's scene): Brier, AUC, re-scan P std and flips against the
+  // 2-sigma collision map, the signed-distance error.
+  struct Level
+  {
+    std::string wl, name;
+    double brier, auc, p_std, flip_share, sd_error;
+    std::string flip_text;
+  };
+  for (const Level& L : {Level {"W1", "dense", 0.12, 0.98, 0.15, 1.0 / 3.0, 0.5, "1/3"},
+                         Level {"W1-sparse", "sparse", 0.15, 0.97, 0.18, 0.5, 0.75, "1/2"}})
+  {
+    const std::string scope = L.wl + " (" + L.name + ") 0.5%, ours/default";
+    const Summary* s = find (L.wl, 0.5, "ours", "default");
+    const Summary* oct = find (L.wl, 0.5, "octomap_2x", "mesh");
+    if (!s)
+    {
+      for (const char* name : {"Brier (near band)", "ROC AUC (all poses)", "re-scan mean std of P",
+                               "re-scan any-flip rate against the 2-sigma octomap's", "signed-distance median |error|"})
+        add (name, scope, not_run, "", not_run, not_run_note);
+      continue;
+    }
+    add ("Brier (near band)", scope, fmtFixed (s->brier_near_sigma), "<= " + fmtShort (L.brier), atMost (s->brier_near_sigma, L.brier),
+         std::to_string (s->near_sigma) + " poses with |d| <= 2.8 sigma_eff");
+    add ("ROC AUC (all poses)", scope, fmtFixed (s->auc), ">= " + fmtShort (L.auc), atLeast (s->auc, L.auc),
+         std::to_string (s->queries) + " poses");
+    add ("re-scan mean std of P", scope, fmtFixed (s->rescan_p_std), "<= " + fmtShort (L.p_std), atMost (s->rescan_p_std, L.p_std),
+         std::to_string (s->rescan_poses) + " near-band poses x " + std::to_string (s->rescans) + " re-scans");
+    if (!oct || std::isnan (oct->rescan_any_flip) || std::isnan (s->rescan_any_flip))
+      add ("re-scan any-flip rate against the 2-sigma octomap's", scope,
+           std::isnan (s->rescan_any_flip) ? not_run : fmtFixed (s->rescan_any_flip) + " (octomap: not run)",
+           "<= " + L.flip_text + " of octomap_2x", not_run, o.ours_only ? "--ours-only" : "");
+    else
+    {
+      const double limit = L.flip_share * oct->rescan_any_flip;
+      add ("re-scan any-flip rate against the 2-sigma octomap's", scope,
+           fmtFixed (s->rescan_any_flip) + " against " + fmtFixed (oct->rescan_any_flip),
+           "<= " + L.flip_text + " of it (" + fmtFixed (limit) + ")", s->rescan_any_flip <= limit ? "met" : "missed");
+    }
+    if (s->sd_near_sigma.count == 0)
+      add ("signed-distance median |error| (sigma_eff)", scope, not_run, "<= " + fmtShort (L.sd_error), not_run,
+           "no signed_distance in the results (surface layer absent or off)");
+    else
+      add ("signed-distance median |error| (sigma_eff)", scope, fmtFixed (s->sd_near_sigma.median_abs_error),
+           "<= " + fmtShort (L.sd_error), atMost (s->sd_near_sigma.median_abs_error, L.sd_error),
+           "near band, " + std::to_string (s->sd_near_sigma.count) + " poses with a distance");
+  }
+  // Speed: the query against the classifier alone on the same build (today's method without the
+  // surface layer; bench_performance is the reference measure); the build is not separable here.
+  {
+    const std::string scope = "W1 (dense) 0.5%, ours/default against ours/classifier";
+    const Summary* s = find ("W1", 0.5, "ours", "default");
+    const Summary* c = find ("W1", 0.5, "ours", "classifier");
+    if (!s || !c)
+      add ("median query <= 1.5 times today's", scope, not_run, "<= 1.5", not_run, not_run_note);
+    else
+    {
+      const double median = s->t.median / c->t.median, p99 = s->t.p99 / c->t.p99;
+      add ("median query <= 1.5 times today's", scope,
+           fmtFixed (median, 2) + " (" + fmtFixed (s->t.median, 0) + " / " + fmtFixed (c->t.median, 0) + " us)", "<= 1.5",
+           atMost (median, 1.5), "one run, other work on the machine can move it; bench_performance is the reference");
+      add ("p99 query <= 1.5 times today's", scope,
+           fmtFixed (p99, 2) + " (" + fmtFixed (s->t.p99, 0) + " / " + fmtFixed (c->t.p99, 0) + " us)", "<= 1.5",
+           atMost (p99, 1.5), "as above");
+    }
+    add ("build <= 1.3 times today's", "W1 0.5%", not_run, "<= 1.3", not_run,
+         "the surface model is built with the hierarchy: compare builds across commits with bench_performance");
+  }
+  return t;
+}
+
+std::string
+csvField (const std::string& v)
+{
+  if (v.find_first_of (",\"\n") == std::string::npos)
+    return v;
+  std::string q = "\"";
+  for (const char c : v)
+    q += c == '"' ? std::string ("\"\"") : std::string (1, c);
+  return q + "\"";
+}
+
+void
+printTargets (const std::vector<Target>& targets)
+{
+  std::size_t w0 = 6, w1 = 5, w2 = 8, w3 = 9;
+  for (const auto& t : targets)
+  {
+    w0 = std::max (w0, t.target.size ());
+    w1 = std::max (w1, t.scope.size ());
+    w2 = std::max (w2, t.measured.size ());
+    w3 = std::max (w3, t.threshold.size ());
+  }
+  auto pad = [] (const std::string& s, std::size_t w) { return s + std::string (w > s.size () ? w - s.size () : 0, ' '); };
+  std::cout << "\nIssue 16 targets (targets.csv):\n"
+            << pad ("target", w0) << "  " << pad ("scope", w1) << "  " << pad ("measured", w2) << "  "
+            << pad ("threshold", w3) << "  status\n";
+  for (const auto& t : targets)
+    std::cout << pad (t.target, w0) << "  " << pad (t.scope, w1) << "  " << pad (t.measured, w2) << "  "
+              << pad (t.threshold, w3) << "  " << t.status << '\n';
+  std::size_t met = 0, missed = 0, unmeasured = 0;
+  for (const auto& t : targets)
+    (t.status == "met" ? met : t.status == "missed" ? missed : unmeasured)++;
+  std::cout << met << " met, " << missed << " missed, " << unmeasured << " not measured\n";
+}
+
 void
 writeOutputs (const Options& o, const Results& results)
 {
   std::ostringstream q;
   q << "workload,noise_pct,sigma_eff,query,exact_distance,exact_collision,near_contact,easy,method,setting,score,"
-       "verdict,query_us\n";
+       "verdict,query_us,near_sigma,pose_set,signed_distance,signed_distance_std\n";
   for (const auto& r : results.queries)
     q << r.workload << ',' << fmt (r.noise_pct) << ',' << fmt (r.sigma_eff) << ',' << r.query << ','
       << fmt (r.exact_distance) << ',' << r.exact_collision << ',' << r.near_contact << ',' << isEasy (r) << ','
-      << r.method << ',' << r.setting << ',' << fmt (r.score) << ',' << r.verdict << ',' << fmt (r.query_us) << '\n';
+      << r.method << ',' << r.setting << ',' << fmt (r.score) << ',' << r.verdict << ',' << fmt (r.query_us) << ','
+      << r.near_sigma << ',' << r.pose_set << ',' << fmtOrEmpty (r.signed_distance) << ','
+      << fmtOrEmpty (r.signed_distance_std) << '\n';
   writeFile (o.out_dir + "/queries.csv", q.str ());
 
   // Group rows per (workload, noise, method, setting), in first-seen order.
@@ -449,64 +1025,40 @@ writeOutputs (const Options& o, const Results& results)
   for (const auto& b : results.builds)
     builds[{b.workload, b.noise_pct, b.method, b.setting}] = &b;
 
-  struct Summary
-  {
-    Key key;
-    std::size_t queries = 0, easy = 0;
-    double easy_accuracy = NAN, auc = NAN, brier = NAN, flip = NAN, p_std = NAN;
-    TimeSummary t;
-    double build_ms = NAN, memory = NAN;
-  };
   std::vector<Summary> summaries;
   std::ostringstream rel;
-  rel << "workload,noise_pct,method,setting,bin_lo,bin_hi,mean_predicted,observed,count\n";
+  rel << "workload,noise_pct,method,setting,band,bin_lo,bin_hi,mean_predicted,observed,count,tolerance,judged,within\n";
   for (const Key& k : order)
   {
-    const auto& rows = groups[k];
-    Summary s;
-    s.key = k;
-    s.queries = rows.size ();
-    std::vector<double> scores, times, near_scores;
-    std::vector<bool> outcomes, near_outcomes;
-    std::size_t right = 0;
-    for (const QueryRow* r : rows)
-    {
-      scores.push_back (r->score);
-      outcomes.push_back (r->exact_collision);
-      times.push_back (r->query_us);
-      if (isEasy (*r))
+    Summary s = summarize (k, groups[k]);
+    for (const auto& band : s.reliability)
+      for (const auto& bin : band.bins)
       {
-        ++s.easy;
-        right += easyCorrect (*r) ? 1 : 0;
+        const bool judged = bin.count >= kJudgedBin;
+        rel << std::get<0> (k) << ',' << fmt (std::get<1> (k)) << ',' << std::get<2> (k) << ',' << std::get<3> (k) << ','
+            << band.band << ',' << fmt (bin.lo) << ',' << fmt (bin.hi) << ',' << fmt (bin.mean_predicted) << ','
+            << fmt (bin.observed) << ',' << bin.count << ',' << fmt (reliabilityTolerance (bin.mean_predicted, bin.count))
+            << ',' << judged << ',' << (judged ? (reliabilityBinWithin (bin) ? "1" : "0") : "") << '\n';
       }
-      if (r->near_contact)
-      {
-        near_scores.push_back (r->score);
-        near_outcomes.push_back (r->exact_collision);
-      }
-    }
-    s.easy_accuracy = s.easy ? static_cast<double> (right) / s.easy : NAN;
-    s.auc = rocAuc (scores, outcomes);
-    // W3's "in-contact" queries have no exact outcome (resting objects touch): no Brier there.
-    if (std::get<2> (k) == "ours" && std::get<0> (k) != "W3" && !near_scores.empty ())
-    {
-      s.brier = brierScore (near_scores, near_outcomes);
-      for (const auto& bin : reliabilityBins (near_scores, near_outcomes, 10))
-        rel << std::get<0> (k) << ',' << fmt (std::get<1> (k)) << ',' << std::get<2> (k) << ',' << std::get<3> (k)
-            << ',' << fmt (bin.lo) << ',' << fmt (bin.hi) << ',' << fmt (bin.mean_predicted) << ','
-            << fmt (bin.observed) << ',' << bin.count << '\n';
-    }
-    s.t = summarizeTimes (times);
     if (builds.count (k))
     {
       s.build_ms = builds[k]->build_ms;
       s.memory = builds[k]->memory_bytes;
     }
-    const auto f = results.flips.find (k);
-    if (f != results.flips.end ())
+    const auto f = results.renoise.find (k);
+    if (f != results.renoise.end ())
     {
-      s.flip = flipRate (f->second.is_free);
-      s.p_std = std::get<2> (k) == "ours" ? meanGroupStd (f->second.scores) : NAN;
+      s.renoise_flip = flipRate (f->second.is_free);
+      s.renoise_p_std = std::get<2> (k) == "ours" ? meanGroupStd (f->second.scores) : NAN;
+    }
+    const auto r = results.rescan.find (k);
+    if (r != results.rescan.end ())
+    {
+      s.rescan_poses = r->second.is_free.size ();
+      s.rescans = s.rescan_poses ? r->second.is_free.front ().size () : 0;
+      s.rescan_any_flip = anyFlipRate (r->second.is_free);
+      s.rescan_flip = flipRate (r->second.is_free);
+      s.rescan_p_std = std::get<2> (k) == "ours" ? meanGroupStd (r->second.scores) : NAN;
     }
     summaries.push_back (s);
   }
@@ -530,21 +1082,48 @@ writeOutputs (const Options& o, const Results& results)
     }
   }
   std::ostringstream sum;
-  sum << "workload,noise_pct,method,setting,queries,easy_queries,easy_accuracy,auc,brier_near,flip_rate,p_std,"
-         "median_us,p90_us,max_us,build_ms,memory_bytes,pareto\n";
+  sum << "workload,noise_pct,method,setting,queries,easy_queries,easy_accuracy,auc,brier_near,renoise_flip_rate,"
+         "renoise_p_std,median_us,p90_us,max_us,build_ms,memory_bytes,pareto,p99_us,easy_right,"
+         "near_sigma_queries,near_sigma_colliding,brier_near_sigma,auc_near_sigma,free_near_sigma,hidden_near_sigma,"
+         "hidden_rate_near_sigma,missed_near_sigma,free_all,hidden_all,hidden_rate_all,rescan_poses,rescans,"
+         "rescan_any_flip,rescan_flip_rate,rescan_p_std,sd_count_near_sigma,sd_median_abs_err_near_sigma,"
+         "sd_coverage_near_sigma,sd_count_all,sd_median_abs_err_all,sd_coverage_all,rel_bins_judged,rel_bins_outside\n";
   std::ostringstream flips;
-  flips << "workload,noise_pct,method,setting,flip_rate,p_std\n";
+  flips << "workload,noise_pct,method,setting,kind,poses,draws,flip_rate,any_flip_rate,p_std\n";
   for (std::size_t i = 0; i < summaries.size (); ++i)
   {
     const Summary& s = summaries[i];
-    sum << std::get<0> (s.key) << ',' << fmt (std::get<1> (s.key)) << ',' << std::get<2> (s.key) << ','
-        << std::get<3> (s.key) << ',' << s.queries << ',' << s.easy << ',' << fmt (s.easy_accuracy) << ','
-        << fmt (s.auc) << ',' << fmt (s.brier) << ',' << fmt (s.flip) << ',' << fmt (s.p_std) << ','
-        << fmt (s.t.median) << ',' << fmt (s.t.p90) << ',' << fmt (s.t.max) << ',' << fmt (s.build_ms) << ','
-        << fmt (s.memory) << ',' << pareto[i] << '\n';
-    if (!std::isnan (s.flip))
-      flips << std::get<0> (s.key) << ',' << fmt (std::get<1> (s.key)) << ',' << std::get<2> (s.key) << ','
-            << std::get<3> (s.key) << ',' << fmt (s.flip) << ',' << fmt (s.p_std) << '\n';
+    const std::string head =
+      std::get<0> (s.key) + ',' + fmt (std::get<1> (s.key)) + ',' + std::get<2> (s.key) + ',' + std::get<3> (s.key);
+    std::size_t judged = 0, outside = 0;
+    bool have_band = false;
+    for (const auto& b : s.reliability)
+      if (b.band == "near_sigma")
+      {
+        judged = b.judged;
+        outside = b.outside;
+        have_band = true;
+      }
+    sum << head << ',' << s.queries << ',' << s.easy << ',' << fmt (s.easy_accuracy) << ',' << fmt (s.auc) << ','
+        << fmt (s.brier) << ',' << fmt (s.renoise_flip) << ',' << fmt (s.renoise_p_std) << ',' << fmt (s.t.median) << ','
+        << fmt (s.t.p90) << ',' << fmt (s.t.max) << ',' << fmt (s.build_ms) << ',' << fmt (s.memory) << ',' << pareto[i]
+        << ',' << fmt (s.t.p99) << ',' << s.easy_right << ',' << s.near_sigma << ',' << s.colliding_near_sigma << ','
+        << fmt (s.brier_near_sigma) << ',' << fmt (s.auc_near_sigma) << ',' << s.hidden_near_sigma.free_answers << ','
+        << s.hidden_near_sigma.hidden << ',' << fmt (s.hidden_near_sigma.rate) << ',' << s.missed_near_sigma << ','
+        << s.hidden_all.free_answers << ',' << s.hidden_all.hidden << ',' << fmt (s.hidden_all.rate) << ','
+        << s.rescan_poses << ',' << s.rescans << ',' << fmt (s.rescan_any_flip) << ',' << fmt (s.rescan_flip) << ','
+        << fmt (s.rescan_p_std) << ',' << s.sd_near_sigma.count << ',' << fmt (s.sd_near_sigma.median_abs_error) << ','
+        << fmt (s.sd_near_sigma.coverage) << ',' << s.sd_all.count << ',' << fmt (s.sd_all.median_abs_error) << ','
+        << fmt (s.sd_all.coverage) << ',' << (have_band ? std::to_string (judged) : "nan") << ','
+        << (have_band ? std::to_string (outside) : "nan") << '\n';
+    const auto f = results.renoise.find (s.key);
+    if (f != results.renoise.end ())
+      flips << head << ",renoise," << f->second.is_free.size () << ','
+            << (f->second.is_free.empty () ? 0 : f->second.is_free.front ().size ()) << ',' << fmt (s.renoise_flip) << ','
+            << fmt (anyFlipRate (f->second.is_free)) << ',' << fmt (s.renoise_p_std) << '\n';
+    if (s.rescan_poses > 0)
+      flips << head << ",rescan," << s.rescan_poses << ',' << s.rescans << ',' << fmt (s.rescan_flip) << ','
+            << fmt (s.rescan_any_flip) << ',' << fmt (s.rescan_p_std) << '\n';
   }
   writeFile (o.out_dir + "/summary.csv", sum.str ());
   writeFile (o.out_dir + "/reliability.csv", rel.str ());
@@ -563,6 +1142,22 @@ writeOutputs (const Options& o, const Results& results)
               << fmt (s.easy_accuracy) << ',' << fmt (s.auc) << '\n';
   }
   writeFile (o.out_dir + "/model_size.csv", model.str ());
+
+  std::ostringstream dens;
+  dens << "workload,density,noise_pct,sigma,robot_points,env_points,env_area,env_spacing,env_area_spacing,"
+          "env_median_nn,spacing_over_sigma,area_spacing_over_sigma,median_nn_over_sigma\n";
+  for (const auto& row : results.density_rows)
+    dens << row << '\n';
+  writeFile (o.out_dir + "/densities.csv", dens.str ());
+
+  const std::vector<Target> targets = issue16Targets (o, summaries, results);
+  std::ostringstream tc;
+  tc << "target,scope,measured,threshold,status,note\n";
+  for (const auto& t : targets)
+    tc << csvField (t.target) << ',' << csvField (t.scope) << ',' << csvField (t.measured) << ','
+       << csvField (t.threshold) << ',' << csvField (t.status) << ',' << csvField (t.note) << '\n';
+  writeFile (o.out_dir + "/targets.csv", tc.str ());
+  printTargets (targets);
 }
 
 Options
@@ -587,11 +1182,18 @@ parse (int argc, char** argv)
       o.seed = std::stoull (value ());
     else if (a == "--poses")
       o.poses = std::stoull (value ());
+    else if (a == "--sigma-poses")
+      o.sigma_poses = std::stoull (value ());
+    else if (a == "--rescans")
+      o.rescans = std::stoi (value ());
+    else if (a == "--rescan-poses")
+      o.rescan_poses = std::stoull (value ());
     else if (a == "--ours-only")
       o.ours_only = true;
     else
       throw std::invalid_argument ("unknown option " + a +
-                                   " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--ours-only])");
+                                   " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
+                                   " [--rescans N] [--rescan-poses N] [--ours-only])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");
@@ -607,20 +1209,19 @@ main (int argc, char** argv)
     const Options o = parse (argc, argv);
     const auto start = Clock::now ();
     Results results;
-    int scenes_right = 0, scenes_total = 0;
     if (!o.ours_only)
     {
-      evaluateScenes (o.data_dir, results.queries, scenes_right, scenes_total);
-      progress ("W3 scenes: " + std::to_string (scenes_right) + " / " + std::to_string (scenes_total) +
+      evaluateScenes (o.data_dir, results.queries, results.scenes_right, results.scenes_total);
+      progress ("W3 scenes: " + std::to_string (results.scenes_right) + " / " + std::to_string (results.scenes_total) +
                 " answered as SCENES.md lists (default setting)");
       evaluatePrimitives (o, results);
     }
-    const PianoRoom w = loadPianoRoom (o);
+    const PianoRoom w = loadPianoRoom (o, results);
     evaluatePianoRoom (o, w, results);
     writeOutputs (o, results);
     progress ("done in " + std::to_string (millisecondsSince (start) / 1000.0) + " s; W3 " +
-              std::to_string (scenes_right) + "/" + std::to_string (scenes_total));
-    return scenes_right == scenes_total ? 0 : 3;
+              std::to_string (results.scenes_right) + "/" + std::to_string (results.scenes_total));
+    return results.scenes_right == results.scenes_total ? 0 : 3;
   }
   catch (const std::exception& e)
   {

@@ -24,10 +24,14 @@ oursSettings (bool full)
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
   const OursSetting defaults;
   const bool projection = defaults.model.surface_projection;
-  OursSetting other = defaults;
+  OursSetting classifier = defaults;
+  classifier.name = "classifier";
+  classifier.request.surface = false;
+  OursSetting other = classifier;
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
   s.push_back (defaults);
+  s.push_back (classifier);
   s.push_back (other);
   if (!full)
     return s;
@@ -55,21 +59,29 @@ oursSettings (bool full)
   return s;
 }
 
-PoseQuery
-buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma, const OursSetting& setting,
-           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query)
+OursModels
+buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
+                 const CloudModelParams& model, BuildRow& build)
 {
-  CloudModelParams params = setting.model;
+  CloudModelParams params = model;
   params.noise = SensorNoiseModel::isotropic (sigma);
   const auto start = std::chrono::steady_clock::now ();
-  const CloudModel::ConstPtr a = buildCloudModel (*robot, params, nullptr, nullptr, "robot");
-  const CloudModel::ConstPtr b = buildCloudModel (*env, params, nullptr, nullptr, "environment");
+  OursModels m;
+  m.robot = buildCloudModel (*robot, params, nullptr, nullptr, "robot");
+  m.env = buildCloudModel (*env, params, nullptr, nullptr, "environment");
   build.build_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
-  build.memory_bytes = static_cast<double> (a->bytes () + b->bytes ());
-  build.nodes = static_cast<double> (a->hierarchy ().nodes ().size () + b->hierarchy ().nodes ().size ());
-  auto classifier = std::make_shared<const RobustClassifier> (setting.request.classifier);
-  const int features = setting.request.classifier.rff_features;
-  const CollisionRequest request = setting.request;
+  build.memory_bytes = static_cast<double> (m.robot->bytes () + m.env->bytes ());
+  build.nodes = static_cast<double> (m.robot->hierarchy ().nodes ().size () + m.env->hierarchy ().nodes ().size ());
+  return m;
+}
+
+PoseQuery
+oursQuery (const OursModels& models, const CollisionRequest& request,
+           std::function<void (std::size_t, std::size_t, double)> on_query)
+{
+  auto classifier = std::make_shared<const RobustClassifier> (request.classifier);
+  const int features = request.classifier.rff_features;
+  const CloudModel::ConstPtr a = models.robot, b = models.env;
   return [a, b, classifier, request, on_query, features] (const Eigen::Isometry3d& T) {
     CollisionResult result;
     Answer answer;
@@ -78,6 +90,9 @@ buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, doubl
       throw std::runtime_error ("our query failed: " + result.message);
     answer.score = result.probability;
     answer.verdict = verdictName (result.verdict);
+    answer.signed_distance = result.signed_distance;
+    answer.signed_distance_std = result.signed_distance_std;
+    answer.surface = request.surface;
     if (on_query)
     {
       const double linear = static_cast<double> (result.leaf_pairs_tested - result.kernel_leaf_pairs);
@@ -87,6 +102,13 @@ buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, doubl
     }
     return answer;
   };
+}
+
+PoseQuery
+buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma, const OursSetting& setting,
+           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query)
+{
+  return oursQuery (buildOursModels (robot, env, sigma, setting.model, build), setting.request, std::move (on_query));
 }
 
 CloudXYZ::Ptr

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,11 +24,16 @@ struct QueryRow
   std::string query;
   double exact_distance = 0.0;
   bool exact_collision = false;
-  bool near_contact = false;
+  bool near_contact = false; ///< W1: |d| <= 5 % of the diagonal; W2: |d| <= 3 sigma_eff; W3: in-contact
+  bool near_sigma = false;   ///< |d| <= 2.8 sigma_eff (issue #16's near band in noise units; not W3)
+  std::string pose_set;      ///< W1: uniform, near_pct (+-5 % targets) or near_sigma (+-2.8 sigma_eff targets)
   std::string method, setting;
   double score = 0.0;        ///< our P, or the baseline's 1/0 (nn: exp(-d / r))
   std::string verdict;       ///< free, contact or collision
   double query_us = 0.0;
+  /** \brief Ours: CollisionResult::signed_distance and its std (NaN when not computed). */
+  double signed_distance = std::numeric_limits<double>::quiet_NaN ();
+  double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
 };
 
 /** \brief Build cost and model size of one method on one workload cell. */
@@ -50,18 +56,40 @@ struct OursSetting
   pcl_probcollision::CloudModelParams model;
 };
 
-/** \brief The sweep: the library defaults first ("default"), the paper's measured-position
-  * maximum ("max"), then one change at a time. full = false keeps default and max only. */
+/** \brief The sweep: the library defaults first ("default"), the classifier alone without the
+  * surface layer ("classifier": CollisionRequest::surface = false), the paper's model ("max":
+  * measured positions, classifier alone), then one change at a time from the defaults.
+  * full = false keeps default, classifier and max. */
 std::vector<OursSetting> oursSettings (bool full);
 
-/** \brief A query's answer: score in [0, 1] and a verdict. */
+/** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and
+  * its std (NaN when not computed, e.g. before the surface layer or with surface off) and the
+  * request's surface switch. */
 struct Answer
 {
   double score = 0.0;
   std::string verdict;
+  double signed_distance = std::numeric_limits<double>::quiet_NaN ();
+  double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
+  bool surface = false;
 };
 /** \brief One method on one cloud pair, prebuilt: answers a pose. */
 using PoseQuery = std::function<Answer (const Eigen::Isometry3d& T)>;
+
+/** \brief Our two cloud models (robot = input A, env = target B). */
+struct OursModels
+{
+  pcl_probcollision::CloudModel::ConstPtr robot, env;
+};
+
+/** \brief Builds both cloud models with isotropic noise sigma declared for both; fills the
+  * build row's time, memory and node count. */
+OursModels buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
+                            const pcl_probcollision::CloudModelParams& model, BuildRow& build);
+
+/** \brief The query of one request on prebuilt models (several requests may share them). */
+PoseQuery oursQuery (const OursModels& models, const pcl_probcollision::CollisionRequest& request,
+                     std::function<void (std::size_t leaf_pairs, std::size_t kernel, double features)> on_query);
 
 /** \brief Our method on a cloud pair (robot = input A, env = target B), isotropic noise sigma
   * declared for both. Builds the hierarchies now (build row filled) and returns the query. */
