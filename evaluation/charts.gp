@@ -5,11 +5,13 @@
 #
 # reads  dir/{summary,queries,flips,model_size,reliability}.csv   (comma separated, header line)
 # writes out/accuracy_vs_time.png, free_probability_vs_distance.png, flip_rate_vs_noise.png,
-#        model_size_vs_accuracy.png, reliability.png                (out defaults to dir)
+#        model_size_vs_accuracy.png, reliability.png, rescan_flips.png,
+#        reliability_grid.png                                        (out defaults to dir)
 #
 # Optional variables, given with -e before the script, e.g. -e "dir='x'; noise=1":
 #   out       directory of the PNGs (default: dir)
-#   wl        workload: rows whose workload starts with it (default 'W1')
+#   wl        workload of charts 1-5: rows whose workload is exactly it (default 'W1', the dense
+#             room; 'W1-sparse' the sparse one)
 #   wlname    the workload as titles state it (default 'W1, piano in a room')
 #   noise     noise level (% of the diagonal) of charts 1, 4 and 5 (default 0.5)
 #   levels    noise levels of chart 2, e.g. '0.25 1 4' (default: every level found for ours)
@@ -17,6 +19,8 @@
 #   baselines methods drawn as yes/no points in chart 2 (default 'octomap_2x nn_2sigma fcl_mesh')
 #   msx       x of chart 4: 'nodes' (default) or 'leaf_pairs_mean'
 #   noiseunit what noise_pct measures, for axis labels (default "% of the piano's bounding-box diagonal")
+#   relband   band of chart 5: 'near_sigma' (|d| <= 2.8 sigma_eff, default), 'near_contact' or 'all'
+#   gridwl    workloads of chart 7, one row each (default 'W1 W1-sparse W2 W3')
 # Columns are found by header name, so the order of the columns does not matter. A chart whose
 # file is missing or whose selection is empty is skipped with a message.
 
@@ -33,6 +37,8 @@ if (!exists("ymetric")) ymetric = "auc"
 if (!exists("baselines")) baselines = "octomap_2x nn_2sigma fcl_mesh"
 if (!exists("msx")) msx = "nodes"
 if (!exists("noiseunit")) noiseunit = "% of the piano's bounding-box diagonal"
+if (!exists("relband")) relband = "near_sigma"
+if (!exists("gridwl")) gridwl = "W1 W1-sparse W2 W3"
 
 set encoding utf8
 if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
@@ -81,7 +87,7 @@ select(file, level, prog) = sprintf("awk -F, -v OFS='\t' -v wl='%s' -v noise='%s
                                     wl, level, awk_funcs, awk_declutter, awk_prologue, prog, dir, file)
 col(name) = sprintf("$c[\"%s\"]", name)
 # Predicates on the current row.
-is_wl = "index($c[\"workload\"], wl) == 1"
+is_wl = "$c[\"workload\"] == wl"
 at_noise = "($c[\"noise_pct\"] - noise) * ($c[\"noise_pct\"] - noise) < 1e-12"
 
 readable(file) = int(system(sprintf("test -r '%s/%s' && echo 1 || echo 0", dir, file)))
@@ -226,9 +232,12 @@ if (!readable("queries.csv")) {
 # ---------------------------------------------------------------------------------------------
 # (3) Verdict flip rate (free versus not free, under noise re-sampling) versus noise level.
 
-series_prog = sprintf("%s { print %s \":\" %s }", is_wl, col("method"), col("setting"))
-flip_prog(s) = sprintf("%s && %s \":\" %s == \"%s\" && num(%s) && num(%s) { print %s, %s }", \
-  is_wl, col("method"), col("setting"), s, col("noise_pct"), col("flip_rate"), col("noise_pct"), col("flip_rate"))
+# Only the re-noise rows (kind renoise: the same samples, the noise re-drawn); chart 6 has the
+# re-scans.
+is_renoise = "(!(\"kind\" in c) || $c[\"kind\"] == \"renoise\")"
+series_prog = sprintf("%s && %s { print %s \":\" %s }", is_wl, is_renoise, col("method"), col("setting"))
+flip_prog(s) = sprintf("%s && %s && %s \":\" %s == \"%s\" && num(%s) && num(%s) { print %s, %s }", \
+  is_wl, is_renoise, col("method"), col("setting"), s, col("noise_pct"), col("flip_rate"), col("noise_pct"), col("flip_rate"))
 cmd3(s) = select("flips.csv", noise, flip_prog(s)) . " | sort -g -k1,1"
 
 if (!readable("flips.csv")) {
@@ -240,7 +249,7 @@ if (!readable("flips.csv")) {
   } else {
     reset
     set output png("flip_rate_vs_noise.png")
-    set title sprintf("%s: verdict flip rate (free / not free) under noise re-sampling", wlname)
+    set title sprintf("%s: verdict flip rate (free / not free) under noise re-draws, same samples", wlname)
     set xlabel sprintf("noise σ (%s; log scale)", noiseunit)
     set ylabel "flip rate (share of re-samples against the pose's majority)"
     flevels = system(select("flips.csv", noise, sprintf("%s && num(%s) && %s > 0 { print %s }", \
@@ -300,12 +309,14 @@ if (!readable("model_size.csv")) {
 # (5) Reliability diagram of ours, default (the calibrated aggregate) and max (the paper's),
 # over the near-contact queries; point area follows the bin count, empty bins are left out.
 
-rel_prog(s) = sprintf("%s && %s && %s == \"ours\" && %s == \"%s\" && %s > 0 && num(%s) && num(%s) { print %s, %s, %s }", \
-  is_wl, at_noise, col("method"), col("setting"), s, col("count"), col("mean_predicted"), col("observed"), \
+in_band(b) = sprintf("(!(\"band\" in c) || $c[\"band\"] == \"%s\")", b)
+rel_prog(s) = sprintf("%s && %s && %s && %s == \"ours\" && %s == \"%s\" && %s > 0 && num(%s) && num(%s) { print %s, %s, %s }", \
+  is_wl, at_noise, in_band(relband), col("method"), col("setting"), s, col("count"), col("mean_predicted"), col("observed"), \
   col("mean_predicted"), col("observed"), col("count"))
 cmd5(s) = select("reliability.csv", noise, rel_prog(s)) . " | sort -g -k1,1"
+brier_col = (relband eq "near_sigma") ? "brier_near_sigma" : "brier_near"
 brier_prog(s) = sprintf("%s && %s && %s == \"ours\" && %s == \"%s\" && num(%s) { printf \"%%.3f\", %s; exit }", \
-  is_wl, at_noise, col("method"), col("setting"), s, col("brier_near"), col("brier_near"))
+  is_wl, at_noise, col("method"), col("setting"), s, col(brier_col), col(brier_col))
 brier(s) = readable("summary.csv") ? system(select("summary.csv", noise, brier_prog(s))) : ""
 rel_title(s) = strlen(brier(s)) > 0 ? sprintf("ours, %s (Brier %s)", s, brier(s)) : sprintf("ours, %s", s)
 max_count(s) = real(system(cmd5(s) . " | awk -F'\t' 'BEGIN { m = 0 } $3 > m { m = $3 } END { print m }'"))
@@ -317,9 +328,11 @@ if (!readable("reliability.csv")) {
     print skip("reliability.png", sprintf("no ours/default or ours/max rows of %s at noise %s", wl, noise))
   } else {
     biggest = max_count("default") > max_count("max") ? max_count("default") : max_count("max")
+    biggest = max_count("classifier") > biggest ? max_count("classifier") : biggest
     reset
     set output png("reliability.png")
-    set title sprintf("%s, noise %s %%: reliability of the collision probability (near-contact queries)", wlname, noise)
+    bandname = (relband eq "near_sigma") ? "|d| <= 2.8 σ_eff" : (relband eq "near_contact") ? "near-contact queries" : "all queries"
+    set title sprintf("%s, noise %s %%: reliability of the collision probability (%s)", wlname, noise, bandname)
     set xlabel "mean predicted collision probability in the bin"
     set ylabel "observed collision frequency"
     set xrange [0:1]
@@ -331,8 +344,118 @@ if (!readable("reliability.csv")) {
     plot x with lines dt 2 lw 1.5 lc rgb "#777777" title "perfect calibration", \
          "< " . cmd5("default") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 7 ps variable \
            lw 2 lc rgb "#1f77b4" title rel_title("default"), \
+         "< " . cmd5("classifier") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 9 ps variable \
+           lw 2 lc rgb "#2ca02c" title rel_title("classifier"), \
          "< " . cmd5("max") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 5 ps variable \
            lw 2 lc rgb "#d62728" title rel_title("max")
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (6) Stability by re-scan (issue 16): any-flip rate of the free / not-free verdict over the
+# re-scans (new sample positions and new noise) against the noise level, per room density
+# (solid: W1, the dense room; dashed: W1-sparse), for ours and the 2-sigma collision map.
+
+scan_series = "ours:default ours:classifier octomap_2x:mesh"
+scan_prog(w, s) = sprintf("$c[\"workload\"] == \"%s\" && $c[\"kind\"] == \"rescan\" && %s \":\" %s == \"%s\" && num(%s) && num(%s) { print %s, %s }", \
+  w, col("method"), col("setting"), s, col("noise_pct"), col("any_flip_rate"), col("noise_pct"), col("any_flip_rate"))
+cmd6(w, s) = select("flips.csv", noise, scan_prog(w, s)) . " | sort -g -k1,1"
+
+if (!readable("flips.csv")) {
+  print skip("rescan_flips.png", "no flips.csv")
+} else {
+  if (count(select("flips.csv", noise, "$c[\"kind\"] == \"rescan\" { print }")) == 0) {
+    print skip("rescan_flips.png", "no re-scan rows")
+  } else {
+    reset
+    set output png("rescan_flips.png")
+    set title "W1: any-flip rate of the verdict over re-scans (new samples, new noise), |d| <= 2.8 σ_eff"
+    set xlabel sprintf("noise σ (%s; log scale)", noiseunit)
+    set ylabel "share of poses whose free / not-free verdict changes"
+    slevels = system(select("flips.csv", noise, sprintf("$c[\"kind\"] == \"rescan\" && num(%s) && %s > 0 { print %s }", \
+                     col("noise_pct"), col("noise_pct"), col("noise_pct"))) . " | sort -gu | tr '\\n' ' '")
+    set logscale x
+    set xtics ()
+    do for [lv in slevels] {
+      set xtics add (lv lv + 0)
+    }
+    set xrange [(word(slevels, 1) + 0) / 1.4 : (word(slevels, words(slevels)) + 0) * 1.4]
+    set yrange [0:1]
+    set grid
+    set key outside right center
+    plot for [i = 1:words(scan_series)] "< " . cmd6("W1", word(scan_series, i)) using 1:2 with linespoints \
+           lw 2 pt 7 dt 1 lc rgb colour(i) title "dense: " . word(scan_series, i), \
+         for [i = 1:words(scan_series)] "< " . cmd6("W1-sparse", word(scan_series, i)) using 1:2 with linespoints \
+           lw 2 pt 6 dt 2 lc rgb colour(i) title "sparse: " . word(scan_series, i)
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (7) Reliability per workload (rows: gridwl) and noise level (columns), ours default and
+# classifier. W1 and W2 over the near band |d| <= 2.8 σ_eff; W3 over all its queries against
+# "listed as not free". Filled markers: bins of >= 30 queries, judged by issue 16's check (red
+# ring: outside max(0.1, 2 binomial SE)); open markers: smaller bins.
+
+grid_band(w) = (w eq "W3") ? "all" : "near_sigma"
+grid_prog(w, lv, s, judged) = sprintf("$c[\"workload\"] == \"%s\" && ($c[\"noise_pct\"] - %s) * ($c[\"noise_pct\"] - %s) < 1e-12 && $c[\"band\"] == \"%s\" && %s == \"ours\" && %s == \"%s\" && %s > 0 && num(%s) && num(%s) && $c[\"judged\"] == %d { print %s, %s, %s, $c[\"within\"] }", \
+  w, lv, lv, grid_band(w), col("method"), col("setting"), s, col("count"), col("mean_predicted"), col("observed"), judged, \
+  col("mean_predicted"), col("observed"), col("count"))
+cmd7(w, lv, s, judged) = select("reliability.csv", noise, grid_prog(w, lv, s, judged))
+grid_levels(w) = system(select("reliability.csv", noise, sprintf("$c[\"workload\"] == \"%s\" && %s == \"ours\" { print %s }", \
+                        w, col("method"), col("noise_pct"))) . " | sort -gu | tr '\\n' ' '")
+
+if (!readable("reliability.csv")) {
+  print skip("reliability_grid.png", "no reliability.csv")
+} else {
+  rows = ""
+  ncols = 0
+  do for [w in gridwl] {
+    if (words(grid_levels(w)) > 0) {
+      rows = rows . " " . w
+      ncols = words(grid_levels(w)) > ncols ? words(grid_levels(w)) : ncols
+    }
+  }
+  nrows = words(rows)
+  if (nrows == 0) {
+    print skip("reliability_grid.png", "no rows of ours")
+  } else {
+    reset
+    if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
+      set terminal pngcairo size (ncols > 2 ? 300 * ncols + 60 : 720), 300 * nrows + 60 noenhanced font "DejaVu Sans,9"
+    } else {
+      set terminal png size (ncols > 2 ? 300 * ncols + 60 : 720), 300 * nrows + 60 noenhanced
+    }
+    set output png("reliability_grid.png")
+    set multiplot layout nrows, ncols title "Reliability of P (blue: default, green: classifier; filled: bin of >= 30, judged; red ring: outside)"
+    set xrange [0:1]
+    set yrange [0:1]
+    set size ratio -1
+    set grid
+    set xtics 0.5
+    set ytics 0.5
+    unset key
+    do for [r = 1:nrows] {
+      w = word(rows, r)
+      lvls = grid_levels(w)
+      do for [k = 1:ncols] {
+        if (k <= words(lvls)) {
+          lv = word(lvls, k)
+          set title sprintf("%s, noise %s (%s)", w, lv, grid_band(w))
+          plot x with lines dt 2 lc rgb "#777777", \
+               "< " . cmd7(w, lv, "default", 0) using 1:2 with points pt 6 ps 0.8 lc rgb "#1f77b4", \
+               "< " . cmd7(w, lv, "classifier", 0) using 1:2 with points pt 8 ps 0.8 lc rgb "#2ca02c", \
+               "< " . cmd7(w, lv, "default", 1) using 1:2 with points pt 7 ps 1.3 lc rgb "#1f77b4", \
+               "< " . cmd7(w, lv, "classifier", 1) using 1:2 with points pt 9 ps 1.3 lc rgb "#2ca02c", \
+               "< " . cmd7(w, lv, "default", 1) . " | awk -F'\t' '$4 == 0'" using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb "#d62728", \
+               "< " . cmd7(w, lv, "classifier", 1) . " | awk -F'\t' '$4 == 0'" using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb "#d62728"
+        } else {
+          set multiplot next
+        }
+      }
+    }
+    unset multiplot
     unset output
   }
 }

@@ -3,7 +3,8 @@
 # workload (W1 piano/room, W2 primitives, W3 real scans), writes CSV files, a markdown summary
 # and PNG charts (gnuplot).
 #   scripts/evaluate.sh           full run (about 25 min on 2 cores) into docs/results/
-#   scripts/evaluate.sh --quick   smoke run (under 3 min after the build) into build/evaluation-quick/
+#   scripts/evaluate.sh --quick   smoke run (under 2 min after the build) into build/evaluation-quick/
+# Issue 16's targets: targets.csv / targets.md (met, missed or not measured), printed by the run.
 #   --out=DIR                     another output directory
 # Fails when a W3 query is not answered as SCENES.md lists, or an output is missing.
 set -euo pipefail
@@ -23,12 +24,23 @@ data="${PCL_PROBCOLLISION_SHARED_DATA:-$(cd .. && pwd)/shared/data}"
 
 bash scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build build -j2 --target evaluate_collision calibration_drift
+cmake --build build -j2 --target evaluate_collision calibration_drift pcd_collision
 mkdir -p "$out"
 start=$(date +%s)
 build/evaluation/evaluate_collision --out "$out" --data "$data" "${quick[@]}"
 build/evaluation/calibration_drift > "$out/drift.csv.tmp" && mv "$out/drift.csv.tmp" "$out/drift.csv"
 echo "evaluate.sh: evaluation took $(( $(date +%s) - start )) s"
+
+# Issue 16's demo target: the README's demo through pcd_collision itself; its row of targets.csv
+# (written "not measured" by evaluate_collision) gets the verdict of pose 2.
+demo_verdict=$(build/tools/pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt 2>/dev/null |
+               awk '$1 == "pose" && $2 == "2:" { print $3; exit }') || demo_verdict=""
+awk -F, -v OFS=, -v v="$demo_verdict" '
+  index($0, "the demo'"'"'s pose 2 reads collision,") == 1 && v != "" {
+    print $1, $2, v, "collision", (v == "collision") ? "met" : "missed",
+          "pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt"; next
+  } { print }' "$out/targets.csv" > "$out/targets.csv.tmp" && mv "$out/targets.csv.tmp" "$out/targets.csv"
+echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)} (issue 16 target: collision)"
 
 # The summary table as markdown (docs/RESULTS.md quotes it).
 awk -F, 'NR == 1 { print "| workload | noise | method | setting | queries | easy | easy acc. | AUC | Brier (near) | flip rate | P std | median us | p90 us | max us | build ms | memory MB |";
@@ -38,10 +50,35 @@ awk -F, 'NR == 1 { print "| workload | noise | method | setting | queries | easy
                   $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, mem }' \
   "$out/summary.csv" > "$out/summary.md"
 
+# Issue 16's measures of ours and the 2-sigma collision map (columns found by header name).
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
+                   print "";
+                   print "| workload | noise | method | setting | near-band queries | Brier (near band) | free answers | hidden collisions | hidden rate | re-scan any-flip | re-scan P std | re-noise flip | distance error (sigma_eff, median) | +-2 std coverage | reliability bins outside / judged |";
+                   print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
+         $c["workload"] != "W3" && ($c["method"] == "ours" || $c["method"] == "octomap_2x") {
+           printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s / %s |\n",
+                  $c["workload"], $c["noise_pct"], $c["method"], $c["setting"], $c["near_sigma_queries"],
+                  $c["brier_near_sigma"], $c["free_near_sigma"], $c["hidden_near_sigma"], $c["hidden_rate_near_sigma"],
+                  $c["rescan_any_flip"], $c["rescan_p_std"], $c["renoise_flip_rate"], $c["sd_median_abs_err_near_sigma"],
+                  $c["sd_coverage_near_sigma"], $c["rel_bins_outside"], $c["rel_bins_judged"] }' \
+  "$out/summary.csv" >> "$out/summary.md"
+
+# Issue 16's targets as a markdown table.
+awk -F, 'NR == 1 { print "| target | scope | measured | threshold | status | note |"; print "|---|---|---|---|---|---|"; next }
+         { line = $0; n = 0; field = ""; q = 0
+           for (i = 1; i <= length(line); i++) { ch = substr(line, i, 1)
+             if (ch == "\"") { q = !q; continue }
+             if (ch == "," && !q) { f[++n] = field; field = ""; continue }
+             field = field ch }
+           f[++n] = field
+           printf "| %s | %s | %s | %s | %s | %s |\n", f[1], f[2], f[3], f[4], f[5], f[6] }' \
+  "$out/targets.csv" > "$out/targets.md"
+
 gnuplot -e "dir='$out'" evaluation/charts.gp
 for f in queries.csv summary.csv reliability.csv flips.csv model_size.csv summary.md drift.csv \
+         densities.csv targets.csv targets.md \
          accuracy_vs_time.png free_probability_vs_distance.png flip_rate_vs_noise.png \
-         model_size_vs_accuracy.png reliability.png; do
+         model_size_vs_accuracy.png reliability.png rescan_flips.png reliability_grid.png; do
   [ -s "$out/$f" ] || { echo "evaluate.sh: $out/$f missing or empty" >&2; exit 1; }
 done
 echo "evaluate.sh: results in $out"
