@@ -72,10 +72,12 @@ millisecondsSince (Clock::time_point start)
   return microsecondsSince (start) / 1000.0;
 }
 
+const Clock::time_point kProgramStart = Clock::now ();
+
 void
 progress (const std::string& text)
 {
-  std::cerr << "[evaluate] " << text << std::endl;
+  std::cerr << "[evaluate " << static_cast<long> (millisecondsSince (kProgramStart) / 1000.0) << " s] " << text << std::endl;
 }
 
 std::string
