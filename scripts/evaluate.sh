@@ -63,6 +63,18 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
                   $c["sd_coverage_near_sigma"], $c["rel_bins_outside"], $c["rel_bins_judged"] }' \
   "$out/summary.csv" >> "$out/summary.md"
 
+# Reliability tables per workload (W1 dense, W1-sparse, W2, W3) and noise level, ours default and
+# classifier: the near band for W1 and W2, every query for W3 (against "listed as not free").
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
+                   print "| workload | noise | setting | band | bin | mean P | observed | count | tolerance | check |";
+                   print "|---|---|---|---|---|---|---|---|---|---|"; next }
+         $c["method"] == "ours" && ($c["setting"] == "default" || $c["setting"] == "classifier") && $c["count"] > 0 &&
+         ($c["band"] == "near_sigma" || ($c["workload"] == "W3" && $c["band"] == "all")) {
+           check = $c["judged"] == 1 ? ($c["within"] == 1 ? "within" : "**outside**") : "-"
+           printf "| %s | %s | %s | %s | [%s, %s) | %.3f | %.3f | %s | %.3f | %s |\n", $c["workload"], $c["noise_pct"],
+                  $c["setting"], $c["band"], $c["bin_lo"], $c["bin_hi"], $c["mean_predicted"], $c["observed"], $c["count"],
+                  $c["tolerance"], check }' "$out/reliability.csv" > "$out/reliability.md"
+
 # Issue 16's targets as a markdown table.
 awk -F, 'NR == 1 { print "| target | scope | measured | threshold | status | note |"; print "|---|---|---|---|---|---|"; next }
          { line = $0; n = 0; field = ""; q = 0
@@ -76,7 +88,7 @@ awk -F, 'NR == 1 { print "| target | scope | measured | threshold | status | not
 
 gnuplot -e "dir='$out'" evaluation/charts.gp
 for f in queries.csv summary.csv reliability.csv flips.csv model_size.csv summary.md drift.csv \
-         densities.csv targets.csv targets.md \
+         densities.csv targets.csv targets.md reliability.md \
          accuracy_vs_time.png free_probability_vs_distance.png flip_rate_vs_noise.png \
          model_size_vs_accuracy.png reliability.png rescan_flips.png reliability_grid.png; do
   [ -s "$out/$f" ] || { echo "evaluate.sh: $out/$f missing or empty" >&2; exit 1; }
