@@ -3,6 +3,8 @@
 // own defaults. numpy points become a pcl::PointCloud<pcl::PointXYZ> once and go through
 // buildCloudModel<pcl::PointXYZ>, so a Python model is exactly the C++ model of the same floats.
 #include "cloud_input.h"
+#include "mesh_input.h"
+#include "mesh_sampling.h"
 
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/cloud_model_params.h>
@@ -122,7 +124,7 @@ fillCovariances (const py::array& arr, pcl::PointCloud<Covariance>& covs)
 
 std::shared_ptr<const CloudModel>
 buildModel (const py::object& points, const py::object& covariances, const py::object& params_obj,
-            const std::string& name)
+            const std::string& name, const py::object& viewpoint = py::none ())
 {
   const py::array pts = floatArray (points, "points", 2, "(N, 3)");
   pcl::PointCloud<pcl::PointXYZ> cloud;
@@ -145,6 +147,20 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
       fillCovariances<double> (c, covs);
   }
   const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
+  if (!viewpoint.is_none ())
+  {
+    // PCD's VIEWPOINT: tx ty tz qw qx qy qz, the sensor pose the depth noise models use.
+    auto v = py::array_t<double, py::array::forcecast>::ensure (viewpoint);
+    if (!v || v.size () != 7)
+    {
+      PyErr_Clear ();
+      throw py::value_error ("viewpoint: expected 7 numbers tx ty tz qw qx qy qz (a PCD's VIEWPOINT)");
+    }
+    const double* d = v.data ();
+    cloud.sensor_origin_ = Eigen::Vector4f (static_cast<float> (d[0]), static_cast<float> (d[1]), static_cast<float> (d[2]), 0.f);
+    cloud.sensor_orientation_ = Eigen::Quaternionf (static_cast<float> (d[3]), static_cast<float> (d[4]),
+                                                    static_cast<float> (d[5]), static_cast<float> (d[6]));
+  }
 
   py::gil_scoped_release release;
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name);
@@ -369,6 +385,131 @@ noiseFactory (const SensorNoiseModel& n)
   }
   return "?";
 }
+
+/** The file as pcd_collision reads it: io::loadCloud (PCD, face-less PLY), NaN rows kept. */
+py::tuple
+readCloud (const std::filesystem::path& path)
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::string error;
+  bool loaded = false;
+  {
+    py::gil_scoped_release release;
+    loaded = pcl_probcollision::io::loadCloud (path.string (), cloud, error);
+  }
+  if (!loaded)
+    throw py::value_error ("path: " + error);
+  py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
+  auto p = points.mutable_unchecked<2> ();
+  for (std::size_t i = 0; i < cloud.size (); ++i)
+    for (int d = 0; d < 3; ++d)
+      p (static_cast<py::ssize_t> (i), d) = cloud[i].data[d];
+  py::array_t<double> viewpoint (7);
+  double* v = viewpoint.mutable_data ();
+  for (int d = 0; d < 3; ++d)
+    v[d] = cloud.sensor_origin_[d];
+  v[3] = cloud.sensor_orientation_.w ();
+  v[4] = cloud.sensor_orientation_.x ();
+  v[5] = cloud.sensor_orientation_.y ();
+  v[6] = cloud.sensor_orientation_.z ();
+  return py::make_tuple (points, viewpoint, cloud.width, cloud.height);
+}
+
+pcl_probcollision::io::TriangleMesh
+meshOf (const py::object& vertices_obj, const py::object& triangles_obj)
+{
+  auto V = py::array_t<double, py::array::forcecast>::ensure (vertices_obj);
+  auto F = py::array_t<int, py::array::forcecast>::ensure (triangles_obj);
+  if (!V || !F)
+  {
+    PyErr_Clear ();
+    throw py::type_error ("expected numeric vertices (V, 3) and triangles (T, 3)");
+  }
+  if (V.ndim () != 2 || V.shape (1) != 3 || F.ndim () != 2 || F.shape (1) != 3)
+    throw py::value_error ("expected vertices (V, 3) and triangles (T, 3), got " + shapeOf (V) + " and " + shapeOf (F));
+  pcl_probcollision::io::TriangleMesh mesh;
+  const auto v = V.unchecked<2> ();
+  const auto f = F.unchecked<2> ();
+  for (py::ssize_t i = 0; i < v.shape (0); ++i)
+    mesh.vertices.push_back ({v (i, 0), v (i, 1), v (i, 2)});
+  for (py::ssize_t i = 0; i < f.shape (0); ++i)
+  {
+    for (int d = 0; d < 3; ++d)
+      if (f (i, d) < 0 || f (i, d) >= v.shape (0))
+        throw py::value_error ("triangles: row " + std::to_string (i) + " refers to a missing vertex");
+    mesh.triangles.push_back ({f (i, 0), f (i, 1), f (i, 2)});
+  }
+  return mesh;
+}
+
+py::array_t<float>
+cloudArray (const pcl::PointCloud<pcl::PointXYZ>& cloud)
+{
+  py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
+  auto p = points.mutable_unchecked<2> ();
+  for (std::size_t i = 0; i < cloud.size (); ++i)
+    for (int d = 0; d < 3; ++d)
+      p (static_cast<py::ssize_t> (i), d) = cloud[i].data[d];
+  return points;
+}
+
+/** (M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), exactly as pcd_collision turns -pose into T. */
+py::array_t<double>
+posesFromXyzRpy (const py::object& obj)
+{
+  auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
+  if (!a)
+  {
+    PyErr_Clear ();
+    throw py::type_error ("poses: expected a numeric array of shape (M, 6)");
+  }
+  if (a.ndim () != 2 || a.shape (1) != 6)
+    throw py::value_error ("poses: expected shape (M, 6), got " + shapeOf (a));
+  const auto p = a.unchecked<2> ();
+  py::array_t<double> out ({a.shape (0), static_cast<py::ssize_t> (4), static_cast<py::ssize_t> (4)});
+  auto o = out.mutable_unchecked<3> ();
+  for (py::ssize_t k = 0; k < p.shape (0); ++k)
+  {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
+    T.linear () = (Eigen::AngleAxisd (p (k, 5), Eigen::Vector3d::UnitZ ()) * Eigen::AngleAxisd (p (k, 4), Eigen::Vector3d::UnitY ()) *
+                   Eigen::AngleAxisd (p (k, 3), Eigen::Vector3d::UnitX ()))
+                      .toRotationMatrix ();
+    T.translation () = Eigen::Vector3d (p (k, 0), p (k, 1), p (k, 2));
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        o (k, i, j) = T.matrix () (i, j);
+  }
+  return out;
+}
+
+/** (M, 4, 4) rigid transforms -> their inverses, as Eigen::Isometry3d::inverse() computes them. */
+py::array_t<double>
+invertPoses (const py::object& obj)
+{
+  auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
+  if (!a)
+  {
+    PyErr_Clear ();
+    throw py::type_error ("poses: expected a numeric array of shape (M, 4, 4)");
+  }
+  if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
+    throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
+  const auto p = a.unchecked<3> ();
+  py::array_t<double> out ({a.shape (0), static_cast<py::ssize_t> (4), static_cast<py::ssize_t> (4)});
+  auto o = out.mutable_unchecked<3> ();
+  for (py::ssize_t k = 0; k < p.shape (0); ++k)
+  {
+    Eigen::Isometry3d T;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        T.matrix () (i, j) = p (k, i, j);
+    const Eigen::Isometry3d inv = T.inverse ();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        o (k, i, j) = inv.matrix () (i, j);
+  }
+  return out;
+}
 } // namespace
 
 PYBIND11_MODULE (_core, m)
@@ -467,6 +608,16 @@ PYBIND11_MODULE (_core, m)
                      [] (CloudModelParams& p, double v) { p.hierarchy.epsilon = v; })
       .def_property ("k_sigma", [] (const CloudModelParams& p) { return p.hierarchy.k_sigma; },
                      [] (CloudModelParams& p, double v) { p.hierarchy.k_sigma = v; })
+      .def_property ("split",
+                     [] (const CloudModelParams& p) {
+                       return std::string (p.hierarchy.split_style == BVHParams::SplitStyle::Octree ? "octree" : "pca");
+                     },
+                     [] (CloudModelParams& p, const std::string& v) {
+                       if (v != "pca" && v != "octree")
+                         throw py::value_error ("split: expected 'pca' or 'octree', got '" + v + "'");
+                       p.hierarchy.split_style = v == "octree" ? BVHParams::SplitStyle::Octree : BVHParams::SplitStyle::Pca;
+                     },
+                     "Hierarchy split style, 'pca' (default) or 'octree' (pcd_collision's -split).")
       .def ("validate", &CloudModelParams::validate, "Raises ValueError naming the first member out of range.")
       .def ("__repr__", [] (const CloudModelParams& p) {
         return "CloudModelParams(k=" + std::to_string (p.k) + ", noise=SensorNoiseModel." + noiseFactory (p.noise) +
@@ -598,17 +749,19 @@ PYBIND11_MODULE (_core, m)
 
   // --- functions ----------------------------------------------------------------------------------
   m.def ("build_model",
-         [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name) {
-           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name));
+         [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
+             const py::object& viewpoint) {
+           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name, viewpoint));
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
-         py::arg ("name") = "cloud",
+         py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (),
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
          "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
          "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
          "covariances: optional (N, 3, 3) float32/float64, symmetric; estimated from the k nearest neighbours when None.\n"
          "params: CloudModelParams (None = CloudModelParams()).\n"
          "name: what error messages call the cloud.\n"
+         "viewpoint: optional sensor pose tx ty tz qw qx qy qz (a PCD's VIEWPOINT; None = the origin, looking along +z).\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
@@ -630,4 +783,63 @@ PYBIND11_MODULE (_core, m)
          "(timings aside). ValueError naming the first invalid pose.");
   m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
          "The verdict of a probability under a request's thresholds (Unknown for NaN).");
+
+  // --- file input and poses as pcd_collision reads them (io/, used by pcl_probcollision.dask) ------
+  m.def ("read_cloud", &readCloud, py::arg ("path"),
+         "Reads a .pcd (or face-less .ply) file as pcd_collision does.\n\n"
+         "Returns (points (N, 3) float32 with NaN rows kept, viewpoint (7,) tx ty tz qw qx qy qz, width, height).\n"
+         "ValueError with pcd_collision's message for a file it cannot read.");
+  m.def ("is_faceless_ply", [] (const std::filesystem::path& p) { return pcl_probcollision::io::isFacelessPly (p.string ()); },
+         py::arg ("path"), "True for a .ply whose header declares no face (pcd_collision reads it as a cloud).");
+  m.def ("read_mesh",
+         [] (const std::filesystem::path& path) {
+           pcl_probcollision::io::TriangleMesh mesh;
+           std::string error;
+           if (!pcl_probcollision::io::loadTriangleMesh (path.string (), mesh, error))
+             throw py::value_error ("path: " + error);
+           py::array_t<double> V ({static_cast<py::ssize_t> (mesh.vertices.size ()), static_cast<py::ssize_t> (3)});
+           py::array_t<int> F ({static_cast<py::ssize_t> (mesh.triangles.size ()), static_cast<py::ssize_t> (3)});
+           auto v = V.mutable_unchecked<2> ();
+           auto f = F.mutable_unchecked<2> ();
+           for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
+             for (int d = 0; d < 3; ++d)
+               v (static_cast<py::ssize_t> (i), d) = mesh.vertices[i][static_cast<std::size_t> (d)];
+           for (std::size_t i = 0; i < mesh.triangles.size (); ++i)
+             for (int d = 0; d < 3; ++d)
+               f (static_cast<py::ssize_t> (i), d) = mesh.triangles[i][static_cast<std::size_t> (d)];
+           return py::make_tuple (V, F);
+         },
+         py::arg ("path"), "A triangle mesh (.ply .obj .stl .vtk) as pcd_collision reads it: (vertices (V, 3), triangles (T, 3)).");
+  m.def ("sample_mesh",
+         [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
+           const auto mesh = meshOf (vertices, triangles);
+           pcl::PointCloud<pcl::PointXYZ> cloud;
+           {
+             py::gil_scoped_release release;
+             cloud = pcl_probcollision::io::sampleMesh (mesh, spacing, seed);
+           }
+           return cloudArray (cloud);
+         },
+         py::arg ("vertices"), py::arg ("triangles"), py::arg ("spacing"), py::arg ("seed") = 20111,
+         "pcd_collision's MeshSampled-mode samples (vertices first, then area samples at `spacing`), float32 (N, 3).");
+  m.def ("mesh_diagonal",
+         [] (const py::object& vertices, const py::object& triangles) {
+           return pcl_probcollision::io::meshDiagonal (meshOf (vertices, triangles));
+         },
+         py::arg ("vertices"), py::arg ("triangles"), "Bounding-box diagonal of a mesh, as pcd_collision measures it.");
+  m.def ("median_spacing",
+         [] (const py::object& points) {
+           const py::array pts = floatArray (points, "points", 2, "(N, 3)");
+           pcl::PointCloud<pcl::PointXYZ> cloud;
+           if (py::isinstance<py::array_t<float>> (pts))
+             fillPoints<float> (pts, cloud);
+           else
+             fillPoints<double> (pts, cloud);
+           py::gil_scoped_release release;
+           return pcl_probcollision::io::medianSpacing (cloud);
+         },
+         py::arg ("points"), "Median nearest-neighbour spacing of a cloud (pcd_collision's mesh sample spacing).");
+  m.def ("poses_from_xyzrpy", &posesFromXyzRpy, py::arg ("poses"),
+         "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.");
+  m.def ("invert_poses", &invertPoses, py::arg ("poses"), "(M, 4, 4) rigid transforms -> their inverses (Eigen's).");
 }

@@ -9,6 +9,7 @@ Build a model per cloud once, then query pairs of models under poses::
     print(r.verdict, r.probability)
 
 The compiled core is pcl_probcollision._core; everything public is re-exported here.
+Pose batches over Dask workers: pcl_probcollision.dask (needs python3-distributed).
 """
 from ._core import (  # noqa: F401
     CloudModel,
@@ -21,7 +22,15 @@ from ._core import (  # noqa: F401
     build_model,
     collide,
     collide_batch,
+    invert_poses,
+    is_faceless_ply,
     load_model,
+    median_spacing,
+    mesh_diagonal,
+    poses_from_xyzrpy,
+    read_cloud,
+    read_mesh,
+    sample_mesh,
     verdict_for,
 )
 
@@ -36,6 +45,14 @@ __all__ = [
     "build_model",
     "collide",
     "collide_batch",
+    "invert_poses",
+    "is_faceless_ply",
     "load_model",
+    "median_spacing",
+    "mesh_diagonal",
+    "poses_from_xyzrpy",
+    "read_cloud",
+    "read_mesh",
+    "sample_mesh",
     "verdict_for",
 ]
