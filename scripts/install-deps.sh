@@ -4,7 +4,8 @@
 set -euo pipefail
 packages=(cmake make g++ pkg-config libpcl-dev libeigen3-dev libflann-dev libboost-dev
           libgtest-dev libbenchmark-dev libfcl-dev liboctomap-dev gnuplot-nox
-          pybind11-dev python3-dev python3-numpy python3-pytest "$@")
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed
+          python3-open3d "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

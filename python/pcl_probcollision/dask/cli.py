@@ -1,0 +1,287 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""The command line of `python3 -m pcl_probcollision.dask`: pcd_collision's batch mode with the poses
+answered on Dask. Same flags (-sigma, -sensor, ...; docs/CLI.md), same JSON lines on stdout as
+`pcd_collision a b -poses FILE -json`, same exit status (1 runtime failure, 2 usage error)."""
+import json
+import math
+import os
+import re
+import sys
+import time
+
+import numpy as np
+
+from .. import _core as core
+from . import collide_poses, connect, prepare_input
+
+USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
+
+Answers every pose of <poses.txt> (pcd_collision's -poses format) on Dask workers and prints the
+JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
+
+  --scheduler ADDRESS|local[:N]  a running scheduler (tcp://host:8786) or a LocalCluster of N
+                                 single-threaded worker processes (default N = cores)
+  --timeout S                    seconds to reach the scheduler (default 10)
+  --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
+  pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
+  -measured -deterministic -stochastic -seed -exhaustive -nmax -sigma_max -epsilon -split
+  -mesh_density -json (accepted; the output is always JSON lines) -v. A value is the next argument
+  or follows '='.
+"""
+
+_VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
+          "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
+          "split": str, "mesh_density": float}
+_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "json", "v")
+_OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
+_FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
+_INT = re.compile(r"[+-]?\d+\Z")
+
+
+class Usage(Exception):
+    pass
+
+
+class Failure(Exception):
+    pass
+
+
+def _number(flag, text, kind):
+    if kind is float:
+        if not _FLOAT.match(text):
+            raise Usage(f"option -{flag}: '{text}' is not a number")
+        return float(text)
+    if kind is int or kind == "u64":
+        if not _INT.match(text):
+            raise Usage(f"option -{flag}: '{text}' is not an integer")
+        v = int(text)
+        if kind == "u64" and not 0 <= v < 2 ** 64:
+            raise Usage(f"option -{flag}: '{text}' is out of range")
+        return v
+    if kind == "pair":
+        parts = text.split(",")
+        if len(parts) != 2:
+            raise Usage(f"option -{flag}: expected LOW,HIGH, got '{text}'")
+        low, high = (_number(flag, p, float) for p in parts)
+        if not (0.0 <= low <= 0.5 and 0.5 <= high <= 1.0):
+            raise Usage(f"option -{flag}: LOW must be in [0, 0.5] and HIGH in [0.5, 1], got '{text}'")
+        return (low, high)
+    return text
+
+
+def parse(argv):
+    """(positional, options for collide_poses, own options) or Usage."""
+    positional, options, own, seen = [], {}, {"scheduler": None, "timeout": 10.0, "chunk-size": None}, set()
+    i, only_positional = 0, False
+    while i < len(argv):
+        arg = argv[i]
+        i += 1
+        if only_positional or not arg.startswith("-") or arg == "-":
+            positional.append(arg)
+            continue
+        if arg == "--":
+            only_positional = True
+            continue
+        if arg in ("-h", "--help"):
+            raise SystemExit(print(USAGE, end="") or 0)
+        name, eq, value = arg.lstrip("-").partition("=")
+        if name in ("pose", "poses", "o"):
+            raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
+        if name in seen:
+            raise Usage(f"option -{name} given twice")
+        seen.add(name)
+        if name in _SWITCH:
+            if eq:
+                raise Usage(f"option -{name} takes no value")
+            if name not in ("json", "v"):
+                options[name] = True
+            continue
+        kind = _VALUE.get(name) or _OWN.get(name)
+        if kind is None:
+            raise Usage(f"unknown option '{arg}'")
+        if not eq:
+            if i >= len(argv):
+                raise Usage(f"option -{name} needs a value")
+            value = argv[i]
+            i += 1
+        v = _number(name, value, kind)
+        if name in _OWN:
+            own[name] = v
+        else:
+            options[name] = v
+    if len(positional) != 3:
+        raise Usage(f"expected <a> <b> <poses.txt>, got {len(positional)} argument(s)")
+    if own["scheduler"] is None:
+        raise Usage("--scheduler ADDRESS|local[:N] is required")
+    if "k" in options and options["k"] < 1:
+        raise Usage(f"option -k: must be >= 1, got {options['k']}")
+    for flag in ("sigma", "sigma_a", "sigma_b", "sigma_max"):
+        if flag in options and options[flag] < 0:
+            raise Usage(f"option -{flag}: must be >= 0, got {options[flag]}")
+    if "nmax" in options and options["nmax"] < 1:
+        raise Usage(f"option -nmax: must be >= 1, got {options['nmax']}")
+    return positional, options, own
+
+
+def read_poses(path):
+    """pcd_collision's -poses file: six numbers a line separated by blanks and/or one comma, '#'
+    comments, blank lines."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            lines = f.read().splitlines()
+    except OSError as e:
+        raise Failure(f"cannot read '{path}': {e.strerror}") from None
+    poses = []
+    for number, line in enumerate(lines, 1):
+        body = line.split("#", 1)[0]
+        tokens, current, commas, why = [], "", 0, None
+        for c in body:
+            if c == "," or c.isspace():
+                if current:
+                    tokens.append(current)
+                    current, commas = "", 0
+                if c == ",":
+                    commas += 1
+                    if commas > 1 or not tokens:
+                        why = "empty field between commas"
+                        break
+            else:
+                current += c
+        if why is None:
+            if current:
+                tokens.append(current)
+            elif commas:
+                why = "trailing comma"
+        if why is None and tokens and len(tokens) != 6:
+            why = f"expected 6 numbers (tx ty tz roll pitch yaw), got {len(tokens)}"
+        if why is None and tokens:
+            bad = [t for t in tokens if not _FLOAT.match(t)]
+            if bad:
+                why = f"'{bad[0]}' is not a number"
+        if why is not None:
+            raise Failure(f"{path}:{number}: {why}")
+        if tokens:
+            poses.append([float(t) for t in tokens])
+    if not poses:
+        raise Failure(f"{path}: no pose in the file")
+    return np.array(poses, dtype=np.float64)
+
+
+def _num(v):
+    v = float(v)
+    return "null" if not math.isfinite(v) else "%.10g" % v
+
+
+def _nums(vs):
+    return "[" + ",".join(_num(v) for v in vs) + "]"
+
+
+def _str(s):
+    return json.dumps(s, ensure_ascii=False)
+
+
+def _bool(b):
+    return "true" if b else "false"
+
+
+def _input_json(spec):
+    if spec["kind"] == "cloud":
+        return (f'{{"path":{_str(spec["path"])},"kind":"cloud","points":{len(spec["points"])},'
+                f'"finite":{spec["finite"]},"width":{spec["width"]},"height":{spec["height"]}}}')
+    return (f'{{"path":{_str(spec["path"])},"kind":"mesh","vertices":{len(spec["vertices"])},'
+            f'"triangles":{len(spec["triangles"])},"points":{len(spec["points"])},"spacing":{_num(spec["spacing"])},'
+            f'"spacing_source":{_str(spec["spacing_source"])}}}')
+
+
+_VERDICTS = {0: "unknown", 1: "free", 2: "contact", 3: "collision"}
+
+
+def json_lines(r, pose_rows, o, a, b):
+    """pcd_collision's resultJson() for every pose (docs/CLI.md)."""
+    from . import resolve_options, model_params, _N_MIN  # noqa: F401
+
+    o = resolve_options(o)
+    sensor = _str(o["sensor_a"]) if o["sensor_a"] == o["sensor_b"] else "null"
+    sensor_a = _str(o["sensor_a"]) if a["kind"] == "cloud" else "null"
+    sensor_b = _str(o["sensor_b"]) if b["kind"] == "cloud" else "null"
+    sigma_a = _num(o["sigma_a"]) if o["sensor_a"] == "isotropic" and a["kind"] == "cloud" else "null"
+    sigma_b = _num(o["sigma_b"]) if o["sensor_b"] == "isotropic" and b["kind"] == "cloud" else "null"
+    parameters = (f'{{"sensor":{sensor},"sensor_a":{sensor_a},"sensor_b":{sensor_b},"sigma_a":{sigma_a},'
+                  f'"sigma_b":{sigma_b},"k":{int(o["k"])},"thresholds":{_nums(o["thresholds"])},'
+                  f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
+                  f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
+                  f'"exhaustive":{_bool(o["exhaustive"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
+                  f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
+    inputs = f'{{"a":{_input_json(a)},"b":{_input_json(b)}}}'
+    sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
+    # The surface layer's keys, once the bindings expose them (issue #16).
+    has_surface = hasattr(core.CollisionResult(), "signed_distance")
+
+    def surface(i):
+        if not has_surface:
+            return ""
+        return f'"signed_distance":{_num(r.signed_distance[i])},"signed_distance_std":{_num(r.signed_distance_std[i])},'
+
+    for i in range(len(r)):
+        build = r.build_ms if i == 0 else 0.0
+        query = r.query_ms[i]
+        if r.witness_side[i] == 0:
+            witness = "null"
+        else:
+            witness = (f'{{"point":{_nums(r.witness_point[i])},"side":"{"a" if r.witness_side[i] > 0 else "b"}",'
+                       f'"index":{int(r.witness_index[i])},"normal":{_nums(r.witness_normal[i])}}}')
+        yield (f'{{"pose_index":{i},"pose":{_nums(pose_rows[i])},"verdict":"{_VERDICTS[int(r.verdict[i])]}",'
+               f'"probability":{_num(r.probability[i])},{surface(i)}"lower_bound":{_bool(r.lower_bound[i])},'
+               f'"no_leaf_tested":{_bool(r.no_leaf_tested[i])},"points_a":{int(r.points_a[i])},'
+               f'"points_b":{int(r.points_b[i])},"points_skipped_nonfinite":{int(r.points_skipped_nonfinite[i])},'
+               f'"leaf_pairs":{int(r.leaf_pairs_tested[i])},"bv_tests":{int(r.bv_tests[i])},'
+               f'"kernel_leaf_pairs":{int(r.kernel_leaf_pairs[i])},"degenerate_leaf_pairs":{int(r.degenerate_leaf_pairs[i])},'
+               f'"classifier_iterations":{int(r.classifier_iterations[i])},"build_ms":{_num(build)},'
+               f'"query_ms":{_num(query)},"witness":{witness},'
+               f'"timings_ms":{{"load_a":{_num(a["load_ms"])},"load_b":{_num(b["load_ms"])},'
+               f'"sample_meshes":{_num(sample_ms)},"build":{_num(build)},"query":{_num(query)}}},'
+               f'"inputs":{inputs},"parameters":{parameters}}}')
+
+
+def main(argv):
+    prog = "pcl_probcollision.dask"
+    client = None
+    try:
+        positional, options, own = parse(argv)
+        path_a, path_b, poses_path = positional
+        pose_rows = read_poses(poses_path)  # a malformed file fails before the (slow) loading
+        try:
+            a = prepare_input(path_a, "a")
+            b = prepare_input(path_b, "b")
+        except FileNotFoundError as e:
+            raise Failure(f"cannot read '{e.filename}': No such file or directory") from None
+        except ValueError as e:
+            raise Failure(str(e).removeprefix("path: ")) from None
+        t0 = time.perf_counter()
+        client = connect(own["scheduler"], timeout=own["timeout"])
+        print(f"Scheduler {own['scheduler']} [done, {(time.perf_counter() - t0) * 1e3:.1f} ms : "
+              f"{len(client.nthreads())} workers, {sum(client.nthreads().values())} threads]", file=sys.stderr)
+        try:
+            r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], **options)
+        except (TypeError, ValueError) as e:
+            raise Usage(str(e)) from None
+        bad = np.flatnonzero(r.status != 0)
+        if bad.size:
+            raise Failure(f"pose {bad[0]}: query failed")
+        out = sys.stdout
+        for line in json_lines(r, pose_rows, options, r.inputs[0], r.inputs[1]):
+            out.write(line + "\n")
+        out.flush()
+        return 0
+    except Usage as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
+        return 2
+    except (Failure, ConnectionError, OSError, ValueError, RuntimeError) as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
+        return 1
+    finally:
+        if client is not None:
+            cluster = getattr(client, "cluster", None)
+            client.close()
+            if cluster is not None:
+                cluster.close()

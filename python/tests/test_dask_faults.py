@@ -1,0 +1,76 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""pcl_probcollision.dask under a fault: one of two worker processes killed in the middle of a batch
+(issue #18). The batch completes, every pose is answered once and the answers are unchanged."""
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+
+from pcl_probcollision import dask as pcd
+
+from conftest import DATA
+from test_dask import FIELDS, near_table_poses
+
+POSES = 1200
+CHUNK = 25
+
+
+def _done_chunks(dask_scheduler=None):
+    return sum(1 for ts in dask_scheduler.tasks.values()
+               if ts.key.startswith("pcl_probcollision-") and ts.state in ("memory", "released", "forgotten"))
+
+
+def test_killing_a_worker_mid_batch_changes_no_answer(table_path):
+    from distributed import Client, LocalCluster
+
+    P = near_table_poses(POSES, seed=21)
+    gripper = DATA / "gripper.obj"
+    reference = pcd.collide_poses(gripper, table_path, P, client=None, sigma=0.0015, threads=0)
+    chunks = -(-POSES // CHUNK)
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        pids = client.run(os.getpid)
+        assert len(pids) == 2
+        out = {}
+
+        def batch():
+            try:
+                out["result"] = pcd.collide_poses(gripper, table_path, P, client=client, chunk_size=CHUNK,
+                                                  sigma=0.0015)
+            except BaseException as e:  # reported by the assertions below
+                out["error"] = e
+
+        worker = threading.Thread(target=batch)
+        worker.start()
+        # Wait until both workers are busy and a few chunks have been answered, then kill the
+        # process of a worker that is running a chunk.
+        deadline = time.monotonic() + 120
+        victim = None
+        while victim is None and time.monotonic() < deadline and worker.is_alive():
+            processing = {w: ks for w, ks in client.processing().items()
+                          if any(str(k).startswith("pcl_probcollision-") for k in ks)}
+            if len(processing) == 2 and client.run_on_scheduler(_done_chunks) >= 4:
+                victim = sorted(processing)[0]
+            else:
+                time.sleep(0.02)
+        assert victim is not None, "the batch never had both workers busy"
+        answered_before_kill = client.run_on_scheduler(_done_chunks)
+        os.kill(pids[victim], signal.SIGKILL)
+        assert worker.is_alive(), "the kill must land in the middle of the batch"
+        worker.join(timeout=240)
+        assert not worker.is_alive(), "the batch did not complete after the kill"
+
+        assert "error" not in out, repr(out.get("error"))
+        r = out["result"]
+        # The killed process is gone (its nanny may have started a new one under another pid).
+        assert pids[victim] not in client.run(os.getpid).values()
+        assert answered_before_kill < chunks
+
+    # Every pose answered once (collide_poses checks the indices are exactly 0..M-1), in pose order,
+    # and the answers are those of one process.
+    assert len(r) == POSES and r.chunks == chunks
+    for f in FIELDS:
+        np.testing.assert_array_equal(getattr(r, f), getattr(reference, f), err_msg=f)
