@@ -55,8 +55,8 @@ meshDiagonal (const TriangleMesh& mesh)
   return mesh.triangles.empty () ? 0.0 : (hi - lo).norm ();
 }
 
-pcl::PointCloud<pcl::PointXYZ>
-sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points)
+pcl::PointCloud<pcl::PointNormal>
+sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points)
 {
   if (!(spacing > 0.0) || !std::isfinite (spacing))
     throw std::runtime_error ("mesh sample spacing must be finite and > 0");
@@ -66,15 +66,38 @@ sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::s
                               std::to_string (static_cast<long long> (std::min (expected, 1e18))) +
                               " points (limit " + std::to_string (max_points) + "); raise -mesh_density");
 
-  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  // A vertex's normal: the area-weighted mean of its triangles' (an edge or corner gets the
+  // direction between its faces); a sample's: its triangle's. Taken as outward: the faces'
+  // winding is counter-clockwise seen from outside (OBJ, PLY, STL).
+  std::vector<Eigen::Vector3d> vertex_normal (mesh.vertices.size (), Eigen::Vector3d::Zero ());
+  for (const auto& t : mesh.triangles)
+  {
+    const Eigen::Vector3d a = vertex (mesh, t[0]);
+    const Eigen::Vector3d area_normal = 0.5 * (vertex (mesh, t[1]) - a).cross (vertex (mesh, t[2]) - a);
+    for (const int i : t)
+      vertex_normal[static_cast<std::size_t> (i)] += area_normal;
+  }
+  auto point = [] (const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+    pcl::PointNormal q;
+    q.x = static_cast<float> (p.x ());
+    q.y = static_cast<float> (p.y ());
+    q.z = static_cast<float> (p.z ());
+    const double norm = n.norm ();
+    const Eigen::Vector3d u = norm > 0.0 ? Eigen::Vector3d (n / norm) : Eigen::Vector3d::Zero ();
+    q.normal_x = static_cast<float> (u.x ());
+    q.normal_y = static_cast<float> (u.y ());
+    q.normal_z = static_cast<float> (u.z ());
+    q.curvature = 0.0f;
+    return q;
+  };
   std::vector<char> used (mesh.vertices.size (), 0);
   for (const auto& t : mesh.triangles)
     for (const int i : t)
       used[static_cast<std::size_t> (i)] = 1;
   for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
     if (used[i])
-      cloud.push_back (pcl::PointXYZ (static_cast<float> (mesh.vertices[i][0]), static_cast<float> (mesh.vertices[i][1]),
-                                      static_cast<float> (mesh.vertices[i][2])));
+      cloud.push_back (point (vertex (mesh, static_cast<int> (i)), vertex_normal[i]));
 
   std::mt19937_64 rng (seed);
   for (const auto& t : mesh.triangles)
@@ -82,17 +105,32 @@ sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::s
     const double n_expected = triangleArea (mesh, t) / (spacing * spacing);
     const auto n = static_cast<std::size_t> (std::floor (n_expected + pcl_probcollision::detail::uniformUnit (rng)));
     const Eigen::Vector3d a = vertex (mesh, t[0]), b = vertex (mesh, t[1]), c = vertex (mesh, t[2]);
+    const Eigen::Vector3d face_normal = (b - a).cross (c - a);
     for (std::size_t s = 0; s < n; ++s)
     {
       const double r1 = std::sqrt (pcl_probcollision::detail::uniformUnit (rng));
       const double r2 = pcl_probcollision::detail::uniformUnit (rng);
       const Eigen::Vector3d p = (1.0 - r1) * a + r1 * (1.0 - r2) * b + r1 * r2 * c;
-      cloud.push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
+      cloud.push_back (point (p, face_normal));
     }
   }
   cloud.width = static_cast<std::uint32_t> (cloud.size ());
   cloud.height = 1;
   cloud.is_dense = true;
+  return cloud;
+}
+
+pcl::PointCloud<pcl::PointXYZ>
+sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points)
+{
+  const pcl::PointCloud<pcl::PointNormal> oriented = sampleMeshWithNormals (mesh, spacing, seed, max_points);
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  cloud.resize (oriented.size ());
+  for (std::size_t i = 0; i < oriented.size (); ++i)
+    cloud[i].getVector3fMap () = oriented[i].getVector3fMap ();
+  cloud.width = oriented.width;
+  cloud.height = oriented.height;
+  cloud.is_dense = oriented.is_dense;
   return cloud;
 }
 

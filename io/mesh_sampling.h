@@ -22,6 +22,12 @@ namespace pcl_probcollision::io
 pcl::PointCloud<pcl::PointXYZ> sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed,
                                            std::size_t max_points = 20000000);
 
+/** \brief sampleMesh's points (the same, for the same arguments) with outward normals: a
+  * sample's is its triangle's, a vertex's the area-weighted mean of its triangles' (faces
+  * wound counter-clockwise seen from outside). CloudModelParams' Auto orientation takes them. */
+pcl::PointCloud<pcl::PointNormal> sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t seed,
+                                                         std::size_t max_points = 20000000);
+
 /** \brief Total triangle area. */
 double meshArea (const TriangleMesh& mesh);
 

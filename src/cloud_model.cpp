@@ -3,9 +3,12 @@
 #include <pcl_probcollision/impl/cloud_model.hpp>
 
 #include <pcl/exceptions.h>
+#include <pcl/point_types.h>
 #include <pcl/impl/instantiate.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <memory>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -25,9 +28,36 @@ CloudModel::CloudModel (UncertainCloud points, const BVHParams& hierarchy, std::
 {
   if (points.empty ())
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CloudModel] no point given");
+  const auto start = std::chrono::steady_clock::now ();
   params_.hierarchy = hierarchy;
   buildLocal (std::move (points), hierarchy, source_size);
-  build_ms_ = bvh_.buildMilliseconds ();
+  if (params_.surface)
+    buildSurfaceFromPoints (params_.orientation, params_.k);
+  build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+}
+
+void
+CloudModel::buildSurfaceFromPoints (NormalOrientation orientation, int k)
+{
+  // The local means as a float cloud (centred, so float loses nothing that matters here).
+  const auto& means = bvh_.means ();
+  const auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>> ();
+  cloud->resize (means.size ());
+  for (std::size_t i = 0; i < means.size (); ++i)
+    (*cloud)[i].getVector3fMap () = means[i].cast<float> ();
+  CovarianceEstimation<pcl::PointXYZ> estimation;
+  estimation.setInputCloud (cloud);
+  estimation.setKSearch (k);
+  estimation.setSurfaceProjection (false);
+  estimation.setComputeSurface (true);
+  pcl::PointCloud<Covariance> unused;
+  estimation.compute (unused);
+  SurfaceModel::Inputs in;
+  in.k = k;
+  in.normals = estimation.getNormals ();
+  in.radii = estimation.getNeighbourRadii ();
+  in.neighbours = estimation.getNeighbours ();
+  surface_.build (bvh_, std::move (in), orientation);
 }
 
 void

@@ -5,6 +5,7 @@
 #include <pcl_probcollision/detail/input_checks.h>
 
 #include "leaf_pair_test.h"
+#include "surface_test.h"
 
 #include <pcl/exceptions.h>
 
@@ -87,6 +88,49 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
   result.verdict = verdictFor (result.probability, request);
   return true;
 }
+/** \brief The surface layer (request.surface): each object's points against the other's
+  * oriented surface (surface_test.h). Witness in A's local frame, per-point values in hierarchy
+  * order. */
+bool
+collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b,
+                const CollisionRequest& request, CollisionResult& result)
+{
+  result.points_a = a.size ();
+  result.points_b = b.size ();
+  if (request.per_point)
+  {
+    result.probabilities_a.assign (a.size (), kNotReached);
+    result.probabilities_b.assign (b.size (), kNotReached);
+  }
+  detail::SurfaceAnswer s;
+  try
+  {
+    s = detail::surfaceTest (a, b, T_a_b, request, request.per_point ? &result.probabilities_a : nullptr,
+                             request.per_point ? &result.probabilities_b : nullptr);
+  }
+  catch (const pcl::PCLException& e)
+  {
+    fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
+    return false;
+  }
+  result.status = CollisionResult::Status::Ok;
+  result.probability = s.probability;
+  result.signed_distance = s.signed_distance;
+  result.signed_distance_std = s.signed_distance_std;
+  result.no_leaf_tested = !s.reached;
+  result.lower_bound = s.stopped_early;
+  result.leaf_pairs_tested = s.leaf_pairs;
+  result.bv_tests = s.bv_tests;
+  result.witness_side = s.witness_side;
+  if (s.witness_side != 0)
+  {
+    result.witness_index = (s.witness_side > 0 ? a : b).hierarchy ().sourceIndex (s.witness_index);
+    result.witness_point = s.witness_point;
+    result.witness_normal = s.witness_normal;
+  }
+  result.verdict = verdictFor (result.probability, request);
+  return true;
+}
 } // namespace
 
 Verdict
@@ -127,7 +171,11 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   // to A's local frame by T_local = Translate (-o_a) T_a_b Translate (o_b), composed in double.
   Eigen::Isometry3d T_local = T_a_b;
   T_local.translation () = (T_a_b.linear () * b.origin () + T_a_b.translation ()) - a.origin ();
-  if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
+  // The surface layer answers when both models carry a surface; otherwise (or with
+  // request.surface off) the separators do, as in the paper.
+  const bool surface = request.surface && !a.surface ().empty () && !b.surface ().empty ();
+  if (surface ? !collideSurface (a, b, T_local, request, result)
+              : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
     return false;
 
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.

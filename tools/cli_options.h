@@ -40,6 +40,7 @@ struct Defaults
   static inline const std::uint64_t seed = request.seed;
   static inline const bool stochastic = request.traversal == pcl_probcollision::TraversalMode::Stochastic;
   static inline const bool exhaustive = request.exhaustive;
+  static inline const bool surface = request.surface;
   static inline const bool measured = !model.surface_projection;
   static inline const int n_max = model.hierarchy.n_max;
   static inline const int n_min = model.hierarchy.n_min;
@@ -85,6 +86,7 @@ struct Options
   /** \brief -measured: surface projection off (CloudModelParams::surface_projection). */
   bool measured = Defaults::measured;
   bool exhaustive = Defaults::exhaustive;
+  bool surface = Defaults::surface;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

@@ -40,6 +40,7 @@ using pcl_probcollision::io::loadTriangleMesh;
 using pcl_probcollision::io::meshDiagonal;
 using pcl_probcollision::io::medianSpacing;
 using pcl_probcollision::io::sampleMesh;
+using pcl_probcollision::io::sampleMeshWithNormals;
 using pcl_probcollision::io::setVtkMessages;
 using pcl_probcollision::io::TriangleMesh;
 
@@ -72,6 +73,8 @@ struct Input
   InputKind kind = InputKind::Unsupported;
   Cloud::Ptr cloud = pcl::make_shared<Cloud> ();  ///< loaded, or sampled from the mesh
   TriangleMesh mesh;
+  /** \brief A mesh's samples with its faces' outward normals (the surface model's orientation). */
+  pcl::PointCloud<pcl::PointNormal>::Ptr oriented;
   std::size_t finite = 0;
   double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
   std::string spacing_source;
@@ -142,7 +145,11 @@ sampleInput (Input& in, double spacing, const std::string& source, FILE* log)
                                        " is 0); give -mesh_density"};
   try
   {
-    *in.cloud = sampleMesh (in.mesh, spacing, Defaults::mesh_sampling_seed);
+    in.oriented = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>> (
+        sampleMeshWithNormals (in.mesh, spacing, Defaults::mesh_sampling_seed));
+    in.cloud->resize (in.oriented->size ());
+    for (std::size_t i = 0; i < in.oriented->size (); ++i)
+      (*in.cloud)[i].getVector3fMap () = (*in.oriented)[i].getVector3fMap ();
   }
   catch (const std::runtime_error& e)
   {
@@ -205,6 +212,7 @@ requestFor (const Options& o)
   r.free_below = o.free_below;
   r.collision_above = o.collision_above;
   r.exhaustive = o.exhaustive || o.output.has_value ();
+  r.surface = o.surface;
   r.per_point = o.output.has_value ();
   r.enable_timings = true;
   r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
@@ -220,6 +228,7 @@ modelParamsFor (const Options& o)
   pcl_probcollision::CloudModelParams m;
   m.k = o.k;
   m.surface_projection = !o.measured;
+  m.surface = o.surface;
   m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
                                                 : pcl_probcollision::BVHParams::SplitStyle::Pca;
   m.hierarchy.n_max = o.n_max;
@@ -267,6 +276,8 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("pose").numbers ({pose[0], pose[1], pose[2], pose[3], pose[4], pose[5]});
   j.key ("verdict").string (pcl_probcollision::verdictName (r.verdict));
   j.key ("probability").number (r.probability);
+  j.key ("signed_distance").number (r.signed_distance);
+  j.key ("signed_distance_std").number (r.signed_distance_std);
   j.key ("lower_bound").boolean (r.lower_bound);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
   j.key ("points_a").unsignedInteger (r.points_a);
@@ -324,6 +335,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("positions").string (o.measured ? "measured" : "projected");
   j.key ("seed").unsignedInteger (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
+  j.key ("surface").boolean (rq.surface);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);
@@ -347,11 +359,15 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
 {
   char buf[512];
   const std::string prefix = pose_index >= 0 ? "pose " + std::to_string (pose_index) + ": " : std::string ();
+  // The signed distance, when the surface layer computed one (NaN is never printed).
+  char distance[96] = "";
+  if (std::isfinite (r.signed_distance))
+    std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f", r.signed_distance, r.signed_distance_std);
   std::snprintf (buf, sizeof (buf),
-                 "%s%-9s P %s %.6f   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "%s%-9s P %s %.6f%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
                  "query %.1f ms]",
                  prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
-                 r.probability, r.points_a, r.points_b, r.points_skipped_nonfinite, r.leaf_pairs_tested,
+                 r.probability, distance, r.points_a, r.points_b, r.points_skipped_nonfinite, r.leaf_pairs_tested,
                  std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
   return buf;
 }
@@ -524,12 +540,18 @@ run (int argc, char** argv)
   pc.setTargetCloud (b.cloud);
   pc.setInputModelParams (modelParamsFor (o));
   pc.setTargetModelParams (modelParamsFor (o));
+  // A mesh is exact (zero covariance) and oriented by its faces: its model is built here from
+  // the samples with their normals.
+  auto meshModel = [&] (const Input& in) {
+    const pcl::PointCloud<pcl_probcollision::Covariance> exact (in.oriented->width, in.oriented->height);
+    return pcl_probcollision::buildCloudModel (*in.oriented, modelParamsFor (o), nullptr, &exact, in.path);
+  };
   if (a.kind == InputKind::Mesh)
-    pc.setInputCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (a.cloud->width, a.cloud->height));
+    pc.setInputModel (meshModel (a));
   else
     pc.setInputNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_a, o.sigma_a));
   if (b.kind == InputKind::Mesh)
-    pc.setTargetCovariances (pcl::make_shared<pcl::PointCloud<pcl_probcollision::Covariance>> (b.cloud->width, b.cloud->height));
+    pc.setTargetModel (meshModel (b));
   else
     pc.setTargetNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
   pc.setRequest (requestFor (o));

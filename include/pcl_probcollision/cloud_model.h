@@ -4,6 +4,7 @@
 #include <pcl_probcollision/cloud_model_params.h>
 #include <pcl_probcollision/point_types.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/surface_model.h>
 #include <pcl_probcollision/uncertain_points.h>
 
 #include <pcl/point_cloud.h>
@@ -89,8 +90,11 @@ public:
   const CloudModelParams& params () const { return params_; }
   /** \brief Wall time of the build in milliseconds: covariance estimation and hierarchy. */
   double buildMilliseconds () const { return build_ms_; }
-  /** \brief Memory held in bytes (the hierarchy and its points). */
-  std::size_t bytes () const { return bvh_.bytes (); }
+  /** \brief The oriented surface (METHOD.md 10a), in the local frame; empty() when built
+    * with CloudModelParams::surface off. */
+  const SurfaceModel& surface () const { return surface_; }
+  /** \brief Memory held in bytes (the hierarchy, its points and the surface model). */
+  std::size_t bytes () const { return bvh_.bytes () + surface_.bytes (); }
   /** \brief A warning about the input, empty when there is none: today, coordinates so far
     * from the origin that their float spacing exceeds a tenth of the points' typical standard
     * deviation (the input itself has then lost precision; the model cannot restore it).
@@ -118,7 +122,12 @@ private:
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
   void assessPrecision (double max_abs_coordinate, const std::string& name);
 
+  /** \brief Builds the surface model from the local points alone (the constructor from an
+    * UncertainCloud): normals and neighbours estimated here, Propagate orientation unless
+    * Auto finds nothing else. */
+  void buildSurfaceFromPoints (NormalOrientation orientation, int k);
   ProbabilisticBVH bvh_;
+  SurfaceModel surface_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero ();
   std::size_t source_size_ = 0;
   std::size_t skipped_ = 0;

@@ -17,6 +17,29 @@ namespace pcl_probcollision
   * defaults to isotropic 5 mm instead because its inputs are files of unknown origin, mostly
   * scans, where assuming no noise would make near-contact answers overconfident (docs/CLI.md).
   */
+/** \brief Where the surface model's normals get their orientation (which side is outside). */
+enum class NormalOrientation
+{
+  /** \brief Default: the point type's normals when it has finite ones (meshes: the faces'),
+    * else the viewpoint when the cloud's sensor_origin_ lies outside its bounding box (a scan),
+    * else propagation. */
+  Auto,
+  /** \brief The normals the points carry (PointNormal and the other *Normal types), taken as
+    * outward; points without a finite one are oriented by propagation from their neighbours. */
+  PointNormals,
+  /** \brief Toward the sensor origin (sensor_origin_): a scan sees the outside of what it
+    * scans. Trusted only where the surface faces the sensor (|cos| >= 0.2); grazing points take
+    * their orientation from their neighbours. */
+  Viewpoint,
+  /** \brief Propagated over the neighbour graph (Hoppe et al. 1992) from the point farthest
+    * from the centroid, pointing away from it; then each connected part is flipped if needed so
+    * that its enclosed volume (divergence theorem) is positive: for closed objects. */
+  Propagate
+};
+
+/** \brief "auto", "point_normals", "viewpoint" or "propagate". */
+const char* orientationName (NormalOrientation orientation);
+
 struct CloudModelParams
 {
   /** \brief Neighbours of the covariance estimation (Pauly et al.), >= 1. Default 10. */
@@ -29,6 +52,13 @@ struct CloudModelParams
     * whose maximum over many points near contact drifts toward 1. No effect without a noise
     * model or with covariances given by the caller. */
   bool surface_projection = true;
+  /** \brief Build the surface model (METHOD.md 10a: oriented normals, local spacing, the
+    * winding-number dipoles) that CollisionRequest::surface queries. Default off, as the
+    * surface layer is (experimental, issue #16); it costs a normal fit and an orientation pass
+    * per point at build time. */
+  bool surface = false;
+  /** \brief How the surface's normals are oriented. Default Auto. */
+  NormalOrientation orientation = NormalOrientation::Auto;
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
 

@@ -102,6 +102,19 @@ public:
     * a displacement so that points far from the origin keep their double precision. */
   const std::vector<Eigen::Vector3d>& getSurfaceDisplacements () const { return displacements_; }
 
+  /** \brief Also record, for the surface model (CloudModel), each point's unoriented normal
+    * and its neighbours (default off: costs one eigen solve a point and k indices a point). */
+  void setComputeSurface (bool compute) { compute_surface_ = compute; }
+  bool getComputeSurface () const { return compute_surface_; }
+  /** \brief After compute() with setComputeSurface(true): the unit normal of the plane fitted
+    * to each output point's neighbours (the weakest direction of its discretisation spread),
+    * unoriented; zero where it is undetermined (fewer than two neighbours, all coincident),
+    * NaN for non-finite points. Empty otherwise. */
+  const std::vector<Eigen::Vector3f>& getNormals () const { return normals_; }
+  /** \brief After compute() with setComputeSurface(true): getKSearch() input-cloud indices per
+    * output point (row-major, -1 where fewer neighbours exist), the point itself excluded. */
+  const std::vector<int>& getNeighbours () const { return neighbours_; }
+
 protected:
   bool initCompute () override;
   void computeFeature (PointCloudOut& output) override;
@@ -122,6 +135,9 @@ private:
   std::vector<float> radii_;
   bool project_ = true;  // CloudModelParams::surface_projection; test_cloud_model checks they agree
   std::vector<Eigen::Vector3d> displacements_;
+  bool compute_surface_ = false;
+  std::vector<Eigen::Vector3f> normals_;
+  std::vector<int> neighbours_;
 };
 } // namespace pcl_probcollision
 

@@ -6,6 +6,7 @@
 #include <pcl_probcollision/detail/input_checks.h>
 
 #include <pcl/common/point_tests.h>
+#include <pcl/point_types.h>
 #include <pcl/console/print.h>
 #include <pcl/exceptions.h>
 
@@ -67,19 +68,31 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   pcl::PointCloud<Covariance> estimated;
   std::vector<float> radii;
   std::vector<Eigen::Vector3d> displacements;
-  if (!covariances)
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<int> neighbours;
+  if (!covariances || params.surface)
   {
+    // With covariances given, the estimation runs for the surface model alone (its normals,
+    // radii and neighbours), without noise or projection.
     const typename pcl::PointCloud<PointT>::ConstPtr view (&cloud, [] (const pcl::PointCloud<PointT>*) {});
     CovarianceEstimation<PointT> estimation;
     estimation.setInputCloud (view);
     if (indices)
       estimation.setIndices (pcl::IndicesConstPtr (indices, [] (const pcl::Indices*) {}));
     estimation.setKSearch (params.k);
-    estimation.setSensorNoise (params.noise);
-    estimation.setSurfaceProjection (params.surface_projection);
+    if (!covariances)
+    {
+      estimation.setSensorNoise (params.noise);
+      estimation.setSurfaceProjection (params.surface_projection);
+    }
+    else
+      estimation.setSurfaceProjection (false);
+    estimation.setComputeSurface (params.surface);
     estimation.compute (estimated);
     radii = estimation.getNeighbourRadii ();
     displacements = estimation.getSurfaceDisplacements ();
+    normals = estimation.getNormals ();
+    neighbours = estimation.getNeighbours ();
   }
 
   UncertainCloud points;
@@ -87,8 +100,9 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   points.means.reserve (n);
   points.covariances.reserve (n);
   points.source_indices.reserve (n);
-  if (!radii.empty ())
+  if (!radii.empty () && !covariances)
     points.area_weights.reserve (n);
+  std::vector<std::size_t> kept_slots;  // estimation slot of each model point (surface model)
   for (std::size_t j = 0; j < n; ++j)
   {
     const int i = at (j);
@@ -104,8 +118,10 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       points.means.back () += displacements[j];
     points.covariances.push_back (c.matrix ());
     points.source_indices.push_back (i);
-    if (!radii.empty ())
+    if (!radii.empty () && !covariances)
       points.area_weights.push_back (static_cast<double> (radii[j]) * radii[j]);
+    if (params.surface)
+      kept_slots.push_back (j);
   }
   if (points.empty ())
   {
@@ -115,6 +131,50 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
 
   std::shared_ptr<CloudModel> model (new CloudModel);
   model->buildLocal (std::move (points), params.hierarchy, cloud.size ());
+  if (params.surface)
+  {
+    // The surface model's inputs, re-indexed from estimation slots / cloud indices to model
+    // points.
+    SurfaceModel::Inputs in;
+    const std::size_t m = kept_slots.size ();
+    const std::size_t k = static_cast<std::size_t> (params.k);
+    std::vector<int> model_of (cloud.size (), -1);
+    for (std::size_t p = 0; p < m; ++p)
+      model_of[static_cast<std::size_t> (at (kept_slots[p]))] = static_cast<int> (p);
+    in.k = params.k;
+    in.normals.resize (m);
+    in.radii.resize (m);
+    in.neighbours.assign (m * k, -1);
+    for (std::size_t p = 0; p < m; ++p)
+    {
+      const std::size_t j = kept_slots[p];
+      in.normals[p] = normals[j];
+      in.radii[p] = radii[j];
+      for (std::size_t q = 0; q < k; ++q)
+      {
+        const int c = neighbours[j * k + q];
+        in.neighbours[p * k + q] = c >= 0 ? model_of[static_cast<std::size_t> (c)] : -1;
+      }
+    }
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+    {
+      in.given.assign (m, 0);
+      for (std::size_t p = 0; p < m; ++p)
+      {
+        const PointT& pt = cloud[at (kept_slots[p])];
+        const Eigen::Vector3f given (pt.normal_x, pt.normal_y, pt.normal_z);
+        if (given.allFinite () && given.squaredNorm () > 0.0f)
+        {
+          in.normals[p] = given;
+          in.given[p] = 1;
+        }
+      }
+    }
+    const Eigen::Vector3d view = cloud.sensor_origin_.template head<3> ().template cast<double> ();
+    if (view.allFinite ())
+      in.viewpoint = view - model->origin_;
+    model->surface_.build (model->bvh_, std::move (in), params.orientation);
+  }
   model->params_ = params;
   model->skipped_ = skipped;
   model->assessPrecision (max_abs, name);

@@ -391,6 +391,13 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
     finite_surface += pcl::isXYZFinite (p) ? 1 : 0;
 
   radii_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
+  normals_.clear ();
+  neighbours_.clear ();
+  if (compute_surface_)
+  {
+    normals_.assign (indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
+    neighbours_.assign (indices.size () * static_cast<std::size_t> (this->k_), -1);
+  }
   if (project_)
     displacements_.assign (indices.size (), Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
   // Ask one more than k: the query itself comes back when it is part of the surface.
@@ -442,6 +449,9 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
       r = std::max (r, std::sqrt (static_cast<double> (row_sqr_dists[j])));
     }
     radii_[out] = static_cast<float> (r);
+    if (compute_surface_)
+      std::copy (nn_indices.begin (), nn_indices.begin () + static_cast<std::ptrdiff_t> (kept),
+                 neighbours_.begin () + static_cast<std::ptrdiff_t> (out * static_cast<std::size_t> (this->k_)));
 
     Eigen::Matrix3d psi = Eigen::Matrix3d::Zero ();
     // Weighted mean offset of the neighbours and their effective number (surface projection).
@@ -470,6 +480,14 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
       }
     }
 
+    if (compute_surface_)
+    {
+      Eigen::Vector3d n = Eigen::Vector3d::Zero ();
+      double lambda0 = 0.0;
+      if (kept >= 2 && psi.trace () > 0.0)
+        detail::smallestEigenpair (psi, lambda0, n);
+      normals_[out] = n.cast<float> ();
+    }
     Eigen::Matrix3d total = use_discretization_ ? psi : Eigen::Matrix3d::Zero ();
     if (noise_.type () != SensorNoiseModel::Type::None)
     {

@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/cloud_model_params.h>
+#include <pcl_probcollision/probabilistic_bvh.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace pcl_probcollision
+{
+/** \brief The oriented surface of one cloud (METHOD.md 10a): a unit outward normal and a local
+  * sample spacing per point, and one dipole per hierarchy node for the winding number.
+  *
+  * Part of a CloudModel, built with it in its local frame over its hierarchy's points (index i
+  * = point i of the hierarchy). The query (CollisionRequest::surface) reads it to tell on which
+  * side of the other object's surface each point lies: near contact from a local implicit
+  * surface of the nearest samples' oriented planes, far from it from the winding number.
+  *
+  * Spacing: s_i = r_i sqrt(pi / k), r_i the distance to the k-th neighbour, is the side of the
+  * square each sample stands for on a uniformly sampled surface (k samples in pi r_i^2); its
+  * area a_i = s_i^2 weights the winding number.
+  */
+class SurfaceModel
+{
+public:
+  /** \brief What build() takes, index-aligned with the hierarchy's points. */
+  struct Inputs
+  {
+    /** \brief Unit normals: unoriented from the neighbours' plane, or the point type's own
+      * (given[i] set); zero where undetermined. */
+    std::vector<Eigen::Vector3f> normals;
+    /** \brief Per point: the normal is the caller's (PointNormal types), already outward. */
+    std::vector<std::uint8_t> given;
+    /** \brief Distance of each point to its k-th neighbour. */
+    std::vector<float> radii;
+    /** \brief k neighbours per point (row-major, point indices, -1 where fewer). */
+    std::vector<int> neighbours;
+    /** \brief Neighbours per point in radii and neighbours (>= 1). */
+    int k = 0;
+    /** \brief The sensor origin in the local frame, when the cloud has one. */
+    std::optional<Eigen::Vector3d> viewpoint;
+  };
+
+  /** \brief One node's dipole: the area-weighted centre of its points, the sum of their
+    * area-weighted normals and the largest distance of a point from the centre. */
+  struct Dipole
+  {
+    Eigen::Vector3d center = Eigen::Vector3d::Zero ();
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero ();
+    double area = 0.0;
+    double radius = 0.0;
+  };
+
+  SurfaceModel () = default;
+
+  /** \brief Orients the normals (mode; Auto resolved as NormalOrientation documents) and sums
+    * the dipoles over bvh's nodes. bvh must hold the points the inputs describe.
+    * \throws pcl::BadArgumentException when the inputs' sizes disagree with bvh. */
+  void build (const ProbabilisticBVH& bvh, Inputs&& inputs, NormalOrientation mode);
+
+  /** \brief True before build(). */
+  bool empty () const { return normals_.empty (); }
+  /** \brief Unit outward normal of each point, in the local frame; zero where undetermined. */
+  const std::vector<Eigen::Vector3f>& normals () const { return normals_; }
+  /** \brief Local sample spacing s_i of each point (data units). */
+  const std::vector<float>& spacing () const { return spacing_; }
+  /** \brief Median of spacing(): the cloud's typical sample spacing. */
+  double medianSpacing () const { return median_spacing_; }
+  /** \brief The orientation used (never Auto). */
+  NormalOrientation orientation () const { return orientation_; }
+  /** \brief Points without a normal (too few distinct neighbours): they bound nothing. */
+  std::size_t unorientedPoints () const { return unoriented_; }
+  /** \brief Points whose orientation came from propagation alone in Viewpoint mode (grazing
+    * or out of the sensor's sight) or from a given normal's neighbours in PointNormals mode. */
+  std::size_t propagatedPoints () const { return propagated_; }
+  /** \brief Per hierarchy node, its dipole. */
+  const std::vector<Dipole>& dipoles () const { return dipoles_; }
+
+  /** \brief Generalised winding number of the oriented samples at q (local frame): about 1
+    * inside a closed surface, 0 outside, +-1/2 on either side of an open sheet (Barill et al.
+    * 2018, point version: each sample a disc of area a_i; nodes farther than twice their radius
+    * are taken as one dipole).
+    * \param[in] bvh the hierarchy this model was built over */
+  double windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d& q) const;
+
+  /** \brief Memory held in bytes. */
+  std::size_t bytes () const;
+
+private:
+  std::vector<Eigen::Vector3f> normals_;
+  std::vector<float> spacing_;
+  /** \brief Each point's owner leaf (the first leaf holding it): a point counts once. */
+  std::vector<std::int32_t> owner_;
+  std::vector<Dipole> dipoles_;
+  double median_spacing_ = 0.0;
+  NormalOrientation orientation_ = NormalOrientation::Auto;
+  std::size_t unoriented_ = 0;
+  std::size_t propagated_ = 0;
+};
+} // namespace pcl_probcollision

@@ -1,0 +1,383 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include <pcl_probcollision/surface_model.h>
+
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <tuple>
+
+namespace pcl_probcollision
+{
+const char*
+orientationName (NormalOrientation orientation)
+{
+  switch (orientation)
+  {
+    case NormalOrientation::Auto: return "auto";
+    case NormalOrientation::PointNormals: return "point_normals";
+    case NormalOrientation::Viewpoint: return "viewpoint";
+    case NormalOrientation::Propagate: return "propagate";
+  }
+  return "unknown";
+}
+
+namespace
+{
+constexpr double kPi = 3.14159265358979323846;
+/** \brief A viewpoint orients a point only where the surface faces it at least this much
+  * (|cos| of the angle between normal and line of sight): at grazing angles the fitted normal's
+  * own error can flip the side. */
+constexpr double kMinViewCosine = 0.2;
+
+/** \brief Symmetric neighbour graph in compressed rows: the k-nearest-neighbour relation is
+  * not symmetric, and propagation must be able to cross an edge from either end. */
+struct Graph
+{
+  std::vector<int> offsets, targets;
+};
+
+Graph
+symmetricGraph (const std::vector<int>& neighbours, int k, std::size_t n)
+{
+  std::vector<int> degree (n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int j = 0; j < k; ++j)
+    {
+      const int t = neighbours[i * static_cast<std::size_t> (k) + static_cast<std::size_t> (j)];
+      if (t < 0 || static_cast<std::size_t> (t) == i)
+        continue;
+      ++degree[i];
+      ++degree[static_cast<std::size_t> (t)];
+    }
+  Graph g;
+  g.offsets.assign (n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    g.offsets[i + 1] = g.offsets[i] + degree[i];
+  g.targets.resize (static_cast<std::size_t> (g.offsets[n]));
+  std::vector<int> fill (g.offsets.begin (), g.offsets.end () - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int j = 0; j < k; ++j)
+    {
+      const int t = neighbours[i * static_cast<std::size_t> (k) + static_cast<std::size_t> (j)];
+      if (t < 0 || static_cast<std::size_t> (t) == i)
+        continue;
+      g.targets[static_cast<std::size_t> (fill[i]++)] = t;
+      g.targets[static_cast<std::size_t> (fill[static_cast<std::size_t> (t)]++)] = static_cast<int> (i);
+    }
+  return g;
+}
+
+/** \brief Orientation by propagation (Hoppe et al. 1992): from the oriented points, repeatedly
+  * orient the unvisited neighbour whose normal is most nearly parallel to an oriented one's
+  * (a maximum spanning tree on |n_i . n_j|), so that flips happen across flat regions, not
+  * across creases. Marks every point it reaches with the component id. */
+class Propagation
+{
+public:
+  Propagation (const Graph& graph, std::vector<Eigen::Vector3f>& normals, std::vector<int>& component)
+    : graph_ (graph), normals_ (normals), component_ (component) {}
+
+  void
+  seed (int i)
+  {
+    pushEdges (i);
+  }
+
+  void
+  run ()
+  {
+    while (!queue_.empty ())
+    {
+      const auto [weight, from, to] = queue_.top ();
+      queue_.pop ();
+      (void) weight;
+      if (component_[static_cast<std::size_t> (to)] >= 0)
+        continue;
+      Eigen::Vector3f& n = normals_[static_cast<std::size_t> (to)];
+      if (n.dot (normals_[static_cast<std::size_t> (from)]) < 0.0f)
+        n = -n;
+      component_[static_cast<std::size_t> (to)] = component_[static_cast<std::size_t> (from)];
+      pushEdges (to);
+    }
+  }
+
+private:
+  void
+  pushEdges (int i)
+  {
+    const Eigen::Vector3f& n = normals_[static_cast<std::size_t> (i)];
+    for (int e = graph_.offsets[static_cast<std::size_t> (i)]; e < graph_.offsets[static_cast<std::size_t> (i) + 1]; ++e)
+    {
+      const int t = graph_.targets[static_cast<std::size_t> (e)];
+      if (component_[static_cast<std::size_t> (t)] >= 0 || normals_[static_cast<std::size_t> (t)].isZero ())
+        continue;
+      queue_.emplace (std::abs (n.dot (normals_[static_cast<std::size_t> (t)])), i, t);
+    }
+  }
+
+  const Graph& graph_;
+  std::vector<Eigen::Vector3f>& normals_;
+  std::vector<int>& component_;
+  std::priority_queue<std::tuple<float, int, int>> queue_;
+};
+} // namespace
+
+void
+SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation mode)
+{
+  const std::size_t n = bvh.size ();
+  if (in.normals.size () != n || in.radii.size () != n || in.k < 1 ||
+      in.neighbours.size () != n * static_cast<std::size_t> (in.k) || (!in.given.empty () && in.given.size () != n))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::SurfaceModel::build] inputs of " << in.normals.size () << " normals, "
+                                                                               << in.radii.size () << " radii and "
+                                                                               << in.neighbours.size ()
+                                                                               << " neighbours for " << n << " points");
+  const std::vector<Eigen::Vector3d>& points = bvh.means ();
+  normals_ = std::move (in.normals);
+  for (Eigen::Vector3f& v : normals_)
+  {
+    const float norm = v.norm ();
+    v = norm > 0.0f && std::isfinite (norm) ? Eigen::Vector3f (v / norm) : Eigen::Vector3f::Zero ();
+  }
+  spacing_.resize (n);
+  const double scale = std::sqrt (kPi / in.k);
+  for (std::size_t i = 0; i < n; ++i)
+    spacing_[i] = std::isfinite (in.radii[i]) ? static_cast<float> (in.radii[i] * scale) : 0.0f;
+  {
+    std::vector<float> sorted (spacing_);
+    std::nth_element (sorted.begin (), sorted.begin () + static_cast<std::ptrdiff_t> (n / 2), sorted.end ());
+    median_spacing_ = n ? sorted[n / 2] : 0.0;
+  }
+
+  // Resolve Auto: the caller's normals, else a viewpoint outside the cloud (a scan), else
+  // propagation.
+  bool any_given = false;
+  for (std::size_t i = 0; i < in.given.size () && !any_given; ++i)
+    any_given = in.given[i] && !normals_[i].isZero ();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ()), hi = -lo;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
+  for (const Eigen::Vector3d& p : points)
+  {
+    lo = lo.cwiseMin (p);
+    hi = hi.cwiseMax (p);
+    centroid += p;
+  }
+  centroid /= std::max<std::size_t> (n, 1);
+  const bool view_outside = in.viewpoint && in.viewpoint->allFinite () &&
+                            ((in.viewpoint->array () < lo.array ()).any () || (in.viewpoint->array () > hi.array ()).any ());
+  if (mode == NormalOrientation::Auto)
+    mode = any_given ? NormalOrientation::PointNormals
+                     : view_outside ? NormalOrientation::Viewpoint : NormalOrientation::Propagate;
+  if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
+    mode = NormalOrientation::Propagate;
+  orientation_ = mode;
+
+  const Graph graph = symmetricGraph (in.neighbours, in.k, n);
+  std::vector<int> component (n, -1);
+  Propagation propagation (graph, normals_, component);
+  std::size_t seeded = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    if (normals_[i].isZero ())
+      continue;
+    bool seed = false;
+    if (mode == NormalOrientation::PointNormals)
+      seed = !in.given.empty () && in.given[i];
+    else if (mode == NormalOrientation::Viewpoint)
+    {
+      const Eigen::Vector3d sight = *in.viewpoint - points[i];
+      const double cosine = normals_[i].cast<double> ().dot (sight) / std::max (sight.norm (), 1e-300);
+      if (std::abs (cosine) >= kMinViewCosine)
+      {
+        seed = true;
+        if (cosine < 0.0)
+          normals_[i] = -normals_[i];
+      }
+    }
+    if (seed)
+    {
+      component[i] = 0;
+      ++seeded;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (component[i] == 0)
+      propagation.seed (static_cast<int> (i));
+  propagation.run ();
+
+  // Whatever no seed reached (every point in Propagate mode): one part at a time, from its
+  // point farthest from the centroid, pointing away from it; then the part's enclosed volume
+  // decides (a closed surface oriented outward encloses a positive one).
+  std::vector<double> distance (n);
+  std::vector<std::size_t> order (n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    distance[i] = (points[i] - centroid).squaredNorm ();
+    order[i] = i;
+  }
+  std::sort (order.begin (), order.end (), [&] (std::size_t x, std::size_t y) {
+    return distance[x] > distance[y] || (distance[x] == distance[y] && x < y);
+  });
+  int next_component = 1;
+  for (const std::size_t s : order)
+  {
+    if (component[s] >= 0 || normals_[s].isZero ())
+      continue;
+    const int id = next_component++;
+    if (normals_[s].cast<double> ().dot (points[s] - centroid) < 0.0)
+      normals_[s] = -normals_[s];
+    component[s] = id;
+    propagation.seed (static_cast<int> (s));
+    propagation.run ();
+  }
+  if (next_component > 1)
+  {
+    const std::size_t parts = static_cast<std::size_t> (next_component);
+    std::vector<Eigen::Vector3d> part_centroid (parts, Eigen::Vector3d::Zero ());
+    std::vector<double> part_count (parts, 0.0), volume (parts, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (component[i] > 0)
+      {
+        part_centroid[static_cast<std::size_t> (component[i])] += points[i];
+        part_count[static_cast<std::size_t> (component[i])] += 1.0;
+      }
+    for (std::size_t c = 1; c < parts; ++c)
+      part_centroid[c] /= std::max (part_count[c], 1.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (component[i] > 0)
+      {
+        const std::size_t c = static_cast<std::size_t> (component[i]);
+        const double area = static_cast<double> (spacing_[i]) * spacing_[i];
+        volume[c] += area * normals_[i].cast<double> ().dot (points[i] - part_centroid[c]);
+      }
+    for (std::size_t i = 0; i < n; ++i)
+      if (component[i] > 0 && volume[static_cast<std::size_t> (component[i])] < 0.0)
+        normals_[i] = -normals_[i];
+  }
+  unoriented_ = 0;
+  propagated_ = 0;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    unoriented_ += normals_[i].isZero () ? 1 : 0;
+    propagated_ += mode != NormalOrientation::Propagate && component[i] != 0 && !normals_[i].isZero () ? 1 : 0;
+  }
+
+  // Dipoles: each point counts in the first leaf holding it (leaves overlap by epsilon).
+  const auto& nodes = bvh.nodes ();
+  owner_.assign (n, -1);
+  for (std::size_t id = 0; id < nodes.size (); ++id)
+    if (nodes[id].isLeaf ())
+      for (const int i : bvh.indices (nodes[id]))
+        if (owner_[static_cast<std::size_t> (i)] < 0)
+          owner_[static_cast<std::size_t> (i)] = static_cast<std::int32_t> (id);
+  dipoles_.assign (nodes.size (), Dipole ());
+  if (nodes.empty ())
+    return;
+  // Children before parents: the reverse of a depth-first pre-order.
+  std::vector<std::int32_t> preorder, stack{ProbabilisticBVH::rootId ()};
+  while (!stack.empty ())
+  {
+    const std::int32_t id = stack.back ();
+    stack.pop_back ();
+    preorder.push_back (id);
+    const auto& node = nodes[static_cast<std::size_t> (id)];
+    for (int c = 0; c < node.num_children; ++c)
+      stack.push_back (node.first_child + c);
+  }
+  for (auto it = preorder.rbegin (); it != preorder.rend (); ++it)
+  {
+    const std::int32_t id = *it;
+    const auto& node = nodes[static_cast<std::size_t> (id)];
+    Dipole& d = dipoles_[static_cast<std::size_t> (id)];
+    if (node.isLeaf ())
+    {
+      for (const int i : bvh.indices (node))
+        if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
+        {
+          const double a = static_cast<double> (spacing_[static_cast<std::size_t> (i)]) * spacing_[static_cast<std::size_t> (i)];
+          d.area += a;
+          d.center += a * points[static_cast<std::size_t> (i)];
+          d.moment += a * normals_[static_cast<std::size_t> (i)].cast<double> ();
+        }
+      if (d.area > 0.0)
+        d.center /= d.area;
+      for (const int i : bvh.indices (node))
+        if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
+          d.radius = std::max (d.radius, (points[static_cast<std::size_t> (i)] - d.center).norm ());
+      continue;
+    }
+    for (int c = 0; c < node.num_children; ++c)
+    {
+      const Dipole& child = dipoles_[static_cast<std::size_t> (node.first_child + c)];
+      d.area += child.area;
+      d.center += child.area * child.center;
+      d.moment += child.moment;
+    }
+    if (d.area > 0.0)
+      d.center /= d.area;
+    for (int c = 0; c < node.num_children; ++c)
+    {
+      const Dipole& child = dipoles_[static_cast<std::size_t> (node.first_child + c)];
+      if (child.area > 0.0)
+        d.radius = std::max (d.radius, (child.center - d.center).norm () + child.radius);
+    }
+  }
+}
+
+double
+SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d& q) const
+{
+  if (dipoles_.empty ())
+    return 0.0;
+  const std::vector<Eigen::Vector3d>& points = bvh.means ();
+  // A node farther than this many radii is one dipole (Barill et al. use beta = 2).
+  constexpr double kBeta = 2.0;
+  double w = 0.0;
+  std::vector<std::int32_t> stack{ProbabilisticBVH::rootId ()};
+  while (!stack.empty ())
+  {
+    const std::int32_t id = stack.back ();
+    stack.pop_back ();
+    const Dipole& d = dipoles_[static_cast<std::size_t> (id)];
+    if (d.area <= 0.0)
+      continue;
+    const Eigen::Vector3d v = d.center - q;
+    const double dist = v.norm ();
+    if (dist > kBeta * d.radius && dist > 0.0)
+    {
+      w += d.moment.dot (v) / (dist * dist * dist);
+      continue;
+    }
+    const auto& node = bvh.node (id);
+    if (!node.isLeaf ())
+    {
+      for (int c = 0; c < node.num_children; ++c)
+        stack.push_back (node.first_child + c);
+      continue;
+    }
+    for (const int i : bvh.indices (node))
+    {
+      const std::size_t s = static_cast<std::size_t> (i);
+      if (owner_[s] != id || normals_[s].isZero ())
+        continue;
+      const Eigen::Vector3d u = points[s] - q;
+      // Each sample is a disc of radius ~ s_i / 2: regularised so that a query on a sample
+      // does not divide by zero.
+      const double a = static_cast<double> (spacing_[s]) * spacing_[s];
+      const double r2 = u.squaredNorm () + 0.25 * a;
+      w += a * normals_[s].cast<double> ().dot (u) / (r2 * std::sqrt (r2));
+    }
+  }
+  return w / (4.0 * kPi);
+}
+
+std::size_t
+SurfaceModel::bytes () const
+{
+  return normals_.capacity () * sizeof (Eigen::Vector3f) + spacing_.capacity () * sizeof (float) +
+         owner_.capacity () * sizeof (std::int32_t) + dipoles_.capacity () * sizeof (Dipole);
+}
+} // namespace pcl_probcollision

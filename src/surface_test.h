@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The surface layer of collide() (METHOD.md 10a): each object's points against the other's
+// oriented surface. Private to the library (src/), used by src/collide.cpp.
+#pragma once
+
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/collision_request.h>
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief What the surface test found for one pose. Frames: A's local frame. */
+struct SurfaceAnswer
+{
+  /** \brief Some point came within reach of the other surface, or one object lies inside the
+    * other; false: the surfaces never came near (P = 0, no distance). */
+  bool reached = false;
+  /** \brief One object entirely inside the other (winding number), found without contact. */
+  bool contained = false;
+  double probability = 0.0;
+  double signed_distance = std::numeric_limits<double>::quiet_NaN ();
+  double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief The deciding point: side +1 = A, -1 = B, 0 = none; its hierarchy index. */
+  int witness_side = 0;
+  int witness_index = -1;
+  /** \brief Its position, and the other surface's normal there pointing toward A's side. */
+  Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  /** \brief Stopped at the first point with P_in > collision_above (decision mode): P and the
+    * distance are then bounds (the deepest point may lie elsewhere). */
+  bool stopped_early = false;
+  std::size_t leaf_pairs = 0;    ///< leaf pairs within reach
+  std::size_t points_tested = 0; ///< point-against-surface evaluations, both sides
+  std::size_t bv_tests = 0;      ///< node pairs tested by its traversal
+};
+
+/** \brief Every point of A and B within reach of the other's surface gets a local signed
+  * distance d_i (an implicit surface of the nearest oriented samples, robust to creases) with a
+  * standard deviation sigma_i (both clouds' noise along the normal, the fitted surface's own
+  * error and the discretisation between samples); P_in,i = Phi(-d_i / sigma_i). The pair's P
+  * and distance are those of the point with the smallest d_i / sigma_i. When no point is within
+  * reach, the winding number tells whether one object lies entirely inside the other.
+  *
+  * \param[in] a, b models with surfaces (CloudModel::surface() not empty)
+  * \param[in] T_a_b B's local frame to A's local frame
+  * \param[in] request the query (its thresholds are not used here)
+  * \param[out] per_point_a, per_point_b when not null, P_in per hierarchy point (kept maximum;
+  *             NaN stays for points out of reach); sized by the caller */
+SurfaceAnswer
+surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+             std::vector<float>* per_point_a, std::vector<float>* per_point_b);
+} // namespace detail
+} // namespace pcl_probcollision

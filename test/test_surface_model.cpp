@@ -1,0 +1,287 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The surface model (surface_model.h) and the surface layer of collide() (CollisionRequest::
+// surface, METHOD.md 10a): orientation, winding number, signed distance, containment, and the
+// degenerate inputs that must still get an answer.
+#include "scenes.h"
+
+#include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/collision.h>
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace pcl_probcollision;
+using pcl_probcollision_test::fibonacci;
+
+namespace
+{
+/** \brief A square sheet of side `size` on z = height, regular grid of spacing h, with the
+  * sensor at `view` (the cloud's sensor_origin_). */
+pcl::PointCloud<pcl::PointXYZ>
+sheet (double size, double h, double height, const Eigen::Vector3f& view)
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  const int n = static_cast<int> (std::round (size / h));
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      cloud.push_back (pcl::PointXYZ (static_cast<float> (-0.5 * size + i * h), static_cast<float> (-0.5 * size + j * h),
+                                      static_cast<float> (height)));
+  cloud.sensor_origin_ = Eigen::Vector4f (view.x (), view.y (), view.z (), 0.0f);
+  return cloud;
+}
+
+/** \brief n points on a sphere of radius r about c (Fibonacci lattice), optionally with their
+  * outward (or, flipped, inward) normals. */
+pcl::PointCloud<pcl::PointNormal>
+sphere (int n, double r, const Eigen::Vector3d& c, bool flipped = false)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  for (const Eigen::Vector3d& u : fibonacci (n))
+  {
+    pcl::PointNormal p;
+    p.getVector3fMap () = (c + r * u).cast<float> ();
+    p.getNormalVector3fMap () = (flipped ? -u : u).cast<float> ();
+    cloud.push_back (p);
+  }
+  return cloud;
+}
+
+pcl::PointCloud<pcl::PointXYZ>
+xyz (const pcl::PointCloud<pcl::PointNormal>& in)
+{
+  pcl::PointCloud<pcl::PointXYZ> out;
+  for (const auto& p : in)
+    out.push_back (pcl::PointXYZ (p.x, p.y, p.z));
+  return out;
+}
+
+/** \brief Models with a surface (CloudModelParams::surface), noise-free ... */
+CloudModelParams
+withSurface ()
+{
+  CloudModelParams p;
+  p.surface = true;
+  return p;
+}
+
+/** \brief ... or with isotropic sensor noise sigma. */
+CloudModelParams
+noisy (double sigma)
+{
+  CloudModelParams p = withSurface ();
+  p.noise = SensorNoiseModel::isotropic (sigma);
+  return p;
+}
+
+CollisionRequest
+surfaceRequest ()
+{
+  CollisionRequest r;
+  r.surface = true;
+  r.exhaustive = true;
+  return r;
+}
+
+Eigen::Isometry3d
+shift (double x, double y, double z)
+{
+  return Eigen::Isometry3d (Eigen::Translation3d (x, y, z));
+}
+} // namespace
+
+TEST (SurfaceModel, PropagationOrientsAClosedSurfaceOutward)
+{
+  // The sphere off the origin: PCL's default sensor_origin_ (0, 0, 0) lies outside it, so Auto
+  // would take it for a scan's viewpoint; a sampled closed object states Propagate.
+  CloudModelParams params = withSurface ();
+  params.orientation = NormalOrientation::Propagate;
+  const auto model = buildCloudModel (xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3))), params);
+  const SurfaceModel& s = model->surface ();
+  ASSERT_FALSE (s.empty ());
+  EXPECT_EQ (s.orientation (), NormalOrientation::Propagate);
+  const auto& points = model->hierarchy ().means ();  // local frame: the sphere's centre at ~0
+  std::size_t outward = 0;
+  for (std::size_t i = 0; i < points.size (); ++i)
+    outward += s.normals ()[i].cast<double> ().dot (points[i]) > 0.0 ? 1 : 0;
+  EXPECT_EQ (outward, points.size ());
+  EXPECT_NEAR (s.windingNumber (model->hierarchy (), Eigen::Vector3d::Zero ()), 1.0, 0.25);
+  EXPECT_NEAR (s.windingNumber (model->hierarchy (), Eigen::Vector3d (0.3, 0.0, 0.0)), 0.0, 0.05);
+  // Spacing: 800 samples on 0.126 m^2 is about 12.5 mm apart.
+  EXPECT_NEAR (s.medianSpacing (), std::sqrt (4.0 * M_PI * 0.01 / 800), 0.004);
+}
+
+TEST (SurfaceModel, GivenNormalsAreKeptEvenInsideOut)
+{
+  const auto model = buildCloudModel (sphere (400, 0.1, Eigen::Vector3d::Zero (), true), withSurface ());
+  const SurfaceModel& s = model->surface ();
+  EXPECT_EQ (s.orientation (), NormalOrientation::PointNormals);
+  // Inward normals, as given: the winding number inside is -1 (within the area estimate's
+  // error: s_i^2 from the 10th neighbour on a Fibonacci lattice), 0 outside.
+  EXPECT_NEAR (s.windingNumber (model->hierarchy (), -model->origin ()), -1.0, 0.25);
+  EXPECT_NEAR (s.windingNumber (model->hierarchy (), Eigen::Vector3d (0.3, 0.0, 0.0)), 0.0, 0.05);
+}
+
+TEST (SurfaceModel, ViewpointOrientsASheetTowardTheSensor)
+{
+  for (const float side : {1.0f, -1.0f})
+  {
+    const auto model = buildCloudModel (sheet (0.2, 0.01, 0.0, Eigen::Vector3f (0.0f, 0.0f, side)), noisy (0.001));
+    const SurfaceModel& s = model->surface ();
+    EXPECT_EQ (s.orientation (), NormalOrientation::Viewpoint);
+    for (const Eigen::Vector3f& n : s.normals ())
+      ASSERT_GT (n.z () * side, 0.99f);
+  }
+}
+
+TEST (SurfaceModel, OffByDefault)
+{
+  CloudModelParams p;
+  EXPECT_FALSE (p.surface);
+  EXPECT_FALSE (CollisionRequest ().surface);
+  EXPECT_TRUE (buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f::Zero ()), p)->surface ().empty ());
+}
+
+TEST (SurfaceModel, DegenerateInputsStillAnswer)
+{
+  // One point, two points, collinear points: no normal can be fitted; the model builds and a
+  // query answers.
+  pcl::PointCloud<pcl::PointXYZ> one, line;
+  one.push_back (pcl::PointXYZ (0, 0, 0));
+  for (int i = 0; i < 20; ++i)
+    line.push_back (pcl::PointXYZ (0.01f * i, 0, 0));
+  const auto m1 = buildCloudModel (one, noisy (0.001));
+  const auto m2 = buildCloudModel (line, noisy (0.001));
+  EXPECT_EQ (m1->surface ().unorientedPoints (), 1u);
+  const auto plate = buildCloudModel (sheet (0.2, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  for (const auto& m : {m1, m2})
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*m, *plate, shift (0, 0, -0.05), surfaceRequest (), r));
+    EXPECT_TRUE (r.ok ());
+    EXPECT_TRUE (std::isfinite (r.probability));
+  }
+}
+
+/** \brief A closed slab [-size/2, size/2]^2 x [0, thickness] sampled every h, with its outward
+  * normals (a mesh's faces would give the same). */
+pcl::PointCloud<pcl::PointNormal>
+slab (double size, double thickness, double h)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  const int n = static_cast<int> (std::round (size / h));
+  for (const double z : {0.0, thickness})
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j)
+      {
+        pcl::PointNormal p;
+        p.x = static_cast<float> (-0.5 * size + i * h);
+        p.y = static_cast<float> (-0.5 * size + j * h);
+        p.z = static_cast<float> (z);
+        p.normal_x = p.normal_y = 0.0f;
+        p.normal_z = z > 0.0 ? 1.0f : -1.0f;
+        cloud.push_back (p);
+      }
+  return cloud;
+}
+
+// Collide's pose T_a_b maps B into A's frame: shift (0, 0, -g) puts B g below A.
+// A slab (exact, given normals) over a scanned table (B, sensor above, sigma 1 mm): the gap,
+// then a penetration.
+TEST (SurfaceLayer, SignedDistanceOfASlabOverATable)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto block = buildCloudModel (slab (0.1, 0.05, 0.01), withSurface ());
+  EXPECT_EQ (block->surface ().orientation (), NormalOrientation::PointNormals);
+  for (const double gap : {0.01, 0.003, -0.003, -0.02})
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*block, *table, shift (0, 0, -gap), surfaceRequest (), r)) << gap;
+    ASSERT_TRUE (r.ok ());
+    ASSERT_TRUE (std::isfinite (r.signed_distance)) << gap;
+    EXPECT_NEAR (r.signed_distance, gap, 3.0 * r.signed_distance_std + 1e-4) << gap;
+    EXPECT_GT (r.signed_distance_std, 0.0);
+    if (gap >= 0.01)
+    {
+      EXPECT_EQ (r.verdict, Verdict::Free) << gap;
+    }
+    if (gap <= -0.003)
+    {
+      EXPECT_EQ (r.verdict, Verdict::InCollision) << gap;
+    }
+  }
+  // Without the surface layer, the separators answer and leave the distance unset.
+  CollisionResult r;
+  const CollisionRequest classifier_only;
+  ASSERT_TRUE (collide (*block, *table, shift (0, 0, -0.02), classifier_only, r));
+  EXPECT_TRUE (std::isnan (r.signed_distance));
+}
+
+// A scanned sheet has an unseen back: a table 1 cm behind a sheet seen from above is not read
+// free (the space behind a sheet counts as occupied within the near field's reach).
+TEST (SurfaceLayer, BehindAScannedSheetIsNotFree)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto top = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  CollisionResult r;
+  ASSERT_TRUE (collide (*top, *table, shift (0, 0, -0.01), surfaceRequest (), r));
+  EXPECT_NE (r.verdict, Verdict::Free);
+}
+
+// Sparse table (spacing 10 sigma): a point between four samples, 3 sigma under the surface, is
+// inside; the surface is continuous between samples.
+TEST (SurfaceLayer, SparseSurfaceIsContinuousBetweenSamples)
+{
+  const double sigma = 0.001;
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (sigma));
+  pcl::PointCloud<pcl::PointXYZ> probe;
+  probe.push_back (pcl::PointXYZ (0.005f, 0.005f, 0.0f));
+  const auto point = buildCloudModel (probe, withSurface ());
+  CollisionResult under, over;
+  ASSERT_TRUE (collide (*point, *table, shift (0, 0, 0.004), surfaceRequest (), under));
+  ASSERT_TRUE (collide (*point, *table, shift (0, 0, -0.004), surfaceRequest (), over));
+  EXPECT_GT (under.probability, 0.9) << under.signed_distance << " +- " << under.signed_distance_std << " side "
+                                     << under.witness_side << " at " << under.witness_point.transpose ();
+  EXPECT_LT (over.probability, 0.1) << over.signed_distance << " +- " << over.signed_distance_std;
+}
+
+// A small ball entirely inside a big closed surface with given outward normals: no point is
+// within reach, and the winding number reports the containment.
+TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
+{
+  const auto big = buildCloudModel (sphere (2000, 1.0, Eigen::Vector3d::Zero ()), withSurface ());
+  const auto ball = buildCloudModel (sphere (200, 0.05, Eigen::Vector3d::Zero ()), withSurface ());
+  CollisionResult inside, outside;
+  ASSERT_TRUE (collide (*ball, *big, shift (0.2, 0.1, 0.0), surfaceRequest (), inside));
+  ASSERT_TRUE (collide (*ball, *big, shift (2.0, 0.0, 0.0), surfaceRequest (), outside));
+  EXPECT_EQ (inside.verdict, Verdict::InCollision);
+  EXPECT_LT (inside.signed_distance, -0.5);  // about 0.75 deep: at least half of it
+  EXPECT_EQ (outside.verdict, Verdict::Free);
+  EXPECT_TRUE (outside.no_leaf_tested);
+}
+
+// Per-point values and the witness come back in the callers' frames.
+TEST (SurfaceLayer, PerPointValuesAndWitness)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 5.0, Eigen::Vector3f (0, 0, 6)), noisy (0.001));
+  CollisionRequest request = surfaceRequest ();
+  request.per_point = true;
+  CollisionResult r;
+  ASSERT_TRUE (collide (*plate, *table, shift (0, 0, 5.01), request, r));
+  ASSERT_EQ (r.probabilities_a.size (), plate->sourceSize ());
+  std::size_t high = 0;
+  for (const float p : r.probabilities_a)
+    high += p > 0.9f ? 1 : 0;
+  EXPECT_EQ (high, plate->size ());  // every plate point is 1 cm under the table top
+  ASSERT_NE (r.witness_side, 0);
+  // The witness is in A's frame: the plate's points sit at z = 5 there.
+  if (r.witness_side > 0)
+  {
+    EXPECT_NEAR (r.witness_point.z (), 5.0, 0.01);
+  }
+}
