@@ -2,8 +2,8 @@
 # The evaluation suite of docs/RESULTS.md: builds evaluate_collision, runs every method on every
 # workload (W1 piano/room, W2 primitives, W3 real scans), writes CSV files, a markdown summary
 # and PNG charts (gnuplot).
-#   scripts/evaluate.sh           full run (about 25 min on 2 cores) into docs/results/
-#   scripts/evaluate.sh --quick   smoke run (under 2 min after the build) into build/evaluation-quick/
+#   scripts/evaluate.sh           full run (about 15-20 min on 2 cores) into docs/results/
+#   scripts/evaluate.sh --quick   smoke run (about 30 s after the build) into build/evaluation-quick/
 # Issue 16's targets: targets.csv / targets.md (met, missed or not measured), printed by the run.
 #   --out=DIR                     another output directory
 # Fails when a W3 query is not answered as SCENES.md lists, or an output is missing.
