@@ -306,7 +306,7 @@ if (!readable("model_size.csv")) {
 }
 
 # ---------------------------------------------------------------------------------------------
-# (5) Reliability diagram of ours, default (the calibrated aggregate) and max (the paper's),
+# (5) Reliability diagram of ours: default, classifier, surface and max (the paper's),
 # over the near-contact queries; point area follows the bin count, empty bins are left out.
 
 in_band(b) = sprintf("(!(\"band\" in c) || $c[\"band\"] == \"%s\")", b)
@@ -329,6 +329,7 @@ if (!readable("reliability.csv")) {
   } else {
     biggest = max_count("default") > max_count("max") ? max_count("default") : max_count("max")
     biggest = max_count("classifier") > biggest ? max_count("classifier") : biggest
+    biggest = max_count("surface") > biggest ? max_count("surface") : biggest
     reset
     set output png("reliability.png")
     bandname = (relband eq "near_sigma") ? "|d| <= 2.8 σ_eff" : (relband eq "near_contact") ? "near-contact queries" : "all queries"
@@ -346,6 +347,8 @@ if (!readable("reliability.csv")) {
            lw 2 lc rgb "#1f77b4" title rel_title("default"), \
          "< " . cmd5("classifier") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 9 ps variable \
            lw 2 lc rgb "#2ca02c" title rel_title("classifier"), \
+         "< " . cmd5("surface") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 11 ps variable \
+           lw 2 lc rgb "#ff7f0e" title rel_title("surface"), \
          "< " . cmd5("max") using 1:2:(0.6 + 2.4 * sqrt($3 / biggest)) with linespoints pt 5 ps variable \
            lw 2 lc rgb "#d62728" title rel_title("max")
     unset output
@@ -357,7 +360,7 @@ if (!readable("reliability.csv")) {
 # re-scans (new sample positions and new noise) against the noise level, per room density
 # (solid: W1, the dense room; dashed: W1-sparse), for ours and the 2-sigma collision map.
 
-scan_series = "ours:default ours:classifier octomap_2x:mesh"
+scan_series = "ours:default ours:classifier ours:surface octomap_2x:mesh"
 scan_prog(w, s) = sprintf("$c[\"workload\"] == \"%s\" && $c[\"kind\"] == \"rescan\" && %s \":\" %s == \"%s\" && num(%s) && num(%s) { print %s, %s }", \
   w, col("method"), col("setting"), s, col("noise_pct"), col("any_flip_rate"), col("noise_pct"), col("any_flip_rate"))
 cmd6(w, s) = select("flips.csv", noise, scan_prog(w, s)) . " | sort -g -k1,1"
@@ -393,8 +396,8 @@ if (!readable("flips.csv")) {
 }
 
 # ---------------------------------------------------------------------------------------------
-# (7) Reliability per workload (rows: gridwl) and noise level (columns), ours default and
-# classifier. W1 and W2 over the near band |d| <= 2.8 σ_eff; W3 over all its queries against
+# (7) Reliability per workload (rows: gridwl) and noise level (columns), ours classifier and
+# surface (one of them is the default). W1 and W2 over the near band |d| <= 2.8 σ_eff; W3 over all its queries against
 # "listed as not free". Filled markers: bins of >= 30 queries, judged by issue 16's check (red
 # ring: outside max(0.1, 2 binomial SE)); open markers: smaller bins.
 
@@ -428,7 +431,7 @@ if (!readable("reliability.csv")) {
       set terminal png size (ncols > 2 ? 300 * ncols + 60 : 720), 300 * nrows + 60 noenhanced
     }
     set output png("reliability_grid.png")
-    set multiplot layout nrows, ncols title "Reliability of P (blue: default, green: classifier; filled: bin of >= 30, judged; red ring: outside)"
+    set multiplot layout nrows, ncols title "Reliability of P (green: classifier, orange: surface; filled: bin of >= 30, judged; red ring: outside)"
     set xrange [0:1]
     set yrange [0:1]
     set size ratio -1
@@ -444,11 +447,11 @@ if (!readable("reliability.csv")) {
           lv = word(lvls, k)
           set title sprintf("%s, noise %s (%s)", w, lv, grid_band(w))
           plot x with lines dt 2 lc rgb "#777777", \
-               "< " . cmd7(w, lv, "default", 0) using 1:2 with points pt 6 ps 0.8 lc rgb "#1f77b4", \
+               "< " . cmd7(w, lv, "surface", 0) using 1:2 with points pt 6 ps 0.8 lc rgb "#ff7f0e", \
                "< " . cmd7(w, lv, "classifier", 0) using 1:2 with points pt 8 ps 0.8 lc rgb "#2ca02c", \
-               "< " . cmd7(w, lv, "default", 1) using 1:2 with points pt 7 ps 1.3 lc rgb "#1f77b4", \
+               "< " . cmd7(w, lv, "surface", 1) using 1:2 with points pt 7 ps 1.3 lc rgb "#ff7f0e", \
                "< " . cmd7(w, lv, "classifier", 1) using 1:2 with points pt 9 ps 1.3 lc rgb "#2ca02c", \
-               "< " . cmd7(w, lv, "default", 1) . " | awk -F'\t' '$4 == 0'" using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb "#d62728", \
+               "< " . cmd7(w, lv, "surface", 1) . " | awk -F'\t' '$4 == 0'" using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb "#d62728", \
                "< " . cmd7(w, lv, "classifier", 1) . " | awk -F'\t' '$4 == 0'" using 1:2 with points pt 6 ps 2.2 lw 2 lc rgb "#d62728"
         } else {
           set multiplot next

@@ -24,14 +24,22 @@ oursSettings (bool full)
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
   const OursSetting defaults;
   const bool projection = defaults.model.surface_projection;
+  // The separators alone and the surface layer on, whichever the library's default is: the
+  // names stay when the default changes (one of the two then answers as "default" does).
   OursSetting classifier = defaults;
   classifier.name = "classifier";
   classifier.request.surface = false;
+  classifier.model.surface = false;
+  OursSetting surface = defaults;
+  surface.name = "surface";
+  surface.request.surface = true;
+  surface.model.surface = true;
   OursSetting other = classifier;
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
   s.push_back (defaults);
   s.push_back (classifier);
+  s.push_back (surface);
   s.push_back (other);
   if (!full)
     return s;

@@ -56,10 +56,12 @@ struct OursSetting
   pcl_probcollision::CloudModelParams model;
 };
 
-/** \brief The sweep: the library defaults first ("default"), the classifier alone without the
-  * surface layer ("classifier": CollisionRequest::surface = false), the paper's model ("max":
-  * measured positions, classifier alone), then one change at a time from the defaults.
-  * full = false keeps default, classifier and max. */
+/** \brief The sweep: the library defaults first ("default"), the separators alone without the
+  * surface layer ("classifier": CollisionRequest::surface and CloudModelParams::surface false),
+  * the surface layer on ("surface": both true), the paper's model ("max": measured positions,
+  * separators alone), then one change at a time from the defaults. One of classifier and
+  * surface answers as default does (the surface layer is off by default while experimental).
+  * full = false keeps default, classifier, surface and max. */
 std::vector<OursSetting> oursSettings (bool full);
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and

@@ -31,16 +31,23 @@ build/evaluation/evaluate_collision --out "$out" --data "$data" "${quick[@]}"
 build/evaluation/calibration_drift > "$out/drift.csv.tmp" && mv "$out/drift.csv.tmp" "$out/drift.csv"
 echo "evaluate.sh: evaluation took $(( $(date +%s) - start )) s"
 
-# Issue 16's demo target: the README's demo through pcd_collision itself; its row of targets.csv
-# (written "not measured" by evaluate_collision) gets the verdict of pose 2.
-demo_verdict=$(build/tools/pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt 2>/dev/null |
-               awk '$1 == "pose" && $2 == "2:" { print $3; exit }') || demo_verdict=""
-awk -F, -v OFS=, -v v="$demo_verdict" '
-  index($0, "the demo'"'"'s pose 2 reads collision,") == 1 && v != "" {
-    print $1, $2, v, "collision", (v == "collision") ? "met" : "missed",
-          "pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt"; next
+# Issue 16's demo target: the README's demo through pcd_collision itself, without and with
+# -surface; their rows of targets.csv (written "not measured" by evaluate_collision) get the
+# verdict of pose 2.
+demo() {
+  build/tools/pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt "$@" 2>/dev/null |
+    awk '$1 == "pose" && $2 == "2:" { print $3; exit }' || true
+}
+demo_verdict=$(demo)
+demo_surface=$(demo -surface)
+awk -F, -v OFS=, -v v="$demo_verdict" -v s="$demo_surface" '
+  index($0, "the demo'"'"'s pose 2 reads collision,") == 1 {
+    surf = ($2 ~ /with -surface$/); a = surf ? s : v
+    if (a != "") {
+      print $1, $2, a, "collision", (a == "collision") ? "met" : "missed",
+            "pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt" (surf ? " -surface" : ""); next }
   } { print }' "$out/targets.csv" > "$out/targets.csv.tmp" && mv "$out/targets.csv.tmp" "$out/targets.csv"
-echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)} (issue 16 target: collision)"
+echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)}, with -surface ${demo_surface:-nothing} (issue 16 target: collision)"
 
 # The summary table as markdown (docs/RESULTS.md quotes it).
 awk -F, 'NR == 1 { print "| workload | noise | method | setting | queries | easy | easy acc. | AUC | Brier (near) | flip rate | P std | median us | p90 us | max us | build ms | memory MB |";
@@ -63,12 +70,13 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
                   $c["sd_coverage_near_sigma"], $c["rel_bins_outside"], $c["rel_bins_judged"] }' \
   "$out/summary.csv" >> "$out/summary.md"
 
-# Reliability tables per workload (W1 dense, W1-sparse, W2, W3) and noise level, ours default and
-# classifier: the near band for W1 and W2, every query for W3 (against "listed as not free").
+# Reliability tables per workload (W1 dense, W1-sparse, W2, W3) and noise level, ours default,
+# classifier and surface: the near band for W1 and W2, every query for W3 (against "listed as not
+# free").
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
                    print "| workload | noise | setting | band | bin | mean P | observed | count | tolerance | check |";
                    print "|---|---|---|---|---|---|---|---|---|---|"; next }
-         $c["method"] == "ours" && ($c["setting"] == "default" || $c["setting"] == "classifier") && $c["count"] > 0 &&
+         $c["method"] == "ours" && ($c["setting"] == "default" || $c["setting"] == "classifier" || $c["setting"] == "surface") && $c["count"] > 0 &&
          ($c["band"] == "near_sigma" || ($c["workload"] == "W3" && $c["band"] == "all")) {
            check = $c["judged"] == 1 ? ($c["within"] == 1 ? "within" : "**outside**") : "-"
            printf "| %s | %s | %s | %s | [%s, %s) | %.3f | %.3f | %s | %.3f | %s |\n", $c["workload"], $c["noise_pct"],
