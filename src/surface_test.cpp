@@ -132,6 +132,8 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     r[static_cast<std::size_t> (j)] = s.normal.dot (x - s.position);
     w[static_cast<std::size_t> (j)] = base[static_cast<std::size_t> (j)];
   }
+  // Residual scale of the robust weights: half a spacing plus the samples' noise.
+  const double scale = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
   double f = 0.0;
   for (int round = 0; round < kRobustRounds; ++round)
   {
@@ -142,8 +144,6 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
       den += w[static_cast<std::size_t> (j)];
     }
     f = num / den;
-    // Residual scale: half a spacing plus the samples' noise.
-    const double scale = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
     for (int j = 0; j < found; ++j)
     {
       const double e = (r[static_cast<std::size_t> (j)] - f) / scale;
@@ -151,18 +151,16 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     }
     w[0] = std::max (w[0], 1e-12);  // the nearest sample always counts
   }
-  double den = 0.0, den2 = 0.0, fit_var = 0.0;
+  double den = 0.0, fit_var = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
   for (int j = 0; j < found; ++j)
   {
     const Sample& s = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])];
     const double wj = w[static_cast<std::size_t> (j)];
     den += wj;
-    den2 += wj * wj;
     fit_var += wj * wj * s.variance;
     normal += wj * s.normal;
   }
-  (void) den2;
   fit_var /= den * den;
   const double norm = normal.norm ();
   out.normal = norm > 0.0 ? Eigen::Vector3d (normal / norm) : first.normal;

@@ -123,8 +123,8 @@ private:
   void assessPrecision (double max_abs_coordinate, const std::string& name);
 
   /** \brief Builds the surface model from the local points alone (the constructor from an
-    * UncertainCloud): normals and neighbours estimated here, Propagate orientation unless
-    * Auto finds nothing else. */
+    * UncertainCloud): normals and neighbours estimated here; there is no viewpoint and
+    * there are no given normals, so Auto means Propagate. */
   void buildSurfaceFromPoints (NormalOrientation orientation, int k);
   ProbabilisticBVH bvh_;
   SurfaceModel surface_;
