@@ -169,6 +169,10 @@ struct Density
   std::string workload;   ///< W1 (dense: the room at 50,000 points) or W1-sparse
   std::size_t rob_points = 0, env_points = 0;
   CloudXYZ::Ptr rob_clean, env_clean;
+  /** \brief The side each clean point was sampled on (its face's outward normal): the scans'
+    * viewpoints, for the surface layer's orientation (ScanSides). */
+  Outward rob_outward, env_outward;
+  ScanSides sides () const { return {&rob_outward, &env_outward}; }
 };
 
 struct PianoRoom
@@ -211,14 +215,14 @@ loadPianoRoom (const Options& o, Results& results)
   const double sigma05 = sigmaOf (w, 0.5);
   const auto sparse_max = static_cast<std::size_t> (std::floor (w.env_area / ((10.0 * sigma05) * (10.0 * sigma05))));
   const std::size_t sparse = std::min<std::size_t> (10000, sparse_max);
-  w.densities.push_back ({"dense", "W1", 10000, 50000, nullptr, nullptr});
-  w.densities.push_back ({"sparse", "W1-sparse", 10000, sparse, nullptr, nullptr});
+  w.densities.push_back ({"dense", "W1", 10000, 50000, nullptr, nullptr, {}, {}});
+  w.densities.push_back ({"sparse", "W1-sparse", 10000, sparse, nullptr, nullptr, {}, {}});
   for (std::size_t d = 0; d < w.densities.size (); ++d)
   {
     Density& den = w.densities[d];
     // The dense room keeps the samples of the evaluation before the densities (same seeds).
-    den.rob_clean = sampleCount (w.rob_mesh, den.rob_points, o.seed * 101 + 1);
-    den.env_clean = sampleCount (w.env_mesh, den.env_points, o.seed * 101 + 2 + 10 * d);
+    den.rob_clean = sampleCount (w.rob_mesh, den.rob_points, o.seed * 101 + 1, &den.rob_outward);
+    den.env_clean = sampleCount (w.env_mesh, den.env_points, o.seed * 101 + 2 + 10 * d, &den.env_outward);
     const double nominal = std::sqrt (w.env_area / static_cast<double> (den.env_clean->size ()));
     const double area_only =
       std::sqrt (w.env_area / std::max (1.0, static_cast<double> (den.env_clean->size ()) - w.env_mesh.vertices.size ()));
@@ -362,7 +366,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       kernel += k;
       features += f;
       n += 1;
-    });
+    }, den.sides ());
     proto.method = "ours";
     proto.setting = s.name;
     runQueries (results, proto, cell, q);
@@ -484,7 +488,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       // request without the surface layer ignores it); max on its own.
       const SharedBuild shared = sharedBuild ();
       BuildRow unused;
-      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused);
+      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, den.sides ());
       for (const OursSetting& s : shared.settings)
       {
         const PoseQuery q = oursQuery (m, s.request, nullptr);
@@ -539,11 +543,13 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       // clouds); noise seeds on all three. None equals a seed of the main clouds.
       const std::uint64_t sample_seed = streamSeed (o.seed * 104729 + density, 1000 + r);
       const std::uint64_t scan_noise = streamSeed (sample_seed, static_cast<std::uint64_t> (pct * 100));
-      const CloudXYZ::ConstPtr rob_r = addNoise (*sampleCount (w.rob_mesh, den.rob_points, sample_seed), sigma, scan_noise);
+      Outward rob_out, env_out;
+      const CloudXYZ::ConstPtr rob_r =
+        addNoise (*sampleCount (w.rob_mesh, den.rob_points, sample_seed, &rob_out), sigma, scan_noise);
       const CloudXYZ::ConstPtr env_r =
-        addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1), sigma, scan_noise + 1);
+        addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1, &env_out), sigma, scan_noise + 1);
       BuildRow unused;
-      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused);
+      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, ScanSides {&rob_out, &env_out});
       for (const OursSetting& s : shared.settings)
       {
         const PoseQuery q = oursQuery (m, s.request, nullptr);

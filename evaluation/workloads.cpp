@@ -5,10 +5,12 @@
 #include <pcl_probcollision/normal_distribution.h>
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
+#include <pcl_probcollision/covariance_estimation.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -67,16 +69,55 @@ oursSettings (bool full)
   return s;
 }
 
+pcl::PointCloud<pcl::PointNormal>::Ptr
+orientedScan (const CloudXYZ& noisy, const Outward& outward, int k)
+{
+  if (outward.size () != noisy.size ())
+    throw std::logic_error ("orientedScan: " + std::to_string (outward.size ()) + " sides for " +
+                            std::to_string (noisy.size ()) + " points");
+  CovarianceEstimation<pcl::PointXYZ> estimation;
+  estimation.setInputCloud (noisy.makeShared ());
+  estimation.setKSearch (k);
+  estimation.setComputeSurface (true);
+  pcl::PointCloud<Covariance> unused;
+  estimation.compute (unused);
+  const std::vector<Eigen::Vector3f>& normals = estimation.getNormals ();
+  pcl::PointCloud<pcl::PointNormal>::Ptr out (new pcl::PointCloud<pcl::PointNormal>);
+  out->resize (noisy.size ());
+  for (std::size_t i = 0; i < noisy.size (); ++i)
+  {
+    pcl::PointNormal& p = (*out)[i];
+    p.getVector3fMap () = noisy[i].getVector3fMap ();
+    Eigen::Vector3f n = i < normals.size () ? normals[i] : Eigen::Vector3f::Zero ();
+    if (n.dot (outward[i]) < 0.0f)
+      n = -n;
+    // No plane (too few distinct neighbours): no normal, the model orients it by propagation.
+    if (n.isZero ())
+      n.setConstant (std::numeric_limits<float>::quiet_NaN ());
+    p.getNormalVector3fMap () = n;
+  }
+  return out;
+}
+
 OursModels
 buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
-                 const CloudModelParams& model, BuildRow& build)
+                 const CloudModelParams& model, BuildRow& build, const ScanSides& sides)
 {
   CloudModelParams params = model;
   params.noise = SensorNoiseModel::isotropic (sigma);
+  const bool scans = sides.robot && sides.env && model.surface;
+  pcl::PointCloud<pcl::PointNormal>::Ptr robot_scan, env_scan;
+  if (scans)
+  {
+    robot_scan = orientedScan (*robot, *sides.robot, model.k);
+    env_scan = orientedScan (*env, *sides.env, model.k);
+  }
   const auto start = std::chrono::steady_clock::now ();
   OursModels m;
-  m.robot = buildCloudModel (*robot, params, nullptr, nullptr, "robot");
-  m.env = buildCloudModel (*env, params, nullptr, nullptr, "environment");
+  m.robot = scans ? buildCloudModel (*robot_scan, params, nullptr, nullptr, "robot")
+                  : buildCloudModel (*robot, params, nullptr, nullptr, "robot");
+  m.env = scans ? buildCloudModel (*env_scan, params, nullptr, nullptr, "environment")
+                : buildCloudModel (*env, params, nullptr, nullptr, "environment");
   build.build_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   build.memory_bytes = static_cast<double> (m.robot->bytes () + m.env->bytes ());
   build.nodes = static_cast<double> (m.robot->hierarchy ().nodes ().size () + m.env->hierarchy ().nodes ().size ());
@@ -114,18 +155,30 @@ oursQuery (const OursModels& models, const CollisionRequest& request,
 
 PoseQuery
 buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma, const OursSetting& setting,
-           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query)
+           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query, const ScanSides& sides)
 {
-  return oursQuery (buildOursModels (robot, env, sigma, setting.model, build), setting.request, std::move (on_query));
+  return oursQuery (buildOursModels (robot, env, sigma, setting.model, build, sides), setting.request,
+                    std::move (on_query));
 }
 
 CloudXYZ::Ptr
-sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed)
+sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed, Outward* outward)
 {
   // sampleMesh keeps every vertex: aim the area samples at what the vertices leave.
   const double area_points = std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ());
   const double spacing = std::sqrt (pcl_probcollision::io::meshArea (mesh) / area_points);
-  return CloudXYZ::Ptr (new CloudXYZ (pcl_probcollision::io::sampleMesh (mesh, spacing, seed)));
+  if (!outward)
+    return CloudXYZ::Ptr (new CloudXYZ (pcl_probcollision::io::sampleMesh (mesh, spacing, seed)));
+  const pcl::PointCloud<pcl::PointNormal> with = pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed);
+  CloudXYZ::Ptr cloud (new CloudXYZ);
+  cloud->resize (with.size ());
+  outward->resize (with.size ());
+  for (std::size_t i = 0; i < with.size (); ++i)
+  {
+    (*cloud)[i].getVector3fMap () = with[i].getVector3fMap ();
+    (*outward)[i] = with[i].getNormalVector3fMap ();
+  }
+  return cloud;
 }
 
 CloudXYZ::Ptr

@@ -84,10 +84,30 @@ struct OursModels
   pcl_probcollision::CloudModel::ConstPtr robot, env;
 };
 
+/** \brief Per point of a sampled cloud, the outward normal of the mesh face it came from
+  * (index-aligned with the cloud; noise moves points, not their order). */
+using Outward = std::vector<Eigen::Vector3f>;
+
+/** \brief Which side each point was seen from, for both clouds: what a registered multi-view
+  * scan knows (each point's sensor). The evaluation emulates it with the mesh faces' sides;
+  * only the sign is used (orientedScan). */
+struct ScanSides
+{
+  const Outward* robot = nullptr;
+  const Outward* env = nullptr;
+};
+
+/** \brief A noisy cloud as a scan with oriented normals: each normal is the plane fitted to the
+  * point's k nearest noisy neighbours (the library's own estimate), turned to the side the
+  * point was seen from. Only the side comes from the mesh, never the direction. */
+pcl::PointCloud<pcl::PointNormal>::Ptr orientedScan (const CloudXYZ& noisy, const Outward& outward, int k);
+
 /** \brief Builds both cloud models with isotropic noise sigma declared for both; fills the
-  * build row's time, memory and node count. */
+  * build row's time, memory and node count. With sides, each cloud is built from its
+  * orientedScan (normals estimated before the timed build, as a scan would bring them). */
 OursModels buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
-                            const pcl_probcollision::CloudModelParams& model, BuildRow& build);
+                            const pcl_probcollision::CloudModelParams& model, BuildRow& build,
+                            const ScanSides& sides = ScanSides ());
 
 /** \brief The query of one request on prebuilt models (several requests may share them). */
 PoseQuery oursQuery (const OursModels& models, const pcl_probcollision::CollisionRequest& request,
@@ -97,7 +117,8 @@ PoseQuery oursQuery (const OursModels& models, const pcl_probcollision::Collisio
   * declared for both. Builds the hierarchies now (build row filled) and returns the query. */
 PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
                      const OursSetting& setting, BuildRow& build,
-                     std::function<void (std::size_t leaf_pairs, std::size_t kernel, double features)> on_query);
+                     std::function<void (std::size_t leaf_pairs, std::size_t kernel, double features)> on_query,
+                     const ScanSides& sides = ScanSides ());
 
 /** \brief W3: every SCENES.md query (data_dir/scenes/queries.csv) with our default and max
   * settings; right counts the default's answers that match the listed verdict (resting:
@@ -105,8 +126,9 @@ PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& 
 void evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& right, int& total);
 
 /** \brief The mesh sampled uniformly by area plus every vertex, aiming at `target` points in all
-  * (pcl_probcollision::io::sampleMesh; deterministic for a seed). */
-CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed);
+  * (pcl_probcollision::io::sampleMesh; deterministic for a seed). With outward, also each
+  * sample's face normal (the same points). */
+CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed, Outward* outward = nullptr);
 
 /** \brief Gaussian noise of standard deviation sigma on every coordinate (deterministic). */
 CloudXYZ::Ptr addNoise (const CloudXYZ& clean, double sigma, std::uint64_t seed);
