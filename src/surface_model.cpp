@@ -122,6 +122,38 @@ private:
   std::vector<int>& component_;
   std::priority_queue<std::tuple<float, int, int>> queue_;
 };
+/** \brief Bilateral smoothing of oriented normals over the neighbour graph: each normal
+  * becomes the mean of its own and its neighbours' that lie within kSmoothCosine of it (the
+  * same face), kSmoothPasses times. A plane fitted to k noisy neighbours tilts by about
+  * sigma / spacing; averaging the normals of one face cuts that without rounding its edges. */
+void
+smoothNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals)
+{
+  constexpr int kSmoothPasses = 2;
+  constexpr float kSmoothCosine = 0.7071f;
+  std::vector<Eigen::Vector3f> next (normals.size ());
+  for (int pass = 0; pass < kSmoothPasses; ++pass)
+  {
+    for (std::size_t i = 0; i < normals.size (); ++i)
+    {
+      const Eigen::Vector3f& n = normals[i];
+      if (n.isZero ())
+      {
+        next[i] = n;
+        continue;
+      }
+      Eigen::Vector3f sum = n;
+      for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
+      {
+        const Eigen::Vector3f& m = normals[static_cast<std::size_t> (graph.targets[static_cast<std::size_t> (e)])];
+        if (m.dot (n) > kSmoothCosine)
+          sum += m;
+      }
+      next[i] = sum.normalized ();
+    }
+    normals.swap (next);
+  }
+}
 } // namespace
 
 void
@@ -257,6 +289,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       if (component[i] > 0 && volume[static_cast<std::size_t> (component[i])] < 0.0)
         normals_[i] = -normals_[i];
   }
+  smoothNormals (graph, normals_);
   unoriented_ = 0;
   propagated_ = 0;
   for (std::size_t i = 0; i < n; ++i)
@@ -336,7 +369,8 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
   // A node farther than this many radii is one dipole (Barill et al. use beta = 2).
   constexpr double kBeta = 2.0;
   double w = 0.0;
-  std::vector<std::int32_t> stack{ProbabilisticBVH::rootId ()};
+  thread_local std::vector<std::int32_t> stack;  // no allocation per call once grown
+  stack.assign (1, ProbabilisticBVH::rootId ());
   while (!stack.empty ())
   {
     const std::int32_t id = stack.back ();

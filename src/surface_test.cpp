@@ -32,6 +32,26 @@ constexpr double kBridgeSpacings = 6.0;
 /** \brief Robust reweighting rounds of the implicit surface (RIMLS, Oeztireli et al. 2009):
   * samples across a crease, whose plane disagrees with the local surface, lose their weight. */
 constexpr int kRobustRounds = 3;
+/** \brief Faces among the nearest samples: a box corner has three. */
+constexpr int kMaxFaces = 3;
+/** \brief A sample belongs to a face when its normal is within 45 degrees of the face's first
+  * sample's (noisy normals of one flat face stay well within it). */
+constexpr double kSameFaceCosine = 0.7071;
+/** \brief Two faces are concave (an inner corner, a gap) only when each lies in front of the
+  * other by more than this many noise deviations in sum; otherwise convex (a slab, a sheet). */
+constexpr double kConcaveNoiseSigmas = 6.0;
+/** \brief A face other than the nearest sample's needs this many samples to count: a single
+  * stray normal must not turn a point inside out. */
+constexpr int kMinFaceSamples = 2;
+/** \brief Behind the local plane by more than this many of its deviations, a point is inside
+  * only if the winding number agrees. */
+constexpr double kDeepSigmas = 2.0;
+/** \brief A deep point is behind the surface when its winding number exceeds this: about 1
+  * inside a closed surface, 1/2 behind an open scanned sheet (space behind a sheet is occupied),
+  * 0 beside or in front of either. */
+constexpr double kBehindWinding = 0.25;
+/** \brief A winding number above this is inside (about 1 inside a closed surface, 0 outside). */
+constexpr double kInsideWinding = 0.5;
 
 /** \brief One sample of the other surface, in A's local frame. */
 struct Sample
@@ -80,6 +100,8 @@ struct Evaluation
 {
   double distance = 0.0, sigma = 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
+  double nearest = 0.0;  ///< distance to the nearest sample
+  double spacing = 0.0;  ///< that sample's spacing
 };
 
 /** \brief x against the pool: implicit surface f(x) = sum w_j n_j . (x - p_j) / sum w_j of the
@@ -114,61 +136,144 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   const double h = std::max (first.spacing, 1e-12);
   // Tangential distance to the nearest sample: how far the surface is extrapolated.
   const Eigen::Vector3d offset = x - first.position;
+  out.nearest = std::sqrt (d2[0]);
+  out.spacing = h;
   const double along = first.normal.dot (offset);
   const double tangential = std::sqrt (std::max (0.0, offset.squaredNorm () - along * along));
-  if (tangential > kBridgeSpacings * h)
+  // More than a spacing along the surface from its nearest sample, the surface either spans a
+  // hole (samples of the far rim lie beyond x, in the plane, within the bridging reach) or has
+  // ended at an edge (every sample lies behind x). Only a hole is bridged.
+  bool past_edge = tangential > kBridgeSpacings * h;
+  if (!past_edge && tangential > h)
   {
-    // Past the surface's edge: outside, by the distance to its last sample.
-    out.distance = offset.norm ();
-    out.normal = offset / std::max (out.distance, 1e-300);
+    const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
+    const double reach2 = (kBridgeSpacings * h) * (kBridgeSpacings * h);
+    const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+    past_edge = true;
+    for (const int j : pool)
+    {
+      const Eigen::Vector3d v = samples[static_cast<std::size_t> (j)].position - x;
+      if (v.dot (u) > 0.0 && std::abs (first.normal.dot (v) + along) < thickness && v.squaredNorm () < reach2)
+      {
+        past_edge = false;
+        break;
+      }
+    }
+  }
+  if (past_edge)
+  {
+    // Past the surface's edge: outside. The edge lies anywhere within a spacing beyond the last
+    // sample: half a spacing on average, uncertain by 0.29 spacing.
+    const double beyond = std::max (0.0, tangential - 0.5 * h);
+    out.distance = std::sqrt (beyond * beyond + along * along);
+    out.normal = offset / std::max (offset.norm (), 1e-300);
     out.sigma = std::sqrt (variance_of (out.normal) + first.variance) + kDiscretisationPerDistance * h;
     return true;
   }
-  std::array<double, kSurfaceNeighbours> base, r, w;
+  // The samples split into faces by their normals (up to kMaxFaces: the faces of a box's edge
+  // or corner, the two faces of a thin slab); each face is its own implicit plane.
+  std::array<double, kSurfaceNeighbours> base, r;
+  std::array<int, kSurfaceNeighbours> face;
+  std::array<Eigen::Vector3d, kMaxFaces> face_seed;
+  std::array<int, kMaxFaces> face_size{};
+  int faces = 0;
   for (int j = 0; j < found; ++j)
   {
-    const Sample& s = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])];
-    base[static_cast<std::size_t> (j)] = std::exp (-(d2[static_cast<std::size_t> (j)] - d2[0]) / (h * h));
-    r[static_cast<std::size_t> (j)] = s.normal.dot (x - s.position);
-    w[static_cast<std::size_t> (j)] = base[static_cast<std::size_t> (j)];
+    const std::size_t sj = static_cast<std::size_t> (j);
+    const Sample& s = samples[static_cast<std::size_t> (nearest[sj])];
+    base[sj] = std::exp (-(d2[sj] - d2[0]) / (h * h));
+    r[sj] = s.normal.dot (x - s.position);
+    int best = -1;
+    double best_cos = -2.0;
+    for (int c = 0; c < faces; ++c)
+    {
+      const double cosine = s.normal.dot (face_seed[static_cast<std::size_t> (c)]);
+      if (cosine > best_cos)
+      {
+        best_cos = cosine;
+        best = c;
+      }
+    }
+    if ((best < 0 || best_cos < kSameFaceCosine) && faces < kMaxFaces)
+    {
+      best = faces++;
+      face_seed[static_cast<std::size_t> (best)] = s.normal;
+    }
+    face[sj] = best;
+    ++face_size[static_cast<std::size_t> (best)];
   }
   // Residual scale of the robust weights: half a spacing plus the samples' noise.
   const double scale = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
-  double f = 0.0;
-  for (int round = 0; round < kRobustRounds; ++round)
+  struct Fit
   {
-    double num = 0.0, den = 0.0;
+    double f = 0.0, fit_var = 0.0, weight = 0.0;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero (), center = Eigen::Vector3d::Zero ();
+  };
+  auto fit = [&] (int c) {
+    std::array<double, kSurfaceNeighbours> w;
+    for (int j = 0; j < found; ++j)
+      w[static_cast<std::size_t> (j)] = face[static_cast<std::size_t> (j)] == c ? base[static_cast<std::size_t> (j)] : 0.0;
+    Fit out;
+    for (int round = 0; round < kRobustRounds; ++round)
+    {
+      double num = 0.0, den = 0.0;
+      for (int j = 0; j < found; ++j)
+      {
+        num += w[static_cast<std::size_t> (j)] * r[static_cast<std::size_t> (j)];
+        den += w[static_cast<std::size_t> (j)];
+      }
+      out.f = num / std::max (den, 1e-300);
+      bool first_of_face = true;
+      for (int j = 0; j < found; ++j)
+        if (face[static_cast<std::size_t> (j)] == c)
+        {
+          const double e = (r[static_cast<std::size_t> (j)] - out.f) / scale;
+          // The face's nearest sample always counts.
+          w[static_cast<std::size_t> (j)] =
+            std::max (base[static_cast<std::size_t> (j)] * std::exp (-e * e), first_of_face ? 1e-12 : 0.0);
+          first_of_face = false;
+        }
+    }
     for (int j = 0; j < found; ++j)
     {
-      num += w[static_cast<std::size_t> (j)] * r[static_cast<std::size_t> (j)];
-      den += w[static_cast<std::size_t> (j)];
+      const Sample& s = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])];
+      const double wj = w[static_cast<std::size_t> (j)];
+      out.weight += wj;
+      out.fit_var += wj * wj * s.variance;
+      out.normal += wj * s.normal;
+      out.center += wj * s.position;
     }
-    f = num / den;
-    for (int j = 0; j < found; ++j)
-    {
-      const double e = (r[static_cast<std::size_t> (j)] - f) / scale;
-      w[static_cast<std::size_t> (j)] = base[static_cast<std::size_t> (j)] * std::exp (-e * e);
-    }
-    w[0] = std::max (w[0], 1e-12);  // the nearest sample always counts
-  }
-  double den = 0.0, fit_var = 0.0;
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
-  for (int j = 0; j < found; ++j)
+    out.fit_var /= out.weight * out.weight;
+    out.center /= out.weight;
+    const double norm = out.normal.norm ();
+    out.normal = norm > 0.0 ? Eigen::Vector3d (out.normal / norm) : first.normal;
+    return out;
+  };
+  // The nearest sample's face, then each other face of enough samples: at a convex edge (each
+  // face behind the other's plane; also the two faces of a slab) inside means behind both, the
+  // larger distance; at a concave one (each in front of the other: an inner corner, a gap
+  // between two solids) behind either, the smaller.
+  const Fit nearest_face = fit (0);
+  Fit chosen = nearest_face;
+  for (int c = 1; c < faces; ++c)
   {
-    const Sample& s = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])];
-    const double wj = w[static_cast<std::size_t> (j)];
-    den += wj;
-    fit_var += wj * wj * s.variance;
-    normal += wj * s.normal;
+    if (face_size[static_cast<std::size_t> (c)] < kMinFaceSamples)
+      continue;
+    const Fit other = fit (c);
+    const double facing = nearest_face.normal.dot (other.center - nearest_face.center) +
+                          other.normal.dot (nearest_face.center - other.center);
+    // Noise blurs the two faces of a slab as thin as it into one sheet whose faces' order is
+    // random: only a clear lead is concave (a sheet has no inside, the larger distance).
+    const bool concave = facing > kConcaveNoiseSigmas * std::sqrt (std::max (first.variance, 0.0));
+    if (concave == (other.f < chosen.f))
+      chosen = other;
   }
-  fit_var /= den * den;
-  const double norm = normal.norm ();
-  out.normal = norm > 0.0 ? Eigen::Vector3d (normal / norm) : first.normal;
   // Where the surface runs between samples is uncertain within one spacing of the last one;
   // a bridged hole continues the fitted plane.
   const double disc = kDiscretisationPerDistance * std::min (tangential, h);
-  out.distance = f;
-  out.sigma = std::sqrt (variance_of (out.normal) + fit_var + disc * disc);
+  out.distance = chosen.f;
+  out.normal = chosen.normal;
+  out.sigma = std::sqrt (variance_of (out.normal) + chosen.fit_var + disc * disc);
   return true;
 }
 
@@ -184,6 +289,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const SurfaceModel& s_model = surface.surface ();
   const Eigen::Matrix3d R_q = T_q.linear ();
   const Eigen::Matrix3d R_s = T_s.linear ();
+  const Eigen::Isometry3d T_s_inverse = T_s.inverse ();
   scratch.prepare (s_bvh.size ());
   const std::uint32_t cache_stamp = scratch.next ();
   for (std::size_t g = 0; g < groups.size ();)
@@ -225,6 +331,20 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
                      [&] (const Eigen::Vector3d& n) { return std::max (0.0, cov.quadratic (R_q.transpose () * n)); }, e))
         continue;
       ++answer.points_tested;
+      // Clearly behind the local plane, or behind it farther than a spacing from its nearest
+      // sample: the plane may be extrapolated there (past a face's edge whose other face was not
+      // sampled). The winding number of the whole surface decides: outside, the point is at
+      // least its distance to the nearest sample away. Points within the noise of the plane keep
+      // the local answer: there the winding number is about 1/2 on either side.
+      // Only a point that matters is checked: one that would set the pair's minimum, or any
+      // with per-point values.
+      const bool matters = per_point || e.distance / std::max (e.sigma, 1e-300) < best_z;
+      if (matters && e.distance < 0.0 && (e.nearest > e.spacing || e.distance < -kDeepSigmas * e.sigma) &&
+          s_model.windingNumber (s_bvh, T_s_inverse * x) < kBehindWinding)
+      {
+        e.distance = e.nearest;
+        e.normal = Eigen::Vector3d::Zero ();
+      }
       const double sigma = std::max (e.sigma, 1e-300);
       const double z = e.distance / sigma;
       if (per_point)
@@ -317,7 +437,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   const Eigen::Vector3d a0 = bvh_a.means ().front ();
   const Eigen::Vector3d a0_in_b = T_a_b.inverse () * a0;
   const Eigen::Vector3d b0 = T_a_b * bvh_b.means ().front ();
-  if (trusted (b.surface ()) && b.surface ().windingNumber (bvh_b, a0_in_b) > 0.5)
+  if (trusted (b.surface ()) && b.surface ().windingNumber (bvh_b, a0_in_b) > kInsideWinding)
   {
     answer.reached = answer.contained = true;
     answer.witness_side = 1;
@@ -325,7 +445,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
     answer.witness_point = a0;
     answer.signed_distance = -nearestSampleDistance (b, a0_in_b);
   }
-  else if (trusted (a.surface ()) && a.surface ().windingNumber (bvh_a, b0) > 0.5)
+  else if (trusted (a.surface ()) && a.surface ().windingNumber (bvh_a, b0) > kInsideWinding)
   {
     answer.reached = answer.contained = true;
     answer.witness_side = -1;
