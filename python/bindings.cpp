@@ -122,9 +122,30 @@ fillCovariances (const py::array& arr, pcl::PointCloud<Covariance>& covs)
   }
 }
 
+/** Outward unit normals (N, 3) index-aligned with the points, as pcl::PointNormal's normal_x/y/z:
+  * a row with a NaN or a zero normal has none (the surface model orients it from its neighbours). */
+template <typename T>
+void
+fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud)
+{
+  const auto a = arr.unchecked<T, 2> ();
+  for (py::ssize_t i = 0; i < a.shape (0); ++i)
+  {
+    pcl::PointNormal& p = cloud[static_cast<std::size_t> (i)];
+    p.normal_x = static_cast<float> (a (i, 0));
+    p.normal_y = static_cast<float> (a (i, 1));
+    p.normal_z = static_cast<float> (a (i, 2));
+    const Eigen::Vector3f n (p.normal_x, p.normal_y, p.normal_z);
+    if (n.allFinite () && n.squaredNorm () > 0.0f && std::abs (n.norm () - 1.0f) > 1e-3f)
+      throw py::value_error ("normals: row " + std::to_string (i) + " is not of unit length (norm " +
+                             std::to_string (n.norm ()) + "); give unit normals, or NaN / 0 for none");
+  }
+}
+
 std::shared_ptr<const CloudModel>
 buildModel (const py::object& points, const py::object& covariances, const py::object& params_obj,
-            const std::string& name, const py::object& viewpoint = py::none ())
+            const std::string& name, const py::object& viewpoint = py::none (),
+            const py::object& normals = py::none ())
 {
   const py::array pts = floatArray (points, "points", 2, "(N, 3)");
   pcl::PointCloud<pcl::PointXYZ> cloud;
@@ -162,6 +183,30 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
                                                     static_cast<float> (d[5]), static_cast<float> (d[6]));
   }
 
+  if (!normals.is_none ())
+  {
+    // pcl::PointNormal: the same x y z (the same model) plus the normals the surface layer's Auto
+    // and PointNormals orientations take, as pcd_collision builds a mesh's model.
+    const py::array nrm = floatArray (normals, "normals", 2, "(N, 3)");
+    if (nrm.shape (0) != pts.shape (0))
+      throw py::value_error ("normals: " + std::to_string (nrm.shape (0)) + " normals for " +
+                             std::to_string (pts.shape (0)) + " points");
+    pcl::PointCloud<pcl::PointNormal> oriented;
+    oriented.resize (cloud.size ());
+    oriented.width = cloud.width;
+    oriented.height = cloud.height;
+    oriented.is_dense = cloud.is_dense;
+    oriented.sensor_origin_ = cloud.sensor_origin_;
+    oriented.sensor_orientation_ = cloud.sensor_orientation_;
+    for (std::size_t i = 0; i < cloud.size (); ++i)
+      oriented[i].getVector3fMap () = cloud[i].getVector3fMap ();
+    if (py::isinstance<py::array_t<float>> (nrm))
+      fillNormals<float> (nrm, oriented);
+    else
+      fillNormals<double> (nrm, oriented);
+    py::gil_scoped_release release;
+    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, have_covs ? &covs : nullptr, name);
+  }
   py::gil_scoped_release release;
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name);
 }
@@ -372,6 +417,19 @@ traversalName (TraversalMode t)
 }
 
 const char*
+orientationEnumName (NormalOrientation o)
+{
+  switch (o)
+  {
+    case NormalOrientation::Auto: return "Auto";
+    case NormalOrientation::PointNormals: return "PointNormals";
+    case NormalOrientation::Viewpoint: return "Viewpoint";
+    case NormalOrientation::Propagate: return "Propagate";
+  }
+  return "?";
+}
+
+const char*
 noiseFactory (const SensorNoiseModel& n)
 {
   switch (n.type ())
@@ -550,6 +608,19 @@ PYBIND11_MODULE (_core, m)
       .value ("Stochastic", TraversalMode::Stochastic)
       .value ("ExpandedBV", TraversalMode::ExpandedBV);
 
+  py::enum_<NormalOrientation> (m, "NormalOrientation",
+      "Where the surface model's normals get their orientation (which side is outside); CloudModelParams.orientation.\n\n"
+      "Auto (default): the points' own normals when build_model() was given finite ones (a mesh's faces), else the\n"
+      "    viewpoint when it lies outside the cloud's bounding box (a scan), else Propagate.\n"
+      "PointNormals: the given normals, taken as outward; points without one are oriented from their neighbours.\n"
+      "Viewpoint: toward the sensor origin (the viewpoint); grazing points (|cos| < 0.2) from their neighbours.\n"
+      "Propagate: propagated over the neighbour graph from the point farthest from the centroid, then each\n"
+      "    connected part flipped so that its enclosed volume is positive (closed objects).")
+      .value ("Auto", NormalOrientation::Auto)
+      .value ("PointNormals", NormalOrientation::PointNormals)
+      .value ("Viewpoint", NormalOrientation::Viewpoint)
+      .value ("Propagate", NormalOrientation::Propagate);
+
   // --- SensorNoiseModel -------------------------------------------------------------------------
   py::class_<SensorNoiseModel> noise (m, "SensorNoiseModel",
       "Sensor (position) noise added to the estimated covariances. Build with none(), isotropic(sigma), "
@@ -576,13 +647,18 @@ PYBIND11_MODULE (_core, m)
   py::class_<CloudModelParams> (m, "CloudModelParams",
       "How a CloudModel is built from a point cloud (the per-cloud settings).\n\n"
       "k: neighbours of the covariance estimation (>= 1); noise: SensorNoiseModel added to the covariances;\n"
-      "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma: the hierarchy.")
+      "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma: the hierarchy;\n"
+      "surface: also build the oriented surface model (METHOD.md 10a) that CollisionRequest.surface queries\n"
+      "(experimental, issue #16; costs a normal fit and an orientation pass per point); orientation: how its\n"
+      "normals are oriented (NormalOrientation, default Auto).")
       .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, int n_min,
-                          double sigma_max, double epsilon, double k_sigma) {
+                          double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation) {
               CloudModelParams p;
               p.k = k;
               p.noise = noise;
               p.surface_projection = surface_projection;
+              p.surface = surface;
+              p.orientation = orientation;
               p.hierarchy.n_max = n_max;
               p.hierarchy.n_min = n_min;
               p.hierarchy.sigma_max = sigma_max;
@@ -594,10 +670,15 @@ PYBIND11_MODULE (_core, m)
             py::arg ("surface_projection") = dp.surface_projection, py::arg ("n_max") = dp.hierarchy.n_max,
             py::arg ("n_min") = dp.hierarchy.n_min, py::arg ("sigma_max") = dp.hierarchy.sigma_max,
             py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
+            py::arg ("surface") = dp.surface, py::arg ("orientation") = dp.orientation,
             "Every argument defaults to the C++ CloudModelParams default.")
       .def_readwrite ("k", &CloudModelParams::k)
       .def_readwrite ("noise", &CloudModelParams::noise)
       .def_readwrite ("surface_projection", &CloudModelParams::surface_projection)
+      .def_readwrite ("surface", &CloudModelParams::surface,
+                      "Build the surface model CollisionRequest.surface queries (default False).")
+      .def_readwrite ("orientation", &CloudModelParams::orientation,
+                      "How the surface model's normals are oriented (NormalOrientation, default Auto).")
       .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
                      [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
       .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },
@@ -624,7 +705,8 @@ PYBIND11_MODULE (_core, m)
                ", surface_projection=" + (p.surface_projection ? "True" : "False") +
                ", n_max=" + std::to_string (p.hierarchy.n_max) + ", n_min=" + std::to_string (p.hierarchy.n_min) +
                ", sigma_max=" + num (p.hierarchy.sigma_max) + ", epsilon=" + num (p.hierarchy.epsilon) +
-               ", k_sigma=" + num (p.hierarchy.k_sigma) + ")";
+               ", k_sigma=" + num (p.hierarchy.k_sigma) + ", surface=" + (p.surface ? "True" : "False") +
+               ", orientation=NormalOrientation." + orientationEnumName (p.orientation) + ")";
       });
 
   // --- CollisionRequest ---------------------------------------------------------------------------
@@ -633,10 +715,13 @@ PYBIND11_MODULE (_core, m)
       "What a collision query computes and how. P < free_below is Free, P > collision_above InCollision.\n\n"
       "exhaustive: visit every reachable leaf pair instead of stopping once P > collision_above;\n"
       "per_point: fill probabilities_a/_b; enable_timings: fill build_ms/query_ms; traversal, rho_min, seed,\n"
-      "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier.")
+      "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier;\n"
+      "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
+      "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
+      "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN.")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
-                          double expanded_k_sigma, bool defer_kernel_fits) {
+                          double expanded_k_sigma, bool defer_kernel_fits, bool surface) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -648,6 +733,7 @@ PYBIND11_MODULE (_core, m)
               r.seed = seed;
               r.expanded_k_sigma = expanded_k_sigma;
               r.defer_kernel_fits = defer_kernel_fits;
+              r.surface = surface;
               return r;
             }),
             py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
@@ -655,6 +741,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("enable_timings") = dr.enable_timings, py::arg ("traversal") = dr.traversal,
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
+            py::arg ("surface") = dr.surface,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -666,6 +753,8 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("seed", &CollisionRequest::seed)
       .def_readwrite ("expanded_k_sigma", &CollisionRequest::expanded_k_sigma)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
+      .def_readwrite ("surface", &CollisionRequest::surface,
+                      "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {
@@ -674,7 +763,8 @@ PYBIND11_MODULE (_core, m)
                ", enable_timings=" + (r.enable_timings ? "True" : "False") + ", traversal=TraversalMode." +
                traversalName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
                ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
-               ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") + ")";
+               ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
+               ", surface=" + (r.surface ? "True" : "False") + ")";
       });
 
   // --- CollisionResult ----------------------------------------------------------------------------
@@ -690,6 +780,13 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("message", &CollisionResult::message)
       .def_readonly ("verdict", &CollisionResult::verdict)
       .def_readonly ("probability", &CollisionResult::probability)
+      .def_readonly ("signed_distance", &CollisionResult::signed_distance,
+                     "Signed distance between the two surfaces in data units (the surface layer, METHOD.md 10a):\n"
+                     "> 0 the gap, < 0 minus the penetration depth. NaN when not computed: request.surface off, a\n"
+                     "model built without CloudModelParams.surface, or the surfaces never came within reach.")
+      .def_readonly ("signed_distance_std", &CollisionResult::signed_distance_std,
+                     "Standard deviation of signed_distance (both clouds' noise, the fitted surfaces' uncertainty,\n"
+                     "the discretisation between samples); NaN with it.")
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
       .def_readonly ("no_leaf_tested", &CollisionResult::no_leaf_tested)
       .def_readonly ("witness_side", &CollisionResult::witness_side)
@@ -711,14 +808,18 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("ok", &CollisionResult::ok)
       .def ("__repr__", [] (const CollisionResult& r) {
         std::string s = std::string ("CollisionResult(status=") + statusName (r.status) + ", verdict=Verdict." +
-                        verdictEnumName (r.verdict) + ", probability=" + num (r.probability) +
-                        ", lower_bound=" + (r.lower_bound ? "True" : "False") +
-                        ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
-                        ", witness_side=" + std::to_string (r.witness_side) +
-                        ", witness_index=" + std::to_string (r.witness_index) +
-                        ", points_a=" + std::to_string (r.points_a) + ", points_b=" + std::to_string (r.points_b) +
-                        ", leaf_pairs_tested=" + std::to_string (r.leaf_pairs_tested) +
-                        ", bv_tests=" + std::to_string (r.bv_tests);
+                        verdictEnumName (r.verdict) + ", probability=" + num (r.probability);
+        if (!std::isnan (r.signed_distance))
+          s += ", signed_distance=" + num (r.signed_distance);
+        if (!std::isnan (r.signed_distance_std))
+          s += ", signed_distance_std=" + num (r.signed_distance_std);
+        s = s + ", lower_bound=" + (r.lower_bound ? "True" : "False") +
+            ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
+            ", witness_side=" + std::to_string (r.witness_side) +
+            ", witness_index=" + std::to_string (r.witness_index) +
+            ", points_a=" + std::to_string (r.points_a) + ", points_b=" + std::to_string (r.points_b) +
+            ", leaf_pairs_tested=" + std::to_string (r.leaf_pairs_tested) +
+            ", bv_tests=" + std::to_string (r.bv_tests);
         if (!r.message.empty ())
           s += ", message=" + std::string (py::repr (py::str (r.message)));
         return s + ")";
@@ -739,6 +840,15 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("bytes", &CloudModel::bytes, "Memory held, bytes.")
       .def_property_readonly ("precision_ratio", &CloudModel::precisionRatio)
       .def_property_readonly ("params", &CloudModel::params, "The CloudModelParams it was built with.")
+      .def_property_readonly ("has_surface", [] (const CloudModel& c) { return !c.surface ().empty (); },
+                              "True when built with CloudModelParams.surface (the surface layer can query it).")
+      .def_property_readonly ("surface_orientation",
+                              [] (const CloudModel& c) -> py::object {
+                                if (c.surface ().empty ())
+                                  return py::none ();
+                                return py::cast (c.surface ().orientation ());
+                              },
+                              "The NormalOrientation the surface model used (Auto resolved), None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +
@@ -750,11 +860,11 @@ PYBIND11_MODULE (_core, m)
   // --- functions ----------------------------------------------------------------------------------
   m.def ("build_model",
          [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
-             const py::object& viewpoint) {
-           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name, viewpoint));
+             const py::object& viewpoint, const py::object& normals) {
+           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name, viewpoint, normals));
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
-         py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (),
+         py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
          "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
          "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
@@ -762,6 +872,9 @@ PYBIND11_MODULE (_core, m)
          "params: CloudModelParams (None = CloudModelParams()).\n"
          "name: what error messages call the cloud.\n"
          "viewpoint: optional sensor pose tx ty tz qw qx qy qz (a PCD's VIEWPOINT; None = the origin, looking along +z).\n"
+         "normals: optional (N, 3) float32/float64 outward unit normals (a mesh's: sample_mesh_with_normals), used by\n"
+         "    the surface model (params.surface) under the Auto and PointNormals orientations; a row with NaN or 0 has\n"
+         "    none. The points' model is the same with or without them (pcl::PointNormal instead of pcl::PointXYZ).\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
@@ -822,6 +935,30 @@ PYBIND11_MODULE (_core, m)
          },
          py::arg ("vertices"), py::arg ("triangles"), py::arg ("spacing"), py::arg ("seed") = 20111,
          "pcd_collision's MeshSampled-mode samples (vertices first, then area samples at `spacing`), float32 (N, 3).");
+  m.def ("sample_mesh_with_normals",
+         [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
+           const auto mesh = meshOf (vertices, triangles);
+           pcl::PointCloud<pcl::PointNormal> cloud;
+           {
+             py::gil_scoped_release release;
+             cloud = pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed);
+           }
+           py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
+           py::array_t<float> normals ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
+           auto p = points.mutable_unchecked<2> ();
+           auto n = normals.mutable_unchecked<2> ();
+           for (std::size_t i = 0; i < cloud.size (); ++i)
+             for (int d = 0; d < 3; ++d)
+             {
+               p (static_cast<py::ssize_t> (i), d) = cloud[i].data[d];
+               n (static_cast<py::ssize_t> (i), d) = cloud[i].data_n[d];
+             }
+           return py::make_tuple (points, normals);
+         },
+         py::arg ("vertices"), py::arg ("triangles"), py::arg ("spacing"), py::arg ("seed") = 20111,
+         "sample_mesh()'s points (the same ones) with outward unit normals, float32 (N, 3) each: a sample's is its\n"
+         "triangle's, a vertex's the area-weighted mean of its triangles' (faces wound counter-clockwise seen from\n"
+         "outside). pcd_collision's mesh input with -surface: build_model(points, zeros, params, normals=normals).");
   m.def ("mesh_diagonal",
          [] (const py::object& vertices, const py::object& triangles) {
            return pcl_probcollision::io::meshDiagonal (meshOf (vertices, triangles));

@@ -16,6 +16,7 @@ from ._core import (  # noqa: F401
     CloudModelParams,
     CollisionRequest,
     CollisionResult,
+    NormalOrientation,
     SensorNoiseModel,
     TraversalMode,
     Verdict,
@@ -31,6 +32,7 @@ from ._core import (  # noqa: F401
     read_cloud,
     read_mesh,
     sample_mesh,
+    sample_mesh_with_normals,
     verdict_for,
 )
 
@@ -39,6 +41,7 @@ __all__ = [
     "CloudModelParams",
     "CollisionRequest",
     "CollisionResult",
+    "NormalOrientation",
     "SensorNoiseModel",
     "TraversalMode",
     "Verdict",
@@ -54,5 +57,6 @@ __all__ = [
     "read_cloud",
     "read_mesh",
     "sample_mesh",
+    "sample_mesh_with_normals",
     "verdict_for",
 ]

@@ -52,3 +52,19 @@ def translation(x=0.0, y=0.0, z=0.0):
     T = np.eye(4)
     T[:3, 3] = (x, y, z)
     return T
+
+
+def write_pcd(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
+    """A binary PCD with x y z float32 fields."""
+    points = np.ascontiguousarray(points, dtype="<f4")
+    header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+              f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT {' '.join(repr(float(v)) for v in viewpoint)}\n"
+              f"POINTS {len(points)}\nDATA binary\n")
+    pathlib.Path(path).write_bytes(header.encode("ascii") + points.tobytes())
+
+
+def sheet(n=30, size=0.06, noise=5e-4, seed=1):
+    """A noisy flat n x n sheet in z = 0 (a scanned plane: the noise is along z), float32."""
+    pts = patch(n, size, seed=seed).astype(np.float64)
+    pts[:, 2] += np.random.default_rng(seed + 100).normal(scale=noise, size=len(pts))
+    return pts.astype(np.float32)

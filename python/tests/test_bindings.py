@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pcl_probcollision as pc
-from conftest import patch, translation
+from conftest import DATA, patch, sheet, translation, write_pcd
 
 NOISE = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005))
 Z = [0.0, 0.004, 0.006, 0.01, 0.03]  # patch heights over the table: collision .. contact .. free
@@ -20,6 +20,8 @@ def same_result(r, s):
     assert r.status == s.status and r.message == s.message
     assert r.verdict == s.verdict
     assert r.probability == s.probability  # exact, not approx
+    # The surface layer's distance: exact too, NaN (not computed) on both sides alike.
+    np.testing.assert_array_equal([r.signed_distance, r.signed_distance_std], [s.signed_distance, s.signed_distance_std])
     for f in ("lower_bound", "no_leaf_tested", "witness_side", "witness_index", "points_a", "points_b",
               "points_skipped_nonfinite", "bv_tests", "leaf_pairs_tested", "kernel_leaf_pairs",
               "degenerate_leaf_pairs", "classifier_iterations"):
@@ -51,17 +53,21 @@ def test_defaults_are_the_cpp_defaults():
     r = pc.CollisionRequest()
     assert (r.free_below, r.collision_above, r.exhaustive, r.per_point, r.rho_min, r.seed) == (0.1, 0.9, False, False, 1e-3, 1)
     assert r.traversal == pc.TraversalMode.ExpectedWeight and r.expanded_k_sigma == 3.0
+    assert r.surface is False
     p = pc.CloudModelParams()
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
+    assert p.surface is False and p.orientation == pc.NormalOrientation.Auto
+    assert [o.name for o in pc.NormalOrientation.__members__.values()] == ["Auto", "PointNormals", "Viewpoint", "Propagate"]
     assert p.noise.name == pc.SensorNoiseModel.none().name
     # help() shows every parameter with its default.
     doc = pc.CollisionRequest.__init__.__doc__
     for text in ("free_below: float = 0.1", "collision_above: float = 0.9", "exhaustive: bool = False",
-                 "per_point: bool = False", "rho_min: float = 0.001", "seed: int = 1"):
+                 "per_point: bool = False", "rho_min: float = 0.001", "seed: int = 1", "surface: bool = False"):
         assert text in doc, text
     doc = pc.CloudModelParams.__init__.__doc__
     for text in ("k: int = 10", "n_max: int = 20", "n_min: int = 8", "sigma_max: float = 0.05", "epsilon: float = 0.02",
-                 "noise: pcl_probcollision._core.SensorNoiseModel = SensorNoiseModel.none()"):
+                 "noise: pcl_probcollision._core.SensorNoiseModel = SensorNoiseModel.none()", "surface: bool = False",
+                 "orientation: pcl_probcollision._core.NormalOrientation = <NormalOrientation.Auto: 0>"):
         assert text in doc, text
     assert "threads: int = 0" in pc.collide_batch.__doc__
 
@@ -229,6 +235,128 @@ def test_result_repr_and_verdict_enum(table, gripper_patch):
     assert timed.query_ms >= 0
     assert "size=10848" in repr(table)
     assert np.isnan(pc.CollisionResult().probability) and pc.CollisionResult().verdict == pc.Verdict.Unknown
+
+
+# --- the surface layer (issue #16): signed distances -----------------------------------------------
+
+SURFACE = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True)
+GAPS = [-0.004, -0.002, 0.002, 0.004]  # b's height over a: penetrating .. clear
+
+
+@pytest.fixture(scope="module")
+def sheets():
+    """A noisy 6 cm sheet a with outward normals up (+z) and a 3 cm sheet b with normals down,
+    as numpy points with normals."""
+    a, b = sheet(30, 0.06, seed=1), sheet(20, 0.03, seed=2)
+    up = np.tile(np.float32([0, 0, 1]), (len(a), 1))
+    return a, b, pc.build_model(a, params=SURFACE, normals=up), pc.build_model(b, params=SURFACE, normals=-up[:len(b)])
+
+
+def test_surface_signed_distance_has_the_sign_of_the_gap(sheets):
+    _, _, A, B = sheets
+    assert A.has_surface and B.has_surface
+    assert A.surface_orientation == B.surface_orientation == pc.NormalOrientation.PointNormals
+    request = pc.CollisionRequest(surface=True)
+    for z in GAPS:
+        r = pc.collide(A, B, translation(0.005, -0.003, z), request)
+        assert r.ok and np.isfinite(r.signed_distance) and np.isfinite(r.signed_distance_std), z
+        assert np.sign(r.signed_distance) == np.sign(z), (z, r.signed_distance)
+        assert abs(r.signed_distance - z) < 1e-3, (z, r.signed_distance)
+        assert 0 < r.signed_distance_std < 3e-3
+        # penetrating is a collision, a 4 mm gap (4 sigma) free
+        assert r.verdict == {-0.004: pc.Verdict.InCollision, 0.004: pc.Verdict.Free}.get(z, r.verdict)
+        text = repr(r)
+        assert f"signed_distance={r.signed_distance!r}, signed_distance_std={r.signed_distance_std!r}" in text
+    # Out of reach: no leaf pair, no distance.
+    far = pc.collide(A, B, translation(0, 0, 0.2), request)
+    assert far.no_leaf_tested and np.isnan(far.signed_distance) and np.isnan(far.signed_distance_std)
+    assert "signed_distance" not in repr(far)
+
+
+def test_surface_signed_distance_is_nan_when_off(sheets):
+    a, b, A, B = sheets
+    T = translation(0.005, -0.003, -0.002)
+    off = pc.collide(A, B, T)  # request.surface off: the separators answer
+    assert np.isnan(off.signed_distance) and np.isnan(off.signed_distance_std)
+    assert "signed_distance" not in repr(off)
+    # request.surface on, models built without a surface: the separators answer as well, the
+    # same answer bit for bit as without the request's flag.
+    plain = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    A0, B0 = pc.build_model(a, params=plain), pc.build_model(b, params=plain)
+    assert not A0.has_surface and A0.surface_orientation is None
+    r = pc.collide(A0, B0, T, pc.CollisionRequest(surface=True))
+    assert np.isnan(r.signed_distance)
+    same_result(r, pc.collide(A0, B0, T))
+    # The surface only adds to the points' model: the separators' answer is unchanged by it.
+    same_result(off, r)
+
+
+def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
+    # The sheets as scans, a seen from above and b from below (PCD VIEWPOINT; Auto orients them
+    # toward it): load_model of the files and build_model of the same floats with the same
+    # viewpoint give the same surface answers bit for bit, collide and collide_batch alike.
+    a, b, _, _ = sheets
+    view_a, view_b = (0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0), (0.0, 0.0, -0.5, 1.0, 0.0, 0.0, 0.0)
+    write_pcd(tmp_path / "a.pcd", a, view_a)
+    write_pcd(tmp_path / "b.pcd", b, view_b)
+    files = pc.load_model(tmp_path / "a.pcd", SURFACE), pc.load_model(tmp_path / "b.pcd", SURFACE)
+    arrays = (pc.build_model(a, params=SURFACE, viewpoint=view_a, name="a.pcd"),
+              pc.build_model(b, params=SURFACE, viewpoint=view_b, name="b.pcd"))
+    assert files[0].surface_orientation == arrays[0].surface_orientation == pc.NormalOrientation.Viewpoint
+    request = pc.CollisionRequest(surface=True, exhaustive=True, per_point=True)
+    poses = np.array([translation(0.005, -0.003, z) for z in GAPS + [0.2]])
+    batch = pc.collide_batch(*arrays, poses, request, threads=2)
+    for T, z, rb in zip(poses, GAPS + [0.2], batch):
+        r, s = pc.collide(*files, T, request), pc.collide(*arrays, T, request)
+        same_result(r, s)
+        same_result(rb, s)
+        if z < 0.1:
+            assert np.sign(r.signed_distance) == np.sign(z) and abs(r.signed_distance - z) < 1e-3, (z, r.signed_distance)
+        else:
+            assert np.isnan(r.signed_distance)
+
+
+def test_surface_normals_and_orientation_options(sheets):
+    a, b, A, B = sheets
+    # The normals change the surface only: the points' model (origin, size) is the same.
+    A0 = pc.build_model(a, params=SURFACE)
+    np.testing.assert_array_equal(A0.origin, A.origin)
+    assert A0.size == A.size and A0.surface_orientation == pc.NormalOrientation.Propagate  # viewpoint inside
+    for mode in (pc.NormalOrientation.Propagate, pc.NormalOrientation.Viewpoint):
+        p = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, orientation=mode)
+        assert p.orientation == mode and f"orientation=NormalOrientation.{mode.name}" in repr(p)
+        view = (0.0, 0.0, 0.5, 1.0, 0.0, 0.0, 0.0)
+        assert pc.build_model(a, params=p, viewpoint=view).surface_orientation == mode
+    # Flipped normals flip the sign: b seen as having its outside up, a's points are inside it.
+    flipped = pc.build_model(b, params=SURFACE, normals=np.tile([0.0, 0.0, 1.0], (len(b), 1)))
+    r = pc.collide(A, flipped, translation(0.005, -0.003, 0.004), pc.CollisionRequest(surface=True))
+    assert r.signed_distance < 0
+    # NaN or zero rows have no normal (oriented from their neighbours); bad ones are refused.
+    partial = np.tile(np.float32([0, 0, 1]), (len(a), 1))
+    partial[::3] = np.nan
+    partial[1::3] = 0
+    assert pc.build_model(a, params=SURFACE, normals=partial).surface_orientation == pc.NormalOrientation.PointNormals
+    with pytest.raises(ValueError, match="normals"):
+        pc.build_model(a, normals=np.zeros((len(a) - 1, 3)))
+    with pytest.raises(ValueError, match="normals"):
+        pc.build_model(a, normals=np.zeros((len(a), 2)))
+    with pytest.raises(ValueError, match="unit length"):
+        pc.build_model(a, normals=np.tile([0.0, 0.0, 2.0], (len(a), 1)))
+    with pytest.raises(TypeError, match="normals"):
+        pc.build_model(a, normals=np.zeros((len(a), 3), dtype=np.int32))
+
+
+def test_sample_mesh_with_normals_is_sample_mesh_with_outward_normals():
+    V, F = pc.read_mesh(DATA / "gripper.obj")
+    points, normals = pc.sample_mesh_with_normals(V, F, 0.004)
+    np.testing.assert_array_equal(points, pc.sample_mesh(V, F, 0.004))
+    assert points.dtype == normals.dtype == np.float32 and normals.shape == points.shape
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-5)
+    # Outward: on the whole, normals point away from the mesh's centre.
+    assert np.mean(np.sum((points - points.mean(axis=0)) * normals, axis=1)) > 0
+    # The gripper's exact model with its faces' normals, as pcd_collision builds it with -surface.
+    g = pc.build_model(points, np.zeros((len(points), 3, 3)), params=pc.CloudModelParams(surface=True), normals=normals)
+    assert g.surface_orientation == pc.NormalOrientation.PointNormals
 
 
 # --- the bad-input table (docs/RELIABILITY.md) ----------------------------------------------------

@@ -51,6 +51,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "stochastic": _REQUEST.traversal == core.TraversalMode.Stochastic,
     "seed": _REQUEST.seed,
     "exhaustive": _REQUEST.exhaustive,
+    # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
+    # their faces, clouds by their viewpoint or by propagation) and signed_distance is filled.
+    "surface": _REQUEST.surface,
     "nmax": _MODEL.n_max,
     "sigma_max": _MODEL.sigma_max,
     "epsilon": _MODEL.epsilon,
@@ -110,7 +113,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
     for a mesh's exact samples, whose covariances are given)."""
     p = core.CloudModelParams(k=int(o["k"]), surface_projection=not o["measured"], n_max=int(o["nmax"]),
                               n_min=min(_N_MIN, int(o["nmax"])), sigma_max=float(o["sigma_max"]),
-                              epsilon=float(o["epsilon"]))
+                              epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
     p.split = o["split"]
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
@@ -123,7 +126,7 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         free_below=o["thresholds"][0], collision_above=o["thresholds"][1], exhaustive=bool(o["exhaustive"]),
         per_point=False, enable_timings=True,
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
-        seed=int(o["seed"]))
+        seed=int(o["seed"]), surface=bool(o["surface"]))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -176,9 +179,10 @@ def prepare_input(x, name: Optional[str] = None) -> Dict[str, Any]:
 
 def _sample_meshes(a: Dict[str, Any], b: Dict[str, Any], o: Dict[str, Any]) -> None:
     """pcd_collision's MeshSampled mode: spacing from mesh_density, the other cloud, or the meshes'
-    size; the samples become the input's points (exact: zero covariance)."""
+    size; the samples become the input's points (exact: zero covariance). With surface, the
+    samples carry their faces' outward normals (the same points), as pcd_collision's do."""
     for m, other in ((a, b), (b, a)):
-        if m["kind"] != "mesh" or "points" in m:
+        if m["kind"] != "mesh" or ("points" in m and (not o["surface"] or m.get("normals") is not None)):
             continue
         t0 = time.perf_counter()
         if o["mesh_density"] is not None:
@@ -192,22 +196,30 @@ def _sample_meshes(a: Dict[str, Any], b: Dict[str, Any], o: Dict[str, Any]) -> N
             source = "both inputs are meshes: 1/100 of the larger bounding-box diagonal"
         if not (spacing > 0.0 and math.isfinite(spacing)):
             raise ValueError(f"cannot choose a sample spacing for mesh '{m['path']}' ({source} is 0); give -mesh_density")
-        m["points"] = core.sample_mesh(m["vertices"], m["triangles"], spacing, _MESH_SEED)
+        if o["surface"]:
+            m["points"], m["normals"] = core.sample_mesh_with_normals(m["vertices"], m["triangles"], spacing, _MESH_SEED)
+        else:
+            m["points"] = core.sample_mesh(m["vertices"], m["triangles"], spacing, _MESH_SEED)
         m["spacing"], m["spacing_source"] = spacing, source
         m["finite"] = len(m["points"])
         m["sample_ms"] = (time.perf_counter() - t0) * 1e3
 
 
-def _scattered(spec: Dict[str, Any]) -> Dict[str, Any]:
-    """What a worker needs to build the model, with a content token for its cache."""
+def _scattered(spec: Dict[str, Any], surface: bool = False) -> Dict[str, Any]:
+    """What a worker needs to build the model, with a content token for its cache; a mesh's
+    normals only with surface (the model of the points is the same without them)."""
+    normals = spec.get("normals") if surface else None
     h = hashlib.blake2b(digest_size=16)
     h.update(spec["kind"].encode())
     h.update(np.ascontiguousarray(spec["points"]).tobytes())
     h.update(str(spec["points"].dtype).encode())
     if spec.get("viewpoint") is not None:
         h.update(np.asarray(spec["viewpoint"], dtype=np.float64).tobytes())
+    if normals is not None:
+        h.update(b"normals")
+        h.update(np.ascontiguousarray(normals).tobytes())
     return {"token": h.hexdigest(), "kind": spec["kind"], "name": spec["name"], "points": spec["points"],
-            "viewpoint": spec.get("viewpoint")}
+            "viewpoint": spec.get("viewpoint"), "normals": normals}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -221,7 +233,7 @@ _builds = collections.Counter()  # models built in this process, by token (tests
 
 
 def _params_key(o: Dict[str, Any], side: str, exact: bool) -> tuple:
-    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split")
+    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface")
     noise = () if exact else (o["sensor_" + side], float(o["sigma_" + side]))
     return tuple(o[k] for k in keys) + noise
 
@@ -244,7 +256,7 @@ def _model(spec: Dict[str, Any], o: Dict[str, Any], side: str):
             points = spec["points"]
             covariances = np.zeros((len(points), 3, 3), dtype=np.float32) if exact else None
             model = core.build_model(points, covariances=covariances, params=model_params(o, side, exact),
-                                     name=spec["name"], viewpoint=spec["viewpoint"])
+                                     name=spec["name"], viewpoint=spec["viewpoint"], normals=spec.get("normals"))
             with _cache_lock:
                 _cache[key] = model
                 _builds[spec["token"]] += 1
@@ -270,8 +282,9 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         "status": np.array([int(r.status) for r in results], dtype=np.int8),
         "lower_bound": np.array([r.lower_bound for r in results], dtype=bool),
         "no_leaf_tested": np.array([r.no_leaf_tested for r in results], dtype=bool),
-        "signed_distance": np.array([getattr(r, "signed_distance", math.nan) for r in results], dtype=np.float64),
-        "signed_distance_std": np.array([getattr(r, "signed_distance_std", math.nan) for r in results], dtype=np.float64),
+        # NaN without surface (or where the surfaces never came within reach), as in CollisionResult.
+        "signed_distance": np.array([r.signed_distance for r in results], dtype=np.float64),
+        "signed_distance_std": np.array([r.signed_distance_std for r in results], dtype=np.float64),
         "witness_side": np.array([r.witness_side for r in results], dtype=np.int8),
         "query_ms": np.array([r.query_ms for r in results], dtype=np.float64),
     }
@@ -294,10 +307,11 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
 
 class BatchResults:
     """Answers in pose order, one numpy array per field: probability, verdict (int8 of Verdict),
-    status, lower_bound, no_leaf_tested, signed_distance(_std), the counters (points_a, points_b,
-    points_skipped_nonfinite, leaf_pairs_tested, bv_tests, kernel_leaf_pairs,
-    degenerate_leaf_pairs, classifier_iterations), witness_side/_index/_point/_normal (b's frame),
-    query_ms; inputs describes a and b; chunk_size and chunks how it was split."""
+    status, lower_bound, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
+    the counters (points_a, points_b, points_skipped_nonfinite, leaf_pairs_tested, bv_tests,
+    kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
+    witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; chunk_size
+    and chunks how it was split."""
 
     def __init__(self, fields: Dict[str, np.ndarray], inputs, chunk_size: int, chunks: int, build_ms: float):
         self.fields = fields
@@ -372,14 +386,17 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     client: a distributed.Client; None = the default client if there is one, else this process.
     chunk_size: poses per task (default: about 8 tasks per worker thread, 32 to 2000 poses).
     options: pcd_collision's flags without the dash (sensor, sensor_a, sensor_b, sigma, sigma_a,
-        sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, nmax,
+        sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, surface, nmax,
         sigma_max, epsilon, split, mesh_density) and threads (collide_batch threads per task).
+        surface=True is pcd_collision's -surface: both models get the oriented surface (meshes
+        by their faces' normals) and signed_distance / signed_distance_std are filled (NaN
+        otherwise, and for poses where the surfaces never came within reach).
     Returns BatchResults in pose order, identical to the single-process answers."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)
     A, B = prepare_input(a, "a"), prepare_input(b, "b")
     _sample_meshes(A, B, o)
-    sa, sb = _scattered(A), _scattered(B)
+    sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)
     if client is None:
         client = _default_client()

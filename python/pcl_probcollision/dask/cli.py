@@ -11,7 +11,6 @@ import time
 
 import numpy as np
 
-from .. import _core as core
 from . import collide_poses, connect, prepare_input
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
@@ -24,15 +23,15 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   --timeout S                    seconds to reach the scheduler (default 10)
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
-  -measured -deterministic -stochastic -seed -exhaustive -nmax -sigma_max -epsilon -split
+  -measured -deterministic -stochastic -seed -exhaustive -surface -nmax -sigma_max -epsilon -split
   -mesh_density -json (accepted; the output is always JSON lines) -v. A value is the next argument
-  or follows '='.
+  or follows '='. -surface (experimental) adds the signed distance between the surfaces.
 """
 
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
           "split": str, "mesh_density": float}
-_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "json", "v")
+_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "surface", "json", "v")
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
 _FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
 _INT = re.compile(r"[+-]?\d+\Z")
@@ -210,16 +209,12 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"sigma_b":{sigma_b},"k":{int(o["k"])},"thresholds":{_nums(o["thresholds"])},'
                   f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
                   f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
-                  f'"exhaustive":{_bool(o["exhaustive"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
+                  f'"exhaustive":{_bool(o["exhaustive"])},"surface":{_bool(o["surface"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
     inputs = f'{{"a":{_input_json(a)},"b":{_input_json(b)}}}'
     sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
-    # The surface layer's keys, once the bindings expose them (issue #16).
-    has_surface = hasattr(core.CollisionResult(), "signed_distance")
-
+    # The surface layer's signed distance: null without -surface or out of reach, as pcd_collision.
     def surface(i):
-        if not has_surface:
-            return ""
         return f'"signed_distance":{_num(r.signed_distance[i])},"signed_distance_std":{_num(r.signed_distance_std[i])},'
 
     for i in range(len(r)):
