@@ -62,9 +62,9 @@ dataDir ()
 /** \brief The mesh sampled to about target points as the evaluation samples it, with
   * N(0, sigma^2) on every coordinate. */
 CloudXYZ::Ptr
-noisySamples (const TriangleMesh& mesh, std::size_t target, double sigma, std::uint64_t seed)
+noisySamples (const TriangleMesh& mesh, std::size_t target, double sigma, std::uint64_t seed, Outward* outward = nullptr)
 {
-  return addNoise (*sampleCount (mesh, target, seed), sigma, seed + 7);
+  return addNoise (*sampleCount (mesh, target, seed, outward), sigma, seed + 7);
 }
 
 /** \brief The two meshes and the noise level (all a build benchmark needs). */
@@ -113,6 +113,7 @@ struct Workload
   const Meshes* m = nullptr;
   double sigma = 0.0;
   CloudXYZ::Ptr piano, room;
+  Outward piano_sides, room_sides;  ///< the side each point was seen from (ScanSides)
   std::vector<PoseTruth> uniform, near;
   std::unique_ptr<ProbabilisticCollision<pcl::PointXYZ>> ours;  // hierarchies prebuilt
   std::unique_ptr<OctomapBaseline> octomap;                     // 2 sigma, vs the piano mesh
@@ -127,8 +128,8 @@ workload ()
     const auto start = Clock::now ();
     w.m = &meshes ();
     w.sigma = w.m->sigma;
-    w.piano = noisySamples (w.m->rob_mesh, 10000, w.sigma, 801);
-    w.room = noisySamples (w.m->env_mesh, 10000, w.sigma, 802);
+    w.piano = noisySamples (w.m->rob_mesh, 10000, w.sigma, 801, &w.piano_sides);
+    w.room = noisySamples (w.m->env_mesh, 10000, w.sigma, 802, &w.room_sides);
     w.uniform = uniformPoseTruths (*w.m->exact, 2000, 803, 2);
     NearContactOptions nc;
     nc.band = 0.02 * w.m->diagonal;
@@ -142,9 +143,18 @@ workload ()
     w.ours->setRequest (setting.request);
     w.ours->setInputModelParams (params);
     w.ours->setTargetModelParams (params);
-    // The models are built once here, as a planner would, and handed over prebuilt.
-    w.ours->setInputModel (buildCloudModel (*w.piano, params, nullptr, nullptr, "piano"));
-    w.ours->setTargetModel (buildCloudModel (*w.room, params, nullptr, nullptr, "room"));
+    // The models are built once here, as a planner would, and handed over prebuilt; with the
+    // surface layer, from the clouds oriented as the evaluation orients them (ScanSides).
+    if (params.surface)
+    {
+      w.ours->setInputModel (buildCloudModel (*orientedScan (*w.piano, w.piano_sides, params.k), params, nullptr, nullptr, "piano"));
+      w.ours->setTargetModel (buildCloudModel (*orientedScan (*w.room, w.room_sides, params.k), params, nullptr, nullptr, "room"));
+    }
+    else
+    {
+      w.ours->setInputModel (buildCloudModel (*w.piano, params, nullptr, nullptr, "piano"));
+      w.ours->setTargetModel (buildCloudModel (*w.room, params, nullptr, nullptr, "room"));
+    }
 
     w.octomap.reset (new OctomapBaseline);
     w.octomap->buildEnv (*w.room, 2.0 * w.sigma);

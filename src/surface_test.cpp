@@ -68,6 +68,10 @@ struct Scratch
   std::vector<std::uint32_t> pooled, cached;  ///< stamps per point of the surface's model
   std::vector<Sample> cache;                  ///< the surface's samples mapped into A's frame
   std::vector<int> pool;
+  /** \brief Per pool entry, its sample's distance from the query leaf's centre; pool and keys
+    * sorted by it, so that a nearest-sample search can stop early (triangle inequality). */
+  std::vector<double> keys;
+  std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
 
@@ -109,14 +113,19 @@ struct Evaluation
   * covariance along the normal (variance_of), the fit's error and the discretisation. */
 template <typename VarianceOf>
 bool
-evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vector<Sample>& samples,
-          const VarianceOf& variance_of, Evaluation& out)
+evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vector<double>& keys, double x_key,
+          const std::vector<Sample>& samples, const VarianceOf& variance_of, Evaluation& out)
 {
   std::array<int, kSurfaceNeighbours> nearest;
   std::array<double, kSurfaceNeighbours> d2;
   int found = 0;
-  for (const int j : pool)
+  for (std::size_t k = 0; k < pool.size (); ++k)
   {
+    // |p - x| >= key(p) - key(x): past this, no sample is nearer than the current 8th.
+    const double bound = keys[k] - x_key;
+    if (found == kSurfaceNeighbours && bound > 0.0 && bound * bound >= d2[kSurfaceNeighbours - 1])
+      break;
+    const int j = pool[k];
     const double d = (samples[static_cast<std::size_t> (j)].position - x).squaredNorm ();
     if (found == kSurfaceNeighbours && d >= d2[kSurfaceNeighbours - 1])
       continue;
@@ -321,13 +330,25 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       }
     if (scratch.pool.empty ())
       continue;
+    // The pool sorted by distance from the query leaf's centre.
+    const Eigen::Vector3d center = T_q * q_bvh.node (q_leaf).box.center;
+    scratch.order.clear ();
+    for (const int j : scratch.pool)
+      scratch.order.emplace_back ((scratch.cache[static_cast<std::size_t> (j)].position - center).norm (), j);
+    std::sort (scratch.order.begin (), scratch.order.end ());
+    scratch.keys.resize (scratch.order.size ());
+    for (std::size_t k = 0; k < scratch.order.size (); ++k)
+    {
+      scratch.keys[k] = scratch.order[k].first;
+      scratch.pool[k] = scratch.order[k].second;
+    }
     for (const int i : q_bvh.indices (q_bvh.node (q_leaf)))
     {
       const std::size_t qi = static_cast<std::size_t> (i);
       const Eigen::Vector3d x = T_q * q_bvh.means ()[qi];
       const PackedCovariance& cov = q_bvh.covariances ()[qi];
       Evaluation e;
-      if (!evaluate (x, scratch.pool, scratch.cache,
+      if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
                      [&] (const Eigen::Vector3d& n) { return std::max (0.0, cov.quadratic (R_q.transpose () * n)); }, e))
         continue;
       ++answer.points_tested;
@@ -379,6 +400,92 @@ nearestSampleDistance (const CloudModel& model, const Eigen::Vector3d& x)
     best = std::min (best, (p - x).squaredNorm ());
   return std::sqrt (best);
 }
+/** \brief A point of one object found inside the other, away from its surface. */
+struct DeepPoint
+{
+  bool found = false;
+  int side = 1;
+  int index = -1;         ///< hierarchy index in its own model
+  Eigen::Vector3d point;  ///< in A's local frame
+  double depth = 0.0;     ///< distance to the other's nearest sample
+};
+
+/** \brief True when some leaf box of `s_bvh` (mapped into the box's frame by T_box_s), grown by
+  * margin as the box is, overlaps box: the surface may pass through it. */
+bool
+nearSurface (const ProbabilisticBVH& s_bvh, const OrientedBox& box, const Eigen::Isometry3d& T_box_s, double margin,
+             std::vector<std::int32_t>& stack)
+{
+  stack.assign (1, ProbabilisticBVH::rootId ());
+  while (!stack.empty ())
+  {
+    const ProbabilisticBVH::Node& node = s_bvh.node (stack.back ());
+    stack.pop_back ();
+    if (disjoint (box, node.box, T_box_s, margin))
+      continue;
+    if (node.isLeaf ())
+      return true;
+    for (int c = 0; c < node.num_children; ++c)
+      stack.push_back (node.first_child + c);
+  }
+  return false;
+}
+
+/** \brief The nodes of `query` whose boxes no leaf of `surface` comes near (the surface does not
+  * pass through them, so all their points lie on one side of it), from the root down: the
+  * winding number of one point per node says which side. In decision mode (exhaustive false)
+  * returns the first node found inside; otherwise the deepest, every inside node's points marked
+  * in per_point. T_q and T_s map the two models into A's frame. */
+DeepPoint
+deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface, const Eigen::Isometry3d& T_s,
+            double margin, bool exhaustive, std::vector<float>* per_point)
+{
+  thread_local std::vector<std::int32_t> nodes, stack;
+  const ProbabilisticBVH& q_bvh = query.hierarchy ();
+  const ProbabilisticBVH& s_bvh = surface.hierarchy ();
+  const Eigen::Isometry3d T_q_s = T_q.inverse () * T_s;  // surface frame -> query frame
+  const Eigen::Isometry3d T_s_q = T_q_s.inverse ();
+  const OrientedBox& bound = s_bvh.node (ProbabilisticBVH::rootId ()).box;
+  DeepPoint deep;
+  nodes.assign (1, ProbabilisticBVH::rootId ());
+  while (!nodes.empty ())
+  {
+    const std::int32_t id = nodes.back ();
+    nodes.pop_back ();
+    const ProbabilisticBVH::Node& node = q_bvh.node (id);
+    // Clear of the surface's bounding box: outside it, with everything below.
+    if (disjoint (node.box, bound, T_q_s))
+      continue;
+    if (nearSurface (s_bvh, node.box, T_q_s, margin, stack))
+    {
+      for (int c = 0; c < node.num_children; ++c)
+        nodes.push_back (node.first_child + c);
+      continue;  // a leaf near the surface was tested point by point
+    }
+    const int first = *q_bvh.indices (node).begin ();
+    const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (first)];
+    // Outside the surface's bounding box a point is outside it (behind an open sheet's box
+    // edge the winding number is below 1/2 too): no winding number needed.
+    if (((bound.axes.transpose () * (x - bound.center)).cwiseAbs () - bound.half_extents).maxCoeff () > 0.0 ||
+        surface.surface ().windingNumber (s_bvh, x) <= kInsideWinding)
+      continue;
+    // In decision mode the first inside node decides; otherwise the deepest one sets the depth.
+    const double depth = nearestSampleDistance (surface, x);
+    if (!deep.found || depth > deep.depth)
+    {
+      deep.found = true;
+      deep.index = first;
+      deep.point = T_q * q_bvh.means ()[static_cast<std::size_t> (first)];
+      deep.depth = depth;
+    }
+    if (!exhaustive)
+      return deep;
+    if (per_point)
+      for (const int i : q_bvh.indices (node))
+        (*per_point)[static_cast<std::size_t> (i)] = 1.0f;
+  }
+  return deep;
+}
 } // namespace
 
 SurfaceAnswer
@@ -425,44 +532,46 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
     if (!answer.stopped_early)
       testSide (b, T_a_b, a, Eigen::Isometry3d::Identity (), pairs, scratch, -1, per_point_b, stop_z, answer, best_z);
   }
-  if (answer.reached)
+  if (answer.stopped_early)
   {
     answer.probability = normalCdf (-best_z);
     return answer;
   }
-  // Out of reach of each other's surface: inside entirely, or apart. Only a trusted orientation
-  // (the points' own normals, a viewpoint) may declare containment: a propagated one can be
-  // inside out (a room seen from within), and would put everything inside.
+  // Out of reach of each other's surface: parts of one object deep inside the other (a piano
+  // pushed 30 cm through a wall: the wall's samples inside the piano are far from its surface),
+  // or one object entirely inside the other. Only a trusted orientation (the points' own normals,
+  // a viewpoint) may declare it: a propagated one can be inside out (a room seen from within).
   auto trusted = [] (const SurfaceModel& s) { return s.orientation () != NormalOrientation::Propagate; };
-  const Eigen::Vector3d a0 = bvh_a.means ().front ();
-  const Eigen::Vector3d a0_in_b = T_a_b.inverse () * a0;
-  const Eigen::Vector3d b0 = T_a_b * bvh_b.means ().front ();
-  if (trusted (b.surface ()) && b.surface ().windingNumber (bvh_b, a0_in_b) > kInsideWinding)
+  const double margin = params.box_margin;
+  DeepPoint deep;
+  if (trusted (b.surface ()))
+    deep = deepInside (a, Eigen::Isometry3d::Identity (), b, T_a_b, margin, !may_stop, per_point_a);
+  if ((!deep.found || !may_stop) && trusted (a.surface ()))
   {
-    answer.reached = answer.contained = true;
-    answer.witness_side = 1;
-    answer.witness_index = 0;
-    answer.witness_point = a0;
-    answer.signed_distance = -nearestSampleDistance (b, a0_in_b);
+    DeepPoint other = deepInside (b, T_a_b, a, Eigen::Isometry3d::Identity (), margin, !may_stop, per_point_b);
+    other.side = -1;
+    if (other.found && (!deep.found || other.depth > deep.depth))
+      deep = other;
   }
-  else if (trusted (a.surface ()) && a.surface ().windingNumber (bvh_a, b0) > kInsideWinding)
+  if (deep.found)
   {
-    answer.reached = answer.contained = true;
-    answer.witness_side = -1;
-    answer.witness_index = 0;
-    answer.witness_point = b0;
-    answer.signed_distance = -nearestSampleDistance (a, b0);
+    const SurfaceModel& s = deep.side > 0 ? b.surface () : a.surface ();
+    const double depth = deep.depth;
+    answer.contained = !answer.reached;
+    answer.reached = true;
+    if (!(answer.signed_distance <= -depth))
+    {
+      answer.witness_side = deep.side;
+      answer.witness_index = deep.index;
+      answer.witness_point = deep.point;
+      answer.witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+      answer.signed_distance = -depth;
+      // The depth is measured to the nearest sample: uncertain by about one spacing.
+      answer.signed_distance_std = s.medianSpacing ();
+    }
+    best_z = -std::numeric_limits<double>::infinity ();
   }
-  if (answer.contained)
-  {
-    answer.probability = 1.0;
-    // The depth is measured from the nearest sample: uncertain by about one spacing.
-    answer.signed_distance_std = answer.witness_side > 0 ? b.surface ().medianSpacing () : a.surface ().medianSpacing ();
-    if (per_point_a && answer.witness_side > 0)
-      (*per_point_a)[0] = 1.0f;
-    if (per_point_b && answer.witness_side < 0)
-      (*per_point_b)[0] = 1.0f;
-  }
+  answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;
   return answer;
 }
 } // namespace detail

@@ -264,6 +264,22 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   EXPECT_TRUE (outside.no_leaf_tested);
 }
 
+// A small ball half inside a big closed surface: its far side lies deeper than any point's
+// reach of the big surface, and only the winding number of the nodes out of reach sees it.
+TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)
+{
+  const auto big = buildCloudModel (sphere (2000, 1.0, Eigen::Vector3d::Zero ()), withSurface ());
+  const auto ball = buildCloudModel (sphere (4000, 0.5, Eigen::Vector3d::Zero ()), withSurface ());
+  CollisionRequest request = surfaceRequest ();
+  request.exhaustive = true;
+  CollisionResult r;
+  ASSERT_TRUE (collide (*ball, *big, shift (0.7, 0.0, 0.0), request, r));
+  EXPECT_EQ (r.verdict, Verdict::InCollision);
+  // The ball's far side is 0.8 inside the big sphere; the points of leaves within reach of its
+  // surface are at most a leaf's size (about 0.2) deep.
+  EXPECT_LT (r.signed_distance, -0.5) << r.signed_distance << " witness side " << r.witness_side;
+}
+
 // Per-point values and the witness come back in the callers' frames.
 TEST (SurfaceLayer, PerPointValuesAndWitness)
 {
