@@ -319,7 +319,7 @@ sharedBuild ()
   b.model = OursSetting ().model;
   b.model.surface = true;
   for (const OursSetting& s : oursSettings (false))
-    if (s.name == "default" || s.name == "classifier" || s.name == "surface")
+    if (s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled")
     {
       pcl_probcollision::CloudModelParams m = s.model;
       m.surface = true;
@@ -981,7 +981,10 @@ issue16Targets (const Options& o, const std::vector<Summary>& summaries, const R
   oursTargets ("default");
   // While the surface layer is off by default, its own setting is judged too.
   if (!OursSetting ().request.surface)
+  {
     oursTargets ("surface");
+    oursTargets ("pooled");
+  }
   // The README demo through pcd_collision, without and with -surface. No comma in these rows:
   // scripts/evaluate.sh rewrites them with pcd_collision's answers.
   add ("the demo's pose 2 reads collision", "README demo (data/demo_poses.txt)", not_run, "collision", not_run,

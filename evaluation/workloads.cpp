@@ -36,12 +36,17 @@ oursSettings (bool full)
   surface.name = "surface";
   surface.request.surface = true;
   surface.model.surface = true;
+  // The surface layer pooled with the separators (the mean of the two P).
+  OursSetting pooled = surface;
+  pooled.name = "pooled";
+  pooled.request.surface_pooled = true;
   OursSetting other = classifier;
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
   s.push_back (defaults);
   s.push_back (classifier);
   s.push_back (surface);
+  s.push_back (pooled);
   s.push_back (other);
   if (!full)
     return s;

@@ -61,7 +61,8 @@ struct OursSetting
   * the surface layer on ("surface": both true), the paper's model ("max": measured positions,
   * separators alone), then one change at a time from the defaults. One of classifier and
   * surface answers as default does (the surface layer is off by default while experimental).
-  * full = false keeps default, classifier, surface and max. */
+  * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled).
+  * full = false keeps default, classifier, surface, pooled and max. */
 std::vector<OursSetting> oursSettings (bool full);
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and

@@ -718,10 +718,11 @@ PYBIND11_MODULE (_core, m)
       "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier;\n"
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
-      "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN.")
+      "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
+      "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
-                          double expanded_k_sigma, bool defer_kernel_fits, bool surface) {
+                          double expanded_k_sigma, bool defer_kernel_fits, bool surface, bool surface_pooled) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -734,6 +735,7 @@ PYBIND11_MODULE (_core, m)
               r.expanded_k_sigma = expanded_k_sigma;
               r.defer_kernel_fits = defer_kernel_fits;
               r.surface = surface;
+              r.surface_pooled = surface_pooled;
               return r;
             }),
             py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
@@ -741,7 +743,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("enable_timings") = dr.enable_timings, py::arg ("traversal") = dr.traversal,
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
-            py::arg ("surface") = dr.surface,
+            py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -755,6 +757,8 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
+      .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
+                      "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {
@@ -764,7 +768,8 @@ PYBIND11_MODULE (_core, m)
                traversalName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
                ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
                ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
-               ", surface=" + (r.surface ? "True" : "False") + ")";
+               ", surface=" + (r.surface ? "True" : "False") +
+               ", surface_pooled=" + (r.surface_pooled ? "True" : "False") + ")";
       });
 
   // --- CollisionResult ----------------------------------------------------------------------------

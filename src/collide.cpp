@@ -137,6 +137,36 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   result.verdict = verdictFor (result.probability, request);
   return true;
 }
+/** \brief The surface layer's answer (into) pooled with the separators' on the same pair
+  * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
+  * reached it (else the one that did); the surface layer's distance and witness (the
+  * separators' when the surface layer reached nothing); the work of both counted. */
+void
+pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request)
+{
+  into.probability = 0.5 * (into.probability + separators.probability);
+  into.lower_bound = into.lower_bound || separators.lower_bound;
+  into.no_leaf_tested = into.no_leaf_tested && separators.no_leaf_tested;
+  if (into.witness_side == 0 && separators.witness_side != 0)
+  {
+    into.witness_side = separators.witness_side;
+    into.witness_index = separators.witness_index;
+    into.witness_point = separators.witness_point;
+    into.witness_normal = separators.witness_normal;
+  }
+  into.bv_tests += separators.bv_tests;
+  into.leaf_pairs_tested += separators.leaf_pairs_tested;
+  into.kernel_leaf_pairs = separators.kernel_leaf_pairs;
+  into.degenerate_leaf_pairs = separators.degenerate_leaf_pairs;
+  into.classifier_iterations = separators.classifier_iterations;
+  auto mean = [] (std::vector<float>& values, const std::vector<float>& other) {
+    for (std::size_t i = 0; i < values.size () && i < other.size (); ++i)
+      values[i] = std::isnan (values[i]) ? other[i] : std::isnan (other[i]) ? values[i] : 0.5f * (values[i] + other[i]);
+  };
+  mean (into.probabilities_a, separators.probabilities_a);
+  mean (into.probabilities_b, separators.probabilities_b);
+  into.verdict = verdictFor (into.probability, request);
+}
 } // namespace
 
 Verdict
@@ -183,6 +213,16 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   if (surface ? !collideSurface (a, b, T_local, request, result)
               : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
     return false;
+  if (surface && request.surface_pooled)
+  {
+    CollisionResult separators;
+    if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, separators, classifier))
+    {
+      result = separators;
+      return false;
+    }
+    pool (result, separators, request);
+  }
 
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
   if (result.witness_side != 0)

@@ -280,6 +280,41 @@ TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)
   EXPECT_LT (r.signed_distance, -0.5) << r.signed_distance << " witness side " << r.witness_side;
 }
 
+// Pooled with the separators, P is the mean of the surface layer's and the separators' on the
+// same pair, per point too; the signed distance stays the surface layer's.
+TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  for (const double z : {0.0005, 0.002, -0.002})
+  {
+    CollisionRequest surface = surfaceRequest ();
+    surface.exhaustive = true;
+    surface.per_point = true;
+    CollisionRequest separators = surface;
+    separators.surface = false;
+    CollisionRequest pooled = surface;
+    pooled.surface_pooled = true;
+    CollisionResult rs, rc, rp;
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), surface, rs));
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), separators, rc));
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), pooled, rp));
+    EXPECT_DOUBLE_EQ (rp.probability, 0.5 * (rs.probability + rc.probability)) << "z = " << z;
+    EXPECT_EQ (rp.signed_distance, rs.signed_distance);
+    EXPECT_EQ (rp.verdict, verdictFor (rp.probability, pooled));
+    ASSERT_EQ (rp.probabilities_a.size (), rs.probabilities_a.size ());
+    for (std::size_t i = 0; i < rp.probabilities_a.size (); ++i)
+    {
+      const float s = rs.probabilities_a[i], c = rc.probabilities_a[i];
+      const float expected = std::isnan (s) ? c : std::isnan (c) ? s : 0.5f * (s + c);
+      if (std::isnan (expected))
+        EXPECT_TRUE (std::isnan (rp.probabilities_a[i]));
+      else
+        EXPECT_FLOAT_EQ (rp.probabilities_a[i], expected) << "point " << i << " at z = " << z;
+    }
+  }
+}
+
 // Per-point values and the witness come back in the callers' frames.
 TEST (SurfaceLayer, PerPointValuesAndWitness)
 {

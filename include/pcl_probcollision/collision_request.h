@@ -68,6 +68,13 @@ struct CollisionRequest
     * Default off: on the evaluation's noisy piano-in-room clouds, whose normals are oriented by
     * propagation, it is not yet as accurate as the separators (docs/RESULTS.md, issue #16). */
   bool surface = false;
+  /** \brief With surface on: also run the separators and answer the mean of the two
+    * probabilities (a linear opinion pool), per point and for the pair. The two see different
+    * things: the surface layer whether a point lies behind the other's surface, the separators
+    * whether two sheets cross (thin parts, where noise leaves no inside). The signed distance
+    * stays the surface layer's. Experimental, off by default; the rule was chosen on evaluation
+    * runs with seeds other than the reported one (docs/SURFACE.md). */
+  bool surface_pooled = false;
   /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
   ClassifierParams classifier;
 

@@ -76,10 +76,11 @@ class CollisionRequest:
     expanded_k_sigma: float
     defer_kernel_fits: bool
     surface: bool
+    surface_pooled: bool
     def __init__(self, *, free_below: float = ..., collision_above: float = ..., exhaustive: bool = ...,
                  per_point: bool = ..., enable_timings: bool = ..., traversal: TraversalMode = ...,
                  rho_min: float = ..., seed: int = ..., expanded_k_sigma: float = ...,
-                 defer_kernel_fits: bool = ..., surface: bool = False) -> None: ...
+                 defer_kernel_fits: bool = ..., surface: bool = False, surface_pooled: bool = False) -> None: ...
     def validate(self) -> None: ...
 
 class CollisionResult:

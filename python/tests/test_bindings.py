@@ -291,6 +291,19 @@ def test_surface_signed_distance_is_nan_when_off(sheets):
     same_result(off, r)
 
 
+def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
+    # CollisionRequest.surface_pooled: P is the mean of the surface layer's P and the
+    # separators' on the same pair; the signed distance stays the surface layer's.
+    _, _, A, B = sheets
+    T = translation(0.005, -0.003, -0.002)
+    surface = pc.collide(A, B, T, pc.CollisionRequest(surface=True, exhaustive=True))
+    separators = pc.collide(A, B, T, pc.CollisionRequest(exhaustive=True))
+    pooled = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_pooled=True, exhaustive=True))
+    assert pooled.probability == 0.5 * (surface.probability + separators.probability)
+    assert pooled.signed_distance == surface.signed_distance
+    assert "surface_pooled=True" in repr(pc.CollisionRequest(surface=True, surface_pooled=True))
+
+
 def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
     # The sheets as scans, a seen from above and b from below (PCD VIEWPOINT; Auto orients them
     # toward it): load_model of the files and build_model of the same floats with the same
