@@ -406,7 +406,7 @@ struct DeepPoint
   bool found = false;
   int side = 1;
   int index = -1;         ///< hierarchy index in its own model
-  Eigen::Vector3d point;  ///< in A's local frame
+  Eigen::Vector3d point = Eigen::Vector3d::Zero ();  ///< in A's local frame
   double depth = 0.0;     ///< distance to the other's nearest sample
 };
 

@@ -41,7 +41,7 @@ const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
-                                            "-measured", "-surface", "-v"};
+                                            "-measured", "-surface", "-surface_pooled", "-v"};
 
 ParseResult
 usage (const std::string& message)
@@ -285,6 +285,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.exhaustive = true;
       else if (a == "-surface")
         o.surface = true;
+      else if (a == "-surface_pooled")
+        o.surface = o.surface_pooled = true;
       else if (a == "-json")
         o.json = true;
       else if (a == "-v")
@@ -500,6 +502,7 @@ helpText ()
        "  -exhaustive     visit every reachable leaf pair (no early stop; P is then exact, not a bound)\n"
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
+       "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"
        "  -nmax N         = "
     << D::n_max
     << "      hierarchy: a node with more points is split (n_min = min(" << D::n_min

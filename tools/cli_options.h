@@ -41,6 +41,7 @@ struct Defaults
   static inline const bool stochastic = request.traversal == pcl_probcollision::TraversalMode::Stochastic;
   static inline const bool exhaustive = request.exhaustive;
   static inline const bool surface = request.surface;
+  static inline const bool surface_pooled = request.surface_pooled;
   static inline const bool measured = !model.surface_projection;
   static inline const int n_max = model.hierarchy.n_max;
   static inline const int n_min = model.hierarchy.n_min;
@@ -87,6 +88,8 @@ struct Options
   bool measured = Defaults::measured;
   bool exhaustive = Defaults::exhaustive;
   bool surface = Defaults::surface;
+  /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
+  bool surface_pooled = Defaults::surface_pooled;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

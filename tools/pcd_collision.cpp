@@ -213,6 +213,7 @@ requestFor (const Options& o)
   r.collision_above = o.collision_above;
   r.exhaustive = o.exhaustive || o.output.has_value ();
   r.surface = o.surface;
+  r.surface_pooled = o.surface_pooled;
   r.per_point = o.output.has_value ();
   r.enable_timings = true;
   r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
@@ -336,6 +337,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("seed").unsignedInteger (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
   j.key ("surface").boolean (rq.surface);
+  j.key ("surface_pooled").boolean (rq.surface_pooled);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);

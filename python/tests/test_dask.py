@@ -196,6 +196,7 @@ def cli_inputs(tmp_path_factory, table_points):
     ["-sigma", "0.0015"],
     ["-sensor_b", "kinect", "-k", "12", "-thresholds=0.2,0.8", "-exhaustive", "-nmax", "16", "-split", "octree"],
     ["-sigma", "0.0015", "-surface"],
+    ["-sigma", "0.0015", "-surface_pooled"],
 ])
 def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     args = [str(cli_inputs / "gripper.pcd"), str(cli_inputs / "table.pcd")]
@@ -211,7 +212,8 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     assert {a["verdict"] for a in answers} >= {"free", "collision"}
     assert answers[0]["points_skipped_nonfinite"] == 1
     distances = [a["signed_distance"] for a in answers]
-    if "-surface" in flags:
+    assert all(a["parameters"]["surface_pooled"] == ("-surface_pooled" in flags) for a in answers)
+    if "-surface" in flags or "-surface_pooled" in flags:
         assert all(a["parameters"]["surface"] for a in answers)
         assert sum(d is not None for d in distances) >= 10
         assert any(d is not None and d < 0 for d in distances)

@@ -55,6 +55,8 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.stochastic);
   EXPECT_FALSE (o.measured);
   EXPECT_FALSE (o.exhaustive);
+  EXPECT_FALSE (o.surface);
+  EXPECT_FALSE (o.surface_pooled);
   EXPECT_FALSE (o.mesh_spacing);
   EXPECT_FALSE (o.output);
   EXPECT_FALSE (o.json);
@@ -89,6 +91,19 @@ TEST (CliOptions, EveryOption)
   EXPECT_EQ (*o.output, "out.PCD");
   EXPECT_TRUE (o.json);
   EXPECT_TRUE (o.verbose);
+}
+
+// -surface_pooled implies -surface; -surface alone does not pool.
+TEST (CliOptions, SurfacePooledImpliesSurface)
+{
+  const ParseResult pooled = parse ({"-surface_pooled"});
+  ASSERT_EQ (pooled.kind, Kind::Run) << pooled.error;
+  EXPECT_TRUE (pooled.options.surface);
+  EXPECT_TRUE (pooled.options.surface_pooled);
+  const ParseResult alone = parse ({"-surface"});
+  ASSERT_EQ (alone.kind, Kind::Run) << alone.error;
+  EXPECT_TRUE (alone.options.surface);
+  EXPECT_FALSE (alone.options.surface_pooled);
 }
 
 TEST (CliOptions, Help)

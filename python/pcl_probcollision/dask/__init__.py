@@ -54,6 +54,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
     # their faces, clouds by their viewpoint or by propagation) and signed_distance is filled.
     "surface": _REQUEST.surface,
+    # The surface layer pooled with the separators (the mean of the two P); implies surface.
+    "surface_pooled": _REQUEST.surface_pooled,
     "nmax": _MODEL.n_max,
     "sigma_max": _MODEL.sigma_max,
     "epsilon": _MODEL.epsilon,
@@ -78,6 +80,7 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
         raise TypeError(f"unknown option(s) {', '.join(unknown)}; expected some of {', '.join(OPTION_NAMES)}")
     o = dict(DEFAULT_OPTIONS)
     o.update({k: v for k, v in options.items()})
+    o["surface"] = bool(o["surface"] or o["surface_pooled"])
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
@@ -126,7 +129,7 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         free_below=o["thresholds"][0], collision_above=o["thresholds"][1], exhaustive=bool(o["exhaustive"]),
         per_point=False, enable_timings=True,
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
-        seed=int(o["seed"]), surface=bool(o["surface"]))
+        seed=int(o["seed"]), surface=bool(o["surface"]), surface_pooled=bool(o["surface_pooled"]))
 
 
 # ------------------------------------------------------------------------------------------------

@@ -23,7 +23,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   --timeout S                    seconds to reach the scheduler (default 10)
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
-  -measured -deterministic -stochastic -seed -exhaustive -surface -nmax -sigma_max -epsilon -split
+  -measured -deterministic -stochastic -seed -exhaustive -surface -surface_pooled -nmax -sigma_max -epsilon -split
   -mesh_density -json (accepted; the output is always JSON lines) -v. A value is the next argument
   or follows '='. -surface (experimental) adds the signed distance between the surfaces.
 """
@@ -31,7 +31,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
           "split": str, "mesh_density": float}
-_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "surface", "json", "v")
+_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "surface", "surface_pooled", "json", "v")
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
 _FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
 _INT = re.compile(r"[+-]?\d+\Z")
@@ -209,7 +209,7 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"sigma_b":{sigma_b},"k":{int(o["k"])},"thresholds":{_nums(o["thresholds"])},'
                   f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
                   f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
-                  f'"exhaustive":{_bool(o["exhaustive"])},"surface":{_bool(o["surface"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
+                  f'"exhaustive":{_bool(o["exhaustive"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
     inputs = f'{{"a":{_input_json(a)},"b":{_input_json(b)}}}'
     sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
