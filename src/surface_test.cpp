@@ -26,8 +26,9 @@ constexpr int kSurfaceNeighbours = 8;
   * has a standard deviation of 1 / sqrt(12) = 0.29 spacing. Derived, not fitted. */
 constexpr double kDiscretisationPerDistance = 0.288675;
 /** \brief Holes are bridged up to this many sample spacings from the nearest sample (holes up
-  * to twice as wide: an occlusion shadow); farther, the surface has ended and the point is
-  * outside by its distance to that sample. */
+  * to twice as wide: an occlusion shadow) when samples lie on the far rim; farther, or with no
+  * far rim, the surface has ended and the point is outside by its distance to an edge half a
+  * spacing past that sample. */
 constexpr double kBridgeSpacings = 6.0;
 /** \brief Robust reweighting rounds of the implicit surface (RIMLS, Oeztireli et al. 2009):
   * samples across a crease, whose plane disagrees with the local surface, lose their weight. */
