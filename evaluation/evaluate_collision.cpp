@@ -18,7 +18,12 @@
 // scripts/evaluate.sh renders the charts. Nothing is fitted on these workloads.
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
-//                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only]
+//                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
+//
+// --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
+// (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
+//   pcd_collision scans/W1_0.5_robot.pcd scans/W1_0.5_env.pcd -sigma S -surface -pose ...
+// with S and the pose from scans/W1_0.5_poses.txt.
 
 #include "baselines.h"
 #include "ground_truth.h"
@@ -29,10 +34,13 @@
 
 #include <pcl_probcollision/collision_request.h>
 
+#include <pcl/io/pcd_io.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -58,6 +66,9 @@ struct Options
   int rescans = 0;                ///< re-scans of both objects (0: 8 quick, 10 full)
   std::size_t rescan_poses = 0;   ///< near-band poses re-scanned per cell (0: 20 quick, 100 full)
   bool ours_only = false;         ///< skip the baselines, W2 and W3 (for quick studies)
+  /** \brief Also write each W1 cell's scans and poses into DIR/scans, so that any query can be
+    * re-run alone with pcd_collision (dumpCell). */
+  bool dump = false;
 };
 
 double
@@ -330,6 +341,37 @@ sharedBuild ()
   return b;
 }
 
+/** \brief --dump: the cell's noisy scans as the surface layer gets them (PointNormal, ScanSides'
+  * normals) and one pcd_collision pose line per query (robot in the room's frame), its row of
+  * queries.csv in the comment. */
+void
+dumpCell (const Options& o, const Density& den, double pct, double sigma, const CloudXYZ& rob, const CloudXYZ& env,
+          const CellPoses& cell)
+{
+  const std::string dir = o.out_dir + "/scans";
+  std::filesystem::create_directories (dir);
+  const std::string stem = dir + "/" + den.workload + "_" + fmtShort (pct);
+  const int k = OursSetting ().model.k;
+  if (pcl::io::savePCDFileBinary (stem + "_robot.pcd", *orientedScan (rob, den.rob_outward, k)) < 0 ||
+      pcl::io::savePCDFileBinary (stem + "_env.pcd", *orientedScan (env, den.env_outward, k)) < 0)
+    throw std::runtime_error ("cannot write the scans of " + stem);
+  std::ofstream poses (stem + "_poses.txt");
+  poses.precision (17);
+  poses << "# " << den.workload << " at " << pct << " % noise: pcd_collision " << stem << "_robot.pcd " << stem
+        << "_env.pcd -sigma " << sigma << " -poses " << stem << "_poses.txt\n"
+        << "# tx ty tz roll pitch yaw  # query, pose set, exact signed distance (mm)\n";
+  for (std::size_t i = 0; i < cell.poses.size (); ++i)
+  {
+    const Eigen::Isometry3d& T = cell.poses[i].T;
+    const Eigen::Vector3d ypr = T.linear ().eulerAngles (2, 1, 0);  // R = Rz(yaw) Ry(pitch) Rx(roll)
+    poses << T.translation ().x () << ' ' << T.translation ().y () << ' ' << T.translation ().z () << ' ' << ypr[2]
+          << ' ' << ypr[1] << ' ' << ypr[0] << "  # " << i << ' ' << cell.set[i] << ' ' << cell.poses[i].signed_distance
+          << '\n';
+  }
+  if (!poses)
+    throw std::runtime_error ("cannot write " + stem + "_poses.txt");
+}
+
 void
 evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double pct, Results& results)
 {
@@ -343,6 +385,8 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   const CloudXYZ::ConstPtr rob = addNoise (*den.rob_clean, sigma, noise_seed);
   const CloudXYZ::ConstPtr env = addNoise (*den.env_clean, sigma, noise_seed + 1);
   const CellPoses cell = cellPoses (w, pct);
+  if (o.dump)
+    dumpCell (o, den, pct, sigma, *rob, *env, cell);
   QueryRow proto;
   proto.workload = den.workload;
   proto.noise_pct = pct;
@@ -1250,10 +1294,12 @@ parse (int argc, char** argv)
       o.rescan_poses = std::stoull (value ());
     else if (a == "--ours-only")
       o.ours_only = true;
+    else if (a == "--dump")
+      o.dump = true;
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");
