@@ -92,20 +92,52 @@ isFacelessPly (const std::string& path)
   return false;  // no end_header: not a PLY header the tool understands
 }
 
-bool
-loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error)
+namespace
 {
-  cloud.clear ();
+/** \brief A cloud file read into PCL's generic form, its fields located and checked: the one
+  * owner of the parsing behind loadCloud and loadCloudWithNormals. */
+struct CloudFile
+{
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero ();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity ();
+  int xyz[3] = {-1, -1, -1};
+  int normal[3] = {-1, -1, -1};  ///< normal_x normal_y normal_z; -1 when the file has none
+  std::size_t size = 0;
+
+  double value (std::size_t point, int field) const
+  {
+    const pcl::PCLPointField& f = blob.fields[static_cast<std::size_t> (field)];
+    return readField (blob.data.data () + point * blob.point_step + f.offset, f.datatype);
+  }
+};
+
+/** \brief Checks a field of the header: present with a known type (a negative index is absent). */
+bool
+checkField (const CloudFile& file, int index, const std::string& path, const char* name, std::string& error)
+{
+  if (fieldSize (file.blob.fields[static_cast<std::size_t> (index)].datatype) == 0)
+  {
+    error = "'" + path + "': field '" + name + "' has an unknown type";
+    return false;
+  }
+  return true;
+}
+
+/** \brief Reads the file (PCD, or PLY by its extension) with every check; with want_normals,
+  * also locates normal_x normal_y normal_z, all three or none (a partial set is an error naming
+  * the missing field). */
+bool
+readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std::string& error)
+{
+  pcl::PCLPointCloud2& blob = file.blob;
   const bool ply = isPly (path);
   const char* format = ply ? "PLY" : "PCD";
   if (ply)
   {
     pcl::PLYReader reader;
     int version = 0;
-    if (reader.read (path, blob, origin, orientation, version) < 0)
+    if (reader.read (path, blob, file.origin, file.orientation, version) < 0)
     {
       error = "'" + path + "' is truncated or corrupt (PLY data could not be read)";
       return false;
@@ -116,7 +148,7 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
     pcl::PCDReader reader;
     int version = 0, data_type = 0;
     unsigned int data_idx = 0;
-    if (reader.readHeader (path, blob, origin, orientation, version, data_type, data_idx) < 0)
+    if (reader.readHeader (path, blob, file.origin, file.orientation, version, data_type, data_idx) < 0)
     {
       error = "'" + path + "' is not a PCD file (malformed or missing header)";
       return false;
@@ -132,70 +164,143 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
     error = "'" + path + "' has no points (empty cloud)";
     return false;
   }
-  // x y z are checked on the PCD header, before the (possibly large) data are read.
-  int idx[3];
+  // The fields are checked on the PCD header, before the (possibly large) data are read.
   const char* names[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i)
   {
-    idx[i] = pcl::getFieldIndex (blob, names[i]);
-    if (idx[i] < 0)
+    file.xyz[i] = pcl::getFieldIndex (blob, names[i]);
+    if (file.xyz[i] < 0)
     {
       error = "'" + path + "' has no '" + names[i] + "' field (a " + format + " input needs x y z)";
       return false;
     }
-    if (fieldSize (blob.fields[idx[i]].datatype) == 0)
-    {
-      error = "'" + path + "': field '" + names[i] + "' has an unknown type";
+    if (!checkField (file, file.xyz[i], path, names[i], error))
       return false;
+  }
+  if (want_normals)
+  {
+    const char* normal_names[3] = {"normal_x", "normal_y", "normal_z"};
+    int present = 0;
+    for (int i = 0; i < 3; ++i)
+    {
+      file.normal[i] = pcl::getFieldIndex (blob, normal_names[i]);
+      present += file.normal[i] >= 0 ? 1 : 0;
+    }
+    std::string given;
+    for (int i = 0; i < 3; ++i)
+      if (file.normal[i] >= 0)
+        given += std::string (given.empty () ? "" : " ") + normal_names[i];
+    for (int i = 0; i < 3 && present > 0; ++i)
+    {
+      if (file.normal[i] < 0)
+      {
+        error = "'" + path + "' has no '" + normal_names[i] + "' field but has " + given +
+                " (normals need normal_x normal_y normal_z)";
+        return false;
+      }
+      if (!checkField (file, file.normal[i], path, normal_names[i], error))
+        return false;
     }
   }
   if (!ply)
   {
     pcl::PCDReader reader;
     int version = 0;
-    if (reader.read (path, blob, origin, orientation, version) < 0)
+    if (reader.read (path, blob, file.origin, file.orientation, version) < 0)
     {
       error = "'" + path + "' is truncated or corrupt (PCD data could not be read)";
       return false;
     }
   }
-  const std::size_t n = static_cast<std::size_t> (blob.width) * blob.height;
-  if (n == 0)
+  file.size = static_cast<std::size_t> (blob.width) * blob.height;
+  if (file.size == 0)
   {
     error = "'" + path + "' has no points";
     return false;
   }
-  if (blob.data.size () < n * blob.point_step)
+  if (blob.data.size () < file.size * blob.point_step)
   {
     error = "'" + path + "' is truncated (fewer data bytes than its header announces)";
     return false;
   }
-  bool all_float = true;
-  for (int i = 0; i < 3; ++i)
-    all_float = all_float && blob.fields[idx[i]].datatype == pcl::PCLPointField::FLOAT32;
-  if (all_float)
-    pcl::fromPCLPointCloud2 (blob, cloud);
-  else
+  return true;
+}
+
+/** \brief x y z of every point, converted from whatever numeric type the file has; organization kept. */
+template <typename PointT>
+void
+copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud)
+{
+  cloud.resize (file.size);
+  for (std::size_t j = 0; j < file.size; ++j)
   {
-    cloud.resize (n);
-    for (std::size_t j = 0; j < n; ++j)
-    {
-      const std::uint8_t* row = blob.data.data () + j * blob.point_step;
-      cloud[j].x = static_cast<float> (readField (row + blob.fields[idx[0]].offset, blob.fields[idx[0]].datatype));
-      cloud[j].y = static_cast<float> (readField (row + blob.fields[idx[1]].offset, blob.fields[idx[1]].datatype));
-      cloud[j].z = static_cast<float> (readField (row + blob.fields[idx[2]].offset, blob.fields[idx[2]].datatype));
-    }
-    cloud.width = blob.width;
-    cloud.height = blob.height;
-    cloud.is_dense = false;
+    cloud[j].x = static_cast<float> (file.value (j, file.xyz[0]));
+    cloud[j].y = static_cast<float> (file.value (j, file.xyz[1]));
+    cloud[j].z = static_cast<float> (file.value (j, file.xyz[2]));
   }
+  cloud.width = file.blob.width;
+  cloud.height = file.blob.height;
+}
+
+/** \brief The viewpoint, a fresh header and is_dense (every x y z finite). */
+template <typename PointT>
+void
+finishCloud (const CloudFile& file, pcl::PointCloud<PointT>& cloud)
+{
   cloud.header = pcl::PCLHeader ();
-  cloud.sensor_origin_ = origin;
-  cloud.sensor_orientation_ = orientation;
+  cloud.sensor_origin_ = file.origin;
+  cloud.sensor_orientation_ = file.orientation;
   bool dense = true;
   for (const auto& p : cloud.points)
     dense = dense && std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
   cloud.is_dense = dense;
+}
+} // namespace
+
+bool
+loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error)
+{
+  cloud.clear ();
+  CloudFile file;
+  if (!readCloudFile (path, false, file, error))
+    return false;
+  bool all_float = true;
+  for (int i = 0; i < 3; ++i)
+    all_float = all_float && file.blob.fields[static_cast<std::size_t> (file.xyz[i])].datatype == pcl::PCLPointField::FLOAT32;
+  if (all_float)
+    pcl::fromPCLPointCloud2 (file.blob, cloud);
+  else
+    copyXyz (file, cloud);
+  finishCloud (file, cloud);
+  return true;
+}
+
+bool
+loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,
+                      std::string& error)
+{
+  cloud.clear ();
+  has_normals = false;
+  CloudFile file;
+  if (!readCloudFile (path, true, file, error))
+    return false;
+  copyXyz (file, cloud);
+  has_normals = file.normal[0] >= 0;
+  const float nan = std::numeric_limits<float>::quiet_NaN ();
+  for (std::size_t j = 0; j < file.size; ++j)
+  {
+    Eigen::Vector3f n (nan, nan, nan);
+    if (has_normals)
+      for (int i = 0; i < 3; ++i)
+        n[i] = static_cast<float> (file.value (j, file.normal[i]));
+    // No usable direction (non-finite or zero): NaN, which the surface model orients from the
+    // point's neighbours.
+    if (!n.allFinite () || n.isZero ())
+      n.setConstant (nan);
+    cloud[j].getNormalVector3fMap () = n;
+    cloud[j].curvature = 0.0f;
+  }
+  finishCloud (file, cloud);
   return true;
 }
 } // namespace io

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-// Point-cloud input: PCD and face-less PLY files into PointXYZ, with every check a file of
-// unknown origin needs (PCL 1.13's PCD reader crashes on a header without FIELDS). Shared by
-// pcd_collision and the Python bindings. pcl/io/pcd_io.h and ply_io.h stay in cloud_input.cpp.
+// Point-cloud input: PCD and face-less PLY files into PointXYZ (or PointNormal, with the file's
+// normals), with every check a file of unknown origin needs (PCL 1.13's PCD reader crashes on a
+// header without FIELDS). Shared by pcd_collision and the Python bindings. pcl/io/pcd_io.h and
+// ply_io.h stay in cloud_input.cpp.
 
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -20,6 +21,16 @@ namespace io
   * of any numeric type are converted. False with a reason naming the file when the file is
   * unreadable, malformed or truncated, has no x y z, or has no points. */
 bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error);
+
+/** \brief loadCloud (the same reader, checks and messages) with the file's normals: when the file
+  * has all of normal_x normal_y normal_z (any numeric type, converted; a PLY's nx ny nz as PCL's
+  * PLY reader names them), has_normals is true and each point gets its stored normal as it is (not
+  * normalized); a non-finite or zero one becomes NaN, a point without a normal, which the surface
+  * model orients from its neighbours (buildCloudModel<PointNormal>). Without normal fields
+  * has_normals is false and every normal is NaN. False with a reason naming the file and the
+  * missing field when only some of the three are there (e.g. normal_x alone). Curvature is 0. */
+bool loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,
+                           std::string& error);
 
 /** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,

@@ -14,6 +14,7 @@
 #include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/sensor_noise.h>
 
+#include <pcl/common/io.h>
 #include <pcl/exceptions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -231,17 +232,27 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
 
   // io::loadCloud is pcd_collision's reader: every check a file of unknown origin needs (PCL
-  // 1.13's PCDReader crashes on a header without FIELDS), messages naming the file.
+  // 1.13's PCDReader crashes on a header without FIELDS), messages naming the file. With a
+  // surface, the file's normals too (loadCloudWithNormals), as pcd_collision -surface reads them:
+  // when the file has normal_x normal_y normal_z, the model is built from pcl::PointNormal, as
+  // build_model(normals=) builds it.
   pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::PointCloud<pcl::PointNormal> oriented;
+  bool has_normals = false;
   std::string error;
   bool loaded = false;
   {
     py::gil_scoped_release release;
-    loaded = pcl_probcollision::io::loadCloud (path.string (), cloud, error);
+    loaded = params.surface ? pcl_probcollision::io::loadCloudWithNormals (path.string (), oriented, has_normals, error)
+                            : pcl_probcollision::io::loadCloud (path.string (), cloud, error);
   }
   if (!loaded)
     throw py::value_error ("path: " + error);
   py::gil_scoped_release release;
+  if (has_normals)
+    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, nullptr, name);
+  if (params.surface)
+    pcl::copyPointCloud (oriented, cloud);
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
 }
 
@@ -610,8 +621,9 @@ PYBIND11_MODULE (_core, m)
 
   py::enum_<NormalOrientation> (m, "NormalOrientation",
       "Where the surface model's normals get their orientation (which side is outside); CloudModelParams.orientation.\n\n"
-      "Auto (default): the points' own normals when build_model() was given finite ones (a mesh's faces), else the\n"
-      "    viewpoint when it lies outside the cloud's bounding box (a scan), else Propagate.\n"
+      "Auto (default): the points' own normals when build_model() was given finite ones (a mesh's faces) or\n"
+      "    load_model() read them from the file, else the viewpoint when it lies outside the cloud's bounding box\n"
+      "    (a scan), else Propagate.\n"
       "PointNormals: the given normals, taken as outward; points without one are oriented from their neighbours.\n"
       "Viewpoint: toward the sensor origin (the viewpoint); grazing points (|cos| < 0.2) from their neighbours.\n"
       "Propagate: propagated over the neighbour graph from the point farthest from the centroid, then each\n"
@@ -886,9 +898,15 @@ PYBIND11_MODULE (_core, m)
            return std::const_pointer_cast<CloudModel> (loadModel (path, params, name));
          },
          py::arg ("path"), py::arg ("params") = py::none (), py::arg ("name") = py::none (),
-         "Builds the CloudModel of a .pcd file (x y z fields; its VIEWPOINT is the sensor pose).\n\n"
+         "Builds the CloudModel of a .pcd file (x y z fields, any numeric type; its VIEWPOINT is the sensor pose).\n\n"
          "params: CloudModelParams (None = defaults); name: defaults to the file name.\n"
-         "FileNotFoundError for a missing file, ValueError for a file PCL cannot read.");
+         "With params.surface, a file with normal_x normal_y normal_z fields (any numeric type) gives its points\n"
+         "    those normals, as build_model(normals=) does: taken as outward by the Auto and PointNormals\n"
+         "    orientations (surface_orientation is then PointNormals); any length is accepted (the surface model\n"
+         "    normalizes them), and a point whose normal is NaN or 0 is oriented from its neighbours. Without\n"
+         "    params.surface the normals are not read (they change nothing else in the model).\n"
+         "FileNotFoundError for a missing file, ValueError for a file PCL cannot read or one with only some of the\n"
+         "    normal fields (with params.surface).");
   m.def ("collide", &collideOne, py::arg ("a"), py::arg ("b"), py::arg ("pose"), py::arg ("request") = py::none (),
          "Probability that the objects of models a and b collide, b placed in a's frame by pose = T_a_b\n"
          "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide().\n\n"

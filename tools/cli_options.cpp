@@ -41,7 +41,7 @@ const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
-                                            "-measured", "-surface", "-surface_pooled", "-v"};
+                                            "-measured", "-surface", "-surface_pooled", "-ignore_normals", "-v"};
 
 ParseResult
 usage (const std::string& message)
@@ -287,6 +287,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.surface = true;
       else if (a == "-surface_pooled")
         o.surface = o.surface_pooled = true;
+      else if (a == "-ignore_normals")
+        o.ignore_normals = true;
       else if (a == "-json")
         o.json = true;
       else if (a == "-v")
@@ -503,6 +505,8 @@ helpText ()
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
        "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"
+       "  -ignore_normals with -surface: orient clouds as if their files had no normal_x normal_y\n"
+       "                  normal_z (by default a cloud's stored normals are its outward ones)\n"
        "  -nmax N         = "
     << D::n_max
     << "      hierarchy: a node with more points is split (n_min = min(" << D::n_min

@@ -90,6 +90,9 @@ struct Options
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;
+  /** \brief -ignore_normals: with -surface, a cloud file's normal_x normal_y normal_z are not
+    * read (the cloud is oriented by its viewpoint or by propagation, as one without normals). */
+  bool ignore_normals = false;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

@@ -12,6 +12,7 @@
 #include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
+#include <pcl/common/io.h>
 #include <pcl/console/print.h>
 
 #include <unistd.h>
@@ -36,6 +37,7 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using pcl_probcollision::io::isFacelessPly;
 using pcl_probcollision::io::JsonWriter;
 using pcl_probcollision::io::loadCloud;
+using pcl_probcollision::io::loadCloudWithNormals;
 using pcl_probcollision::io::loadTriangleMesh;
 using pcl_probcollision::io::meshDiagonal;
 using pcl_probcollision::io::medianSpacing;
@@ -73,7 +75,8 @@ struct Input
   InputKind kind = InputKind::Unsupported;
   Cloud::Ptr cloud = pcl::make_shared<Cloud> ();  ///< loaded, or sampled from the mesh
   TriangleMesh mesh;
-  /** \brief A mesh's samples with its faces' outward normals (the surface model's orientation). */
+  /** \brief The surface model's orientation: a mesh's samples with its faces' outward normals, or
+    * (with -surface) a cloud with the normals its file stores; null for other clouds. */
   pcl::PointCloud<pcl::PointNormal>::Ptr oriented;
   std::size_t finite = 0;
   double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
@@ -106,8 +109,10 @@ countFinite (const Cloud& cloud)
   return n;
 }
 
+/** \brief Loads an input; with_normals (-surface without -ignore_normals): a cloud file's
+  * normal_x normal_y normal_z too, kept in in.oriented when the file has them. */
 void
-loadInput (Input& in, FILE* log)
+loadInput (Input& in, bool with_normals, FILE* log)
 {
   requireReadable (in.path);
   if (in.kind == InputKind::Mesh && isFacelessPly (in.path))
@@ -116,7 +121,17 @@ loadInput (Input& in, FILE* log)
   std::string error;
   if (in.kind == InputKind::Cloud)
   {
-    if (!loadCloud (in.path, *in.cloud, error))
+    if (with_normals)
+    {
+      auto oriented = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>> ();
+      bool has_normals = false;
+      if (!loadCloudWithNormals (in.path, *oriented, has_normals, error))
+        throw Failure{kRuntimeFailure, error};
+      pcl::copyPointCloud (*oriented, *in.cloud);
+      if (has_normals)
+        in.oriented = oriented;
+    }
+    else if (!loadCloud (in.path, *in.cloud, error))
       throw Failure{kRuntimeFailure, error};
     in.finite = countFinite (*in.cloud);
     if (in.finite == 0)
@@ -437,6 +452,26 @@ warnIfScalesDiffer (const Input& a, const Input& b)
                   ratio, da, a.path.c_str (), db, b.path.c_str ());
 }
 
+/** \brief The stage line of -surface that says where an input's surface normals got their
+  * orientation (NormalOrientation, resolved by the model's build). */
+void
+reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, FILE* log)
+{
+  const pcl_probcollision::NormalOrientation orientation = model.surface ().orientation ();
+  const char* how = "";
+  switch (orientation)
+  {
+    case pcl_probcollision::NormalOrientation::PointNormals:
+      how = in.kind == InputKind::Mesh ? "its faces' outward normals"
+                                       : "the file's normal_x normal_y normal_z, taken as outward";
+      break;
+    case pcl_probcollision::NormalOrientation::Viewpoint: how = "toward the sensor origin (VIEWPOINT)"; break;
+    case pcl_probcollision::NormalOrientation::Propagate: how = "propagated over the neighbours"; break;
+    case pcl_probcollision::NormalOrientation::Auto: break;
+  }
+  std::fprintf (log, "Orienting %s [%s: %s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how);
+}
+
 /** \brief "\r[12/300 poses]" on stderr when it is a terminal, at most every 0.2 s, first after
   * 0.2 s (short runs show nothing); erased at the end and before summary lines that share the
   * terminal. */
@@ -518,8 +553,9 @@ run (int argc, char** argv)
   a.kind = inputKindOf (a.path);
   b.path = o.input_b;
   b.kind = inputKindOf (b.path);
-  loadInput (a, log);
-  loadInput (b, log);
+  const bool with_normals = o.surface && !o.ignore_normals;
+  loadInput (a, with_normals, log);
+  loadInput (b, with_normals, log);
   warnIfScalesDiffer (a, b);
 
   // MeshSampled mode: spacing from -mesh_density, the other cloud, or the meshes' size.
@@ -543,19 +579,34 @@ run (int argc, char** argv)
   pc.setInputModelParams (modelParamsFor (o));
   pc.setTargetModelParams (modelParamsFor (o));
   // A mesh is exact (zero covariance) and oriented by its faces: its model is built here from
-  // the samples with their normals.
-  auto meshModel = [&] (const Input& in) {
-    const pcl::PointCloud<pcl_probcollision::Covariance> exact (in.oriented->width, in.oriented->height);
-    return pcl_probcollision::buildCloudModel (*in.oriented, modelParamsFor (o), nullptr, &exact, in.path);
+  // the samples with their normals. A cloud whose file has normals (with -surface) is built here
+  // too, as compute() would build it (its noise, the same name), from the points with their
+  // normals, which the surface model takes as outward.
+  using pcl_probcollision::SensorNoiseModel;
+  auto orientedModel = [&] (const Input& in, const SensorNoiseModel& noise, const char* which) {
+    if (in.kind == InputKind::Mesh)
+    {
+      const pcl::PointCloud<pcl_probcollision::Covariance> exact (in.oriented->width, in.oriented->height);
+      return pcl_probcollision::buildCloudModel (*in.oriented, modelParamsFor (o), nullptr, &exact, in.path);
+    }
+    pcl_probcollision::CloudModelParams params = modelParamsFor (o);
+    params.noise = noise;
+    return pcl_probcollision::buildCloudModel (*in.oriented, params, nullptr, nullptr, which);
   };
-  if (a.kind == InputKind::Mesh)
-    pc.setInputModel (meshModel (a));
+  if (a.oriented)
+    pc.setInputModel (orientedModel (a, SensorNoiseModel::fromName (o.sensor_a, o.sigma_a), "input"));
   else
-    pc.setInputNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_a, o.sigma_a));
-  if (b.kind == InputKind::Mesh)
-    pc.setTargetModel (meshModel (b));
+    pc.setInputNoise (SensorNoiseModel::fromName (o.sensor_a, o.sigma_a));
+  if (b.oriented)
+    pc.setTargetModel (orientedModel (b, SensorNoiseModel::fromName (o.sensor_b, o.sigma_b), "target"));
   else
-    pc.setTargetNoise (pcl_probcollision::SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
+    pc.setTargetNoise (SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
+  // The build time of the clouds built here, which compute() would otherwise have counted.
+  double cloud_build_ms = 0.0;
+  if (a.kind == InputKind::Cloud && a.oriented)
+    cloud_build_ms += pc.getInputModel ()->buildMilliseconds ();
+  if (b.kind == InputKind::Cloud && b.oriented)
+    cloud_build_ms += pc.getTargetModel ()->buildMilliseconds ();
   pc.setRequest (requestFor (o));
 
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));
@@ -571,6 +622,14 @@ run (int argc, char** argv)
     if (!ok || !result.ok ())
       throw Failure{kRuntimeFailure, (batch ? "pose " + std::to_string (i) + ": " : std::string ()) + "query failed: " +
                                          (result.message.empty () ? std::string ("compute() returned false") : result.message)};
+    if (i == 0)
+      result.build_ms += cloud_build_ms;
+    // With -surface, how each surface was oriented, once both models exist.
+    if (i == 0 && o.surface)
+    {
+      reportOrientation (a, *pc.getInputModel (), log);
+      reportOrientation (b, *pc.getTargetModel (), log);
+    }
 
     std::optional<double> write_ms;
     std::size_t written = 0;

@@ -359,6 +359,58 @@ def test_surface_normals_and_orientation_options(sheets):
         pc.build_model(a, normals=np.zeros((len(a), 3), dtype=np.int32))
 
 
+def write_pcd_with_normals(path, points, normals, fields="normal_x normal_y normal_z"):
+    """An ascii PCD with x y z and the given normal fields (float32), the viewpoint at the origin."""
+    rows = np.hstack([points, normals]).astype(np.float32)
+    names = ("x y z " + fields).split()
+    k = len(names)
+    header = (f"VERSION 0.7\nFIELDS {' '.join(names)}\nSIZE {' '.join(['4'] * k)}\nTYPE {' '.join(['F'] * k)}\n"
+              f"COUNT {' '.join(['1'] * k)}\nWIDTH {len(rows)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+              f"POINTS {len(rows)}\nDATA ascii\n")
+    body = "".join(" ".join(repr(float(v)) for v in r) + "\n" for r in rows)
+    pathlib.Path(path).write_text(header + body)
+
+
+def test_load_model_uses_the_files_normals(sheets, tmp_path):
+    # A PCD with normal_x normal_y normal_z: with params.surface, load_model orients its surface by
+    # them (PointNormals, as build_model(normals=)), the same model bit for bit; reversed in the
+    # file, they flip the sign of the distance. Without a surface they are not read.
+    a, b, A, B = sheets
+    up = np.tile(np.float32([0, 0, 1]), (len(a), 1))
+    write_pcd_with_normals(tmp_path / "a.pcd", a, up)
+    write_pcd_with_normals(tmp_path / "b.pcd", b, -up[:len(b)])
+    write_pcd_with_normals(tmp_path / "b_up.pcd", b, up[:len(b)])
+    write_pcd(tmp_path / "b_plain.pcd", b)
+    FA, FB = pc.load_model(tmp_path / "a.pcd", SURFACE), pc.load_model(tmp_path / "b.pcd", SURFACE)
+    assert FA.surface_orientation == FB.surface_orientation == pc.NormalOrientation.PointNormals
+    # Without normals in the file, the same sheet (viewpoint inside its box) is propagated.
+    assert pc.load_model(tmp_path / "b_plain.pcd", SURFACE).surface_orientation == pc.NormalOrientation.Propagate
+    request = pc.CollisionRequest(surface=True, exhaustive=True, per_point=True)
+    for z in GAPS:
+        T = translation(0.005, -0.003, z)
+        same_result(pc.collide(FA, FB, T, request), pc.collide(A, B, T, request))
+    # b's file normals reversed (outside up): a 4 mm gap reads as a's points inside b.
+    T = translation(0.005, -0.003, 0.004)
+    assert pc.collide(FA, FB, T, request).signed_distance > 0
+    flipped = pc.load_model(tmp_path / "b_up.pcd", SURFACE)
+    assert flipped.surface_orientation == pc.NormalOrientation.PointNormals
+    assert pc.collide(FA, flipped, T, request).signed_distance < 0
+    # Without params.surface the file's normals are not read: the plain file's model.
+    plain = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    no_surface = pc.load_model(tmp_path / "b.pcd", plain)
+    assert not no_surface.has_surface and no_surface.surface_orientation is None
+    same_result(pc.collide(FA, no_surface, T), pc.collide(FA, pc.load_model(tmp_path / "b_plain.pcd", plain), T))
+
+
+def test_load_model_refuses_partial_normal_fields(sheets, tmp_path):
+    a = sheets[0]
+    write_pcd_with_normals(tmp_path / "half.pcd", a, np.zeros((len(a), 2)), fields="normal_x normal_z")
+    with pytest.raises(ValueError, match="half.pcd.*'normal_y'"):
+        pc.load_model(tmp_path / "half.pcd", SURFACE)
+    # Without a surface the normals are not read, and the file is a plain cloud.
+    assert len(pc.load_model(tmp_path / "half.pcd")) == len(a)
+
+
 def test_sample_mesh_with_normals_is_sample_mesh_with_outward_normals():
     V, F = pc.read_mesh(DATA / "gripper.obj")
     points, normals = pc.sample_mesh_with_normals(V, F, 0.004)

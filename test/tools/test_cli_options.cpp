@@ -57,6 +57,7 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.exhaustive);
   EXPECT_FALSE (o.surface);
   EXPECT_FALSE (o.surface_pooled);
+  EXPECT_FALSE (o.ignore_normals);
   EXPECT_FALSE (o.mesh_spacing);
   EXPECT_FALSE (o.output);
   EXPECT_FALSE (o.json);
@@ -104,6 +105,11 @@ TEST (CliOptions, SurfacePooledImpliesSurface)
   ASSERT_EQ (alone.kind, Kind::Run) << alone.error;
   EXPECT_TRUE (alone.options.surface);
   EXPECT_FALSE (alone.options.surface_pooled);
+  EXPECT_FALSE (alone.options.ignore_normals);
+  const ParseResult ignore = parse ({"-surface", "-ignore_normals"});
+  ASSERT_EQ (ignore.kind, Kind::Run) << ignore.error;
+  EXPECT_TRUE (ignore.options.ignore_normals);
+  expectUsageError ({"-ignore_normals=1"}, "-ignore_normals");
 }
 
 TEST (CliOptions, Help)

@@ -792,6 +792,133 @@ TEST_F (PcdCollisionTool, MeasuredPositionsAreAnOption)
   EXPECT_NE (projected[0]["probability"].text, measured[0]["probability"].text);
 }
 
+// ---------------------------------------------------------------------- clouds with normals
+/** \brief n points spread evenly over a sphere of radius r about the origin (a Fibonacci
+  * lattice), with their outward unit normals times `sign`, as ascii PCD rows "x y z [nx ny nz]". */
+std::string
+sphereRows (int n, double r, double sign, bool normals)
+{
+  std::string rows;
+  char buf[160];
+  for (int i = 0; i < n; ++i)
+  {
+    const double polar = std::acos (1.0 - 2.0 * (i + 0.5) / n);
+    const double azimuth = M_PI * (1.0 + std::sqrt (5.0)) * (i + 0.5);
+    const double d[3] = {std::cos (azimuth) * std::sin (polar), std::sin (azimuth) * std::sin (polar), std::cos (polar)};
+    if (normals)
+      std::snprintf (buf, sizeof (buf), "%.7f %.7f %.7f %.7f %.7f %.7f\n", r * d[0], r * d[1], r * d[2], sign * d[0],
+                     sign * d[1], sign * d[2]);
+    else
+      std::snprintf (buf, sizeof (buf), "%.7f %.7f %.7f\n", r * d[0], r * d[1], r * d[2]);
+    rows += buf;
+  }
+  return rows;
+}
+
+std::string
+pcdHeader (const std::string& fields, int n)
+{
+  const int k = static_cast<int> (std::count (fields.begin (), fields.end (), ' ')) + 1;
+  std::string size, type, count;
+  for (int i = 0; i < k; ++i)
+  {
+    size += i ? " 4" : "4";
+    type += i ? " F" : "F";
+    count += i ? " 1" : "1";
+  }
+  return "VERSION 0.7\nFIELDS " + fields + "\nSIZE " + size + "\nTYPE " + type + "\nCOUNT " + count + "\nWIDTH " +
+         std::to_string (n) + "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string (n) + "\nDATA ascii\n";
+}
+
+// With -surface, a cloud whose file stores normals is oriented by them, taken as outward: a probe
+// 1.5 cm inside a sphere of radius 10 cm (its points 1 cm to 2 cm deep) collides with the sphere
+// whose normals point out and is free of the same sphere with its normals reversed (then the
+// probe is outside it). -ignore_normals orients both the same way (by propagation: outward), and
+// without -surface the normals change nothing.
+TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
+{
+  constexpr int kSphere = 2000, kProbe = 60;
+  const std::string xyz = "x y z", with_normals = "x y z normal_x normal_y normal_z";
+  writeFile (dir_ / "outward.pcd", pcdHeader (with_normals, kSphere) + sphereRows (kSphere, 0.1, +1.0, true));
+  writeFile (dir_ / "inward.pcd", pcdHeader (with_normals, kSphere) + sphereRows (kSphere, 0.1, -1.0, true));
+  writeFile (dir_ / "plain.pcd", pcdHeader (xyz, kSphere) + sphereRows (kSphere, 0.1, 1.0, false));
+  writeFile (dir_ / "outward.ply", "ply\nformat ascii 1.0\nelement vertex " + std::to_string (kSphere) +
+                                       "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
+                                       "property float ny\nproperty float nz\nend_header\n" +
+                                       sphereRows (kSphere, 0.1, +1.0, true));
+  writeFile (dir_ / "probe.pcd", pcdHeader (xyz, kProbe) + sphereRows (kProbe, 0.005, 1.0, false));
+  const std::string probe = (dir_ / "probe.pcd").string ();
+  auto query = [&] (const char* sphere, std::vector<std::string> extra) {
+    std::vector<std::string> args = {probe, (dir_ / sphere).string (), "-sigma", "0.001", "-pose", "0.085,0,0,0,0,0",
+                                     "-json"};
+    args.insert (args.end (), extra.begin (), extra.end ());
+    const ToolRun r = run (args);
+    EXPECT_EQ (r.status, 0) << r.err;
+    const auto out = lines (r.out);
+    EXPECT_EQ (out.size (), 1u) << r.out;
+    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), r.err);
+  };
+  auto orienting = [&] (const std::string& err, const char* sphere) {
+    for (const auto& l : lines (err))
+      if (l.rfind ("Orienting " + (dir_ / sphere).string () + " [", 0) == 0)
+        return l;
+    return std::string ("(no Orienting line)");
+  };
+
+  for (const char* sphere : {"outward.pcd", "outward.ply"})
+  {
+    SCOPED_TRACE (sphere);
+    const auto [out, err] = query (sphere, {"-surface"});
+    EXPECT_EQ (out["verdict"].text, "collision");
+    ASSERT_EQ (out["signed_distance"].type, Value::Type::Number);
+    EXPECT_LT (out["signed_distance"].number, -0.005);
+    EXPECT_NE (orienting (err, sphere).find ("[point_normals: the file's normal_x normal_y normal_z"), std::string::npos)
+        << err;
+    EXPECT_NE (orienting (err, "probe.pcd").find ("[propagate:"), std::string::npos) << err;  // no normals in it
+  }
+  {
+    const auto [out, err] = query ("inward.pcd", {"-surface"});
+    EXPECT_EQ (out["verdict"].text, "free");
+    ASSERT_EQ (out["signed_distance"].type, Value::Type::Number);
+    EXPECT_GT (out["signed_distance"].number, 0.005);
+    EXPECT_NE (orienting (err, "inward.pcd").find ("[point_normals:"), std::string::npos) << err;
+  }
+  for (const char* sphere : {"inward.pcd", "plain.pcd"})
+  {
+    SCOPED_TRACE (sphere);
+    const auto [out, err] = query (sphere, {"-surface", "-ignore_normals"});
+    EXPECT_EQ (out["verdict"].text, "collision");
+    EXPECT_NE (orienting (err, sphere).find ("[propagate:"), std::string::npos) << err;
+  }
+  // Without -surface the file's normals are not read: reversed or absent, the same answer, and
+  // no Orienting line.
+  const auto [plain, plain_err] = query ("plain.pcd", {});
+  const auto [inward, inward_err] = query ("inward.pcd", {});
+  EXPECT_EQ (plain["probability"].text, inward["probability"].text);
+  EXPECT_EQ (plain["verdict"].text, inward["verdict"].text);
+  for (const char* key : {"points_b", "leaf_pairs", "bv_tests"})
+    EXPECT_EQ (plain[key].text, inward[key].text) << key;
+  EXPECT_EQ (plain["signed_distance"].type, Value::Type::Null);
+  EXPECT_EQ (inward_err.find ("Orienting"), std::string::npos) << inward_err;
+}
+
+// Only some normal fields: with -surface an error naming the file and the missing field (exit
+// 1); without -surface the normals are not read and the file is a plain cloud.
+TEST_F (PcdCollisionTool, PartialNormalFieldsFailWithSurface)
+{
+  writeFile (dir_ / "half.pcd", pcdHeader ("x y z normal_x normal_z", 200) + [] {
+    std::string rows;
+    for (int i = 0; i < 200; ++i)
+      rows += std::to_string ((i % 20) * 0.005) + " " + std::to_string ((i / 20) * 0.005) + " 0.5 0 1\n";
+    return rows;
+  }());
+  const std::string half = (dir_ / "half.pcd").string ();
+  expectFailure ({half, kScene.string (), "-surface"}, 1, "'normal_y'", {dir_ / "half.pcd"});
+  expectFailure ({half, kScene.string (), "-surface", "-json"}, 1, "half.pcd", {dir_ / "half.pcd"});
+  EXPECT_EQ (run ({half, kScene.string ()}).status, 0);
+  EXPECT_EQ (run ({half, kScene.string (), "-surface", "-ignore_normals"}).status, 0);
+}
+
 TEST_F (PcdCollisionTool, DemoDataIsReproducible)
 {
   // The recipe in data/README.md regenerates the committed files byte for byte.
