@@ -51,6 +51,14 @@ constexpr double kDeepSigmas = 2.0;
   * inside a closed surface, 1/2 behind an open scanned sheet (space behind a sheet is occupied),
   * 0 beside or in front of either. */
 constexpr double kBehindWinding = 0.25;
+/** \brief Two points of one object are taken as joined by its surface (for the crossing test)
+  * up to this many of their sample spacings apart: a gap narrower than two spacings is below the
+  * sampling's resolution. */
+constexpr double kCrossingSpacings = 3.0;
+/** \brief ... when their normals agree (kSameFaceCosine) and the segment between them lies
+  * within 45 degrees of the tangent plane at both ends (|n . u| below this): the two faces of a
+  * slab, a fork's facing prongs or the two sides of a corner are not one sheet. */
+constexpr double kCrossingTangentCosine = 0.7071;
 /** \brief A winding number above this is inside (about 1 inside a closed surface, 0 outside). */
 constexpr double kInsideWinding = 0.5;
 
@@ -75,6 +83,15 @@ struct Scratch
   std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  /** \brief The current query leaf's points found outside the other surface, for crossings. */
+  struct Outside
+  {
+    int index;
+    Eigen::Vector3d x, normal, own_normal;  ///< the other's face normal; the point's own normal
+    double distance, sigma, spacing;
+    const PackedCovariance* covariance;     ///< the point's own, in its model's frame
+  };
+  std::vector<Outside> outside;
 
   void
   prepare (std::size_t n)
@@ -107,7 +124,71 @@ struct Evaluation
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
   double nearest = 0.0;  ///< distance to the nearest sample
   double spacing = 0.0;  ///< that sample's spacing
+  /** \brief x lies past the surface's edge (distance to the edge, not to a plane). */
+  bool past_edge = false;
+  int first = -1;          ///< the nearest sample (index into the samples)
+  double along = 0.0;      ///< x's offset from it along its normal
+  double tangential = 0.0; ///< and across it
 };
+
+/** \brief True when samples of the surface lie beyond x, seen from its nearest sample `first`
+  * (offset along its normal `along`, `tangential` across it, > 0): in its plane, farther along
+  * the same direction (within 60 degrees), on the same face, within `reach` of its spacings. x then lies over a hole, not past an edge. */
+bool
+farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tangential, double reach,
+        const std::vector<int>& pool, const std::vector<Sample>& samples)
+{
+  const double h = std::max (first.spacing, 1e-12);
+  const Eigen::Vector3d offset = x - first.position;
+  const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
+  const double reach2 = (reach * h) * (reach * h);
+  const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+  for (const int j : pool)
+  {
+    const Sample& s = samples[static_cast<std::size_t> (j)];
+    const Eigen::Vector3d v = s.position - x;
+    const double height = first.normal.dot (v);
+    // Across the gap: within 60 degrees of u in the plane (a sample off to the side, beside an
+    // edge, is not a far rim), on the same face (not the far face of a thin sheet).
+    if (s.normal.dot (first.normal) > kSameFaceCosine &&
+        v.dot (u) > 0.5 * std::sqrt (std::max (0.0, v.squaredNorm () - height * height)) &&
+        std::abs (height + along) < thickness && v.squaredNorm () < reach2)
+      return true;
+  }
+  return false;
+}
+
+/** \brief True when samples of the same face as `first` (x's nearest sample, with normal n)
+  * surround x within `reach` of its spacings: in each quarter of the plane around x (about
+  * the directions +-u and +-n x u, u = across from first to x), one at least. x then lies inside
+  * the face, not at or past its edge. */
+bool
+surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const std::vector<int>& pool,
+            const std::vector<Sample>& samples)
+{
+  const double h = std::max (first.spacing, 1e-12);
+  const Eigen::Vector3d& n = first.normal;
+  const Eigen::Vector3d offset = x - first.position;
+  Eigen::Vector3d u = offset - n.dot (offset) * n;
+  u = u.norm () > 1e-9 * h ? Eigen::Vector3d (u.normalized ()) : n.unitOrthogonal ();
+  const Eigen::Vector3d w = n.cross (u);
+  const double reach2 = (reach * h) * (reach * h);
+  const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+  const double along = n.dot (offset);
+  int quarters = 0;
+  for (const int j : pool)
+  {
+    const Sample& s = samples[static_cast<std::size_t> (j)];
+    const Eigen::Vector3d v = s.position - x;
+    if (s.normal.dot (n) <= kSameFaceCosine || v.squaredNorm () >= reach2 || std::abs (n.dot (v) + along) >= thickness)
+      continue;
+    const double cu = v.dot (u), cw = v.dot (w);
+    quarters |= std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
+    if (quarters == 15)
+      return true;
+  }
+  return false;
+}
 
 /** \brief x against the pool: implicit surface f(x) = sum w_j n_j . (x - p_j) / sum w_j of the
   * nearest samples (Kolluri's IMLS), with robust weights; variance from the query point's own
@@ -153,23 +234,11 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   // More than a spacing along the surface from its nearest sample, the surface either spans a
   // hole (samples of the far rim lie beyond x, in the plane, within the bridging reach) or has
   // ended at an edge (every sample lies behind x). Only a hole is bridged.
-  bool past_edge = tangential > kBridgeSpacings * h;
-  if (!past_edge && tangential > h)
-  {
-    const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
-    const double reach2 = (kBridgeSpacings * h) * (kBridgeSpacings * h);
-    const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
-    past_edge = true;
-    for (const int j : pool)
-    {
-      const Eigen::Vector3d v = samples[static_cast<std::size_t> (j)].position - x;
-      if (v.dot (u) > 0.0 && std::abs (first.normal.dot (v) + along) < thickness && v.squaredNorm () < reach2)
-      {
-        past_edge = false;
-        break;
-      }
-    }
-  }
+  out.first = nearest[0];
+  out.along = along;
+  out.tangential = tangential;
+  const bool past_edge =
+    tangential > kBridgeSpacings * h || (tangential > h && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
   if (past_edge)
   {
     // Past the surface's edge: outside. The edge lies anywhere within a spacing beyond the last
@@ -178,6 +247,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     out.distance = std::sqrt (beyond * beyond + along * along);
     out.normal = offset / std::max (offset.norm (), 1e-300);
     out.sigma = std::sqrt (variance_of (out.normal) + first.variance) + kDiscretisationPerDistance * h;
+    out.past_edge = true;
     return true;
   }
   // The samples split into faces by their normals (up to kMaxFaces: the faces of a box's edge
@@ -287,6 +357,90 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   return true;
 }
 
+/** \brief Crossings within one query leaf: two of its points outside the other surface, joined
+  * by their own surface (kCrossingSpacings, kCrossingTangentCosine), in front of the two opposite
+  * faces of one sheet of it (face normals more than 135 degrees apart, the second point behind
+  * the first's face plane): a wall about as thin as the noise, crossed, where no sample need lie
+  * deep inside anything. The pair misses the sheet only if both lie in front of the first face,
+  * or both beyond the second:
+  * P_free = Phi(d_a / s_a) Phi(g_b / s_b) + Phi(-(d_a + t) / s_a) Phi(d_b / s_b), g_b the second's
+  * offset from the first's face plane (negative), t = max(0, -g_b - d_b) the sheet's thickness.
+  * Unless samples of that face surround the point where the pair meets its plane, the pair may
+  * pass beside or past the sheet's edge: P is scaled by the chance that the sheet reaches there. The distance is z sigma (z the
+  * crossing's Phi^-1, sigma the larger of the pair's deviations), at most the depth a crossing
+  * implies: the sheet's thickness and the smaller of the two clearances. */
+void
+crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vector<float>* per_point,
+           SurfaceAnswer& answer, double& best_z)
+{
+  const auto& outside = scratch.outside;
+  for (const Scratch::Outside& a : outside)
+    for (const Scratch::Outside& b : outside)
+    {
+      const Eigen::Vector3d v = b.x - a.x;
+      const double length = v.norm ();
+      if (&a == &b || length <= 0.0 || length > kCrossingSpacings * std::max (a.spacing, b.spacing) ||
+          a.normal.dot (b.normal) > -kSameFaceCosine)
+        continue;
+      const double g = a.distance + a.normal.dot (v);  // b's offset from a's face plane
+      if (g >= 0.0)
+        continue;
+      // One sheet of the query: the same face (normals within 45 degrees), the segment along it.
+      if (a.own_normal.dot (b.own_normal) < kSameFaceCosine ||
+          std::abs (a.own_normal.dot (v)) > kCrossingTangentCosine * length ||
+          std::abs (b.own_normal.dot (v)) > kCrossingTangentCosine * length)
+        continue;
+      const double t = std::max (0.0, -g - b.distance);
+      double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
+                    normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
+      auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
+      if (!per_point && zOf (free) >= best_z)
+        continue;
+      // Does the sheet reach where the pair meets a's face plane, or does the pair pass beside
+      // or past its edge? Surrounded by samples of that face, it does. Otherwise the point may
+      // lie past an edge: the edge lies anywhere within a spacing past the last sample (half a
+      // spacing on average, 0.29 spacing deviation: kDiscretisationPerDistance's model), and
+      // the point itself is as uncertain as the pair.
+      const Eigen::Vector3d x = a.x + (a.distance / (a.distance - g)) * v;
+      Evaluation at;
+      if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
+                     [] (const Eigen::Vector3d&) { return 0.0; }, at))
+        continue;
+      const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
+      if (!surrounded (x, first, kCrossingSpacings, scratch.pool, scratch.cache))
+      {
+        const double h = std::max (first.spacing, 1e-12);
+        const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));
+        free = 1.0 - (1.0 - free) * normalCdf (-(at.tangential - 0.5 * h) / spread);
+      }
+      const double z = zOf (free);
+      if (per_point)
+      {
+        const float p = static_cast<float> (1.0 - free);
+        for (const int i : {a.index, b.index})
+        {
+          float& slot = (*per_point)[static_cast<std::size_t> (i)];
+          if (std::isnan (slot) || p > slot)
+            slot = p;
+        }
+      }
+      if (z < best_z)
+      {
+        best_z = z;
+        answer.reached = true;
+        // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
+        // the depth a crossing implies (the sheet's thickness and the smaller clearance).
+        const double sigma = std::max (a.sigma, b.sigma);
+        answer.signed_distance = std::max (z * sigma, -(t + std::min (a.distance, b.distance)));
+        answer.signed_distance_std = sigma;
+        answer.witness_side = side;
+        answer.witness_index = a.index;
+        answer.witness_point = x;
+        answer.witness_normal = side > 0 ? a.normal : Eigen::Vector3d (-a.normal);
+      }
+    }
+}
+
 /** \brief The points of `query` (mapped by T_q into A's frame) against `surface` (mapped by
   * T_s), leaf by leaf: groups[i] = (query leaf, surface leaf) sorted by query leaf. */
 void
@@ -297,6 +451,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const ProbabilisticBVH& q_bvh = query.hierarchy ();
   const ProbabilisticBVH& s_bvh = surface.hierarchy ();
   const SurfaceModel& s_model = surface.surface ();
+  const SurfaceModel& q_model = query.surface ();
   const Eigen::Matrix3d R_q = T_q.linear ();
   const Eigen::Matrix3d R_s = T_s.linear ();
   const Eigen::Isometry3d T_s_inverse = T_s.inverse ();
@@ -343,6 +498,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       scratch.keys[k] = scratch.order[k].first;
       scratch.pool[k] = scratch.order[k].second;
     }
+    scratch.outside.clear ();
     for (const int i : q_bvh.indices (q_bvh.node (q_leaf)))
     {
       const std::size_t qi = static_cast<std::size_t> (i);
@@ -369,6 +525,9 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       }
       const double sigma = std::max (e.sigma, 1e-300);
       const double z = e.distance / sigma;
+      if (e.distance > 0.0 && !e.normal.isZero ())
+        scratch.outside.push_back ({i, x, e.normal, R_q * q_model.normals ()[qi].cast<double> (), e.distance, sigma,
+                                    static_cast<double> (q_model.spacing ()[qi]), &cov});
       if (per_point)
       {
         float& slot = (*per_point)[qi];
@@ -389,6 +548,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         answer.witness_normal = side > 0 ? e.normal : Eigen::Vector3d (-e.normal);
       }
     }
+    crossings (scratch, center, side, per_point, answer, best_z);
   }
 }
 

@@ -336,3 +336,44 @@ TEST (SurfaceLayer, PerPointValuesAndWitness)
     EXPECT_NEAR (r.witness_point.z (), 5.0, 0.01);
   }
 }
+
+/** \brief A vertical plate x in [x0, x0 + 0.4], faces y = +-0.01 (given normals +-y), sampled
+  * every 0.04 in x and at the heights zs. */
+pcl::PointCloud<pcl::PointNormal>
+plate (double x0, const std::vector<double>& zs)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  for (const double y : {-0.01, 0.01})
+    for (int i = 0; i <= 10; ++i)
+      for (const double z : zs)
+      {
+        pcl::PointNormal p;
+        p.x = static_cast<float> (x0 + 0.04 * i);
+        p.y = static_cast<float> (y);
+        p.z = static_cast<float> (z);
+        p.normal_x = p.normal_z = 0.0f;
+        p.normal_y = y > 0.0 ? 1.0f : -1.0f;
+        cloud.push_back (p);
+      }
+  return cloud;
+}
+
+// Two thin sheets crossing: a plate through a wall three noise deviations thick (sigma 1 cm,
+// wall 3 cm, both sampled every 4-5 cm). No sample of either lies inside the other: the plate's
+// nearest samples are 2 sigma in front of each face. The crossing test reads collision from the
+// pairs on either side; the same plate beside the wall's edge (6 cm clear) reads free.
+TEST (SurfaceLayer, ThinSheetsCrossingWithoutDeepSamples)
+{
+  const double sigma = 0.01;
+  const auto wall = buildCloudModel (slab (1.0, 0.03, 0.05), noisy (sigma));
+  const std::vector<double> zs {-0.14, -0.10, -0.06, -0.02, 0.05, 0.09, 0.13, 0.17};
+  const auto through = buildCloudModel (plate (-0.2, zs), noisy (sigma));
+  const auto beside = buildCloudModel (plate (0.56, zs), noisy (sigma));
+  CollisionResult crossing, clear;
+  ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), crossing));
+  ASSERT_TRUE (collide (*beside, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), clear));
+  EXPECT_EQ (crossing.verdict, Verdict::InCollision) << crossing.probability << " d " << crossing.signed_distance;
+  // The depth is a bound: the wall's thickness and the smaller clearance.
+  EXPECT_LT (crossing.signed_distance, -0.03) << crossing.signed_distance;
+  EXPECT_EQ (clear.verdict, Verdict::Free) << clear.probability << " d " << clear.signed_distance;
+}
