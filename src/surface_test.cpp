@@ -348,9 +348,27 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     if (concave == (other.f < chosen.f))
       chosen = other;
   }
-  // Where the surface runs between samples is uncertain within one spacing of the last one;
-  // a bridged hole continues the fitted plane.
-  const double disc = kDiscretisationPerDistance * std::min (tangential, h);
+  // Where the surface runs between samples is uncertain within one spacing of the last one
+  // (an edge may lie there); a bridged hole continues the fitted plane. Inside a face, its
+  // samples among the nearest on all four sides of x (quarters about u = across from the
+  // nearest sample to x, and n x u), no edge lies between them: the plane holds there.
+  bool inside_face = false;
+  if (tangential > 0.0)
+  {
+    const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
+    const Eigen::Vector3d w = first.normal.cross (u);
+    int quarters = 0;
+    for (int j = 0; j < found; ++j)
+    {
+      if (face[static_cast<std::size_t> (j)] != 0)
+        continue;
+      const Eigen::Vector3d v = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])].position - x;
+      const double cu = v.dot (u), cw = v.dot (w);
+      quarters |= std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
+    }
+    inside_face = quarters == 15;
+  }
+  const double disc = inside_face ? 0.0 : kDiscretisationPerDistance * std::min (tangential, h);
   out.distance = chosen.f;
   out.normal = chosen.normal;
   out.sigma = std::sqrt (variance_of (out.normal) + chosen.fit_var + disc * disc);
