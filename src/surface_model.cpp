@@ -3,6 +3,8 @@
 
 #include <pcl/exceptions.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <queue>
@@ -176,8 +178,42 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   }
   spacing_.resize (n);
   const double scale = std::sqrt (kPi / in.k);
+  const std::size_t k = static_cast<std::size_t> (in.k);
   for (std::size_t i = 0; i < n; ++i)
-    spacing_[i] = std::isfinite (in.radii[i]) ? static_cast<float> (in.radii[i] * scale) : 0.0f;
+  {
+    if (!std::isfinite (in.radii[i]))
+    {
+      spacing_[i] = 0.0f;
+      continue;
+    }
+    double s = in.radii[i] * scale;
+    // On a strip narrower than the neighbourhood (a board's edge, a leg, a thin rim) the k
+    // neighbours do not fill the disc of radius r_k: the area they cover is that of the ellipse
+    // of their spread in the plane, 4 pi sqrt(l1 l2) (l1, l2 the two larger eigenvalues; pi r^2
+    // on a uniformly filled disc), so the spacing is at most sqrt(area / (k + 1)).
+    Eigen::Vector3d mean = points[i];
+    Eigen::Matrix3d second = points[i] * points[i].transpose ();
+    std::size_t count = 1;
+    for (std::size_t j = 0; j < k; ++j)
+    {
+      const int t = in.neighbours[i * k + j];
+      if (t < 0 || static_cast<std::size_t> (t) >= n)
+        continue;
+      const Eigen::Vector3d& p = points[static_cast<std::size_t> (t)];
+      mean += p;
+      second += p * p.transpose ();
+      ++count;
+    }
+    if (count >= 3)
+    {
+      mean /= static_cast<double> (count);
+      const Eigen::Matrix3d cov = second / static_cast<double> (count) - mean * mean.transpose ();
+      const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> (cov, Eigen::EigenvaluesOnly).eigenvalues ();
+      const double area = 4.0 * kPi * std::sqrt (std::max (0.0, l[1]) * std::max (0.0, l[2]));
+      s = std::min (s, std::sqrt (area / static_cast<double> (count)));
+    }
+    spacing_[i] = static_cast<float> (s);
+  }
   {
     std::vector<float> sorted (spacing_);
     std::nth_element (sorted.begin (), sorted.begin () + static_cast<std::ptrdiff_t> (n / 2), sorted.end ());

@@ -324,7 +324,9 @@ def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
         same_result(r, s)
         same_result(rb, s)
         if z < 0.1:
-            assert np.sign(r.signed_distance) == np.sign(z) and abs(r.signed_distance - z) < 1e-3, (z, r.signed_distance)
+            # Within about one sigma_eff (1.4 mm): exhaustive, the deepest of 900 noisy points
+            # answers, which the noise biases deeper (docs/SURFACE.md, shared error).
+            assert np.sign(r.signed_distance) == np.sign(z) and abs(r.signed_distance - z) < 1.5e-3, (z, r.signed_distance)
         else:
             assert np.isnan(r.signed_distance)
 
