@@ -123,6 +123,7 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   result.probability = s.probability;
   result.signed_distance = s.signed_distance;
   result.signed_distance_std = s.signed_distance_std;
+  result.unobserved = s.unobserved;
   result.no_leaf_tested = !s.reached;
   result.lower_bound = s.stopped_early;
   result.leaf_pairs_tested = s.leaf_pairs;

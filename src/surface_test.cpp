@@ -126,6 +126,8 @@ struct Evaluation
   double spacing = 0.0;  ///< that sample's spacing
   /** \brief x lies past the surface's edge (distance to the edge, not to a plane). */
   bool past_edge = false;
+  /** \brief The surface spans a hole in the samples here (far rim found beyond a spacing). */
+  bool bridged = false;
   int first = -1;          ///< the nearest sample (index into the samples)
   double along = 0.0;      ///< x's offset from it along its normal
   double tangential = 0.0; ///< and across it
@@ -239,6 +241,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   out.tangential = tangential;
   const bool past_edge =
     tangential > kBridgeSpacings * h || (tangential > h && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
+  out.bridged = !past_edge && tangential > h;
   if (past_edge)
   {
     // Past the surface's edge: outside. The edge lies anywhere within a spacing beyond the last
@@ -451,6 +454,7 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
         const double sigma = std::max (a.sigma, b.sigma);
         answer.signed_distance = std::max (z * sigma, -(t + std::min (a.distance, b.distance)));
         answer.signed_distance_std = sigma;
+        answer.unobserved = false;
         answer.witness_side = side;
         answer.witness_index = a.index;
         answer.witness_point = x;
@@ -470,6 +474,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const ProbabilisticBVH& s_bvh = surface.hierarchy ();
   const SurfaceModel& s_model = surface.surface ();
   const SurfaceModel& q_model = query.surface ();
+  const bool behind_unseen = s_model.orientation () == NormalOrientation::Viewpoint;
   const Eigen::Matrix3d R_q = T_q.linear ();
   const Eigen::Matrix3d R_s = T_s.linear ();
   const Eigen::Isometry3d T_s_inverse = T_s.inverse ();
@@ -535,12 +540,15 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       // Only a point that matters is checked: one that would set the pair's minimum, or any
       // with per-point values.
       const bool matters = per_point || e.distance / std::max (e.sigma, 1e-300) < best_z;
-      if (matters && e.distance < 0.0 && (e.nearest > e.spacing || e.distance < -kDeepSigmas * e.sigma) &&
-          s_model.windingNumber (s_bvh, T_s_inverse * x) < kBehindWinding)
+      const bool deep = e.distance < 0.0 && (e.nearest > e.spacing || e.distance < -kDeepSigmas * e.sigma);
+      if (matters && deep && s_model.windingNumber (s_bvh, T_s_inverse * x) < kBehindWinding)
       {
         e.distance = e.nearest;
         e.normal = Eigen::Vector3d::Zero ();
       }
+      // Over a bridged hole, or clearly behind a surface seen from one viewpoint (whose far
+      // side no sample shows), the answer rests on surface the samples do not show.
+      const bool unobserved = e.bridged || (behind_unseen && deep && e.distance < 0.0);
       const double sigma = std::max (e.sigma, 1e-300);
       const double z = e.distance / sigma;
       if (e.distance > 0.0 && !e.normal.isZero ())
@@ -564,6 +572,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         answer.witness_point = x;
         // Toward A's side: the other surface's outward normal points away from it.
         answer.witness_normal = side > 0 ? e.normal : Eigen::Vector3d (-e.normal);
+        answer.unobserved = unobserved;
       }
     }
     crossings (scratch, center, side, per_point, answer, best_z);
@@ -747,6 +756,8 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
       answer.signed_distance = -depth;
       // The depth is measured to the nearest sample: uncertain by about one spacing.
       answer.signed_distance_std = s.medianSpacing ();
+      // Inside a surface seen from one viewpoint: behind it, where no sample looked.
+      answer.unobserved = s.orientation () == NormalOrientation::Viewpoint;
     }
     best_z = -std::numeric_limits<double>::infinity ();
   }

@@ -33,6 +33,9 @@ struct SurfaceAnswer
   /** \brief Its position, and the other surface's normal there pointing toward A's side. */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  /** \brief The deciding point lies over a bridged hole, or clearly behind a surface oriented
+    * by its viewpoint (CollisionResult::unobserved). */
+  bool unobserved = false;
   /** \brief Stopped at the first point with P_in > collision_above (decision mode): P and the
     * distance are then bounds (the deepest point may lie elsewhere). */
   bool stopped_early = false;

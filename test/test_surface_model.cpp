@@ -230,6 +230,8 @@ TEST (SurfaceLayer, BehindAScannedSheetIsNotFree)
   CollisionResult r;
   ASSERT_TRUE (collide (*top, *table, shift (0, 0, -0.01), surfaceRequest (), r));
   EXPECT_NE (r.verdict, Verdict::Free);
+  // ... and that space was never seen: the answer says so.
+  EXPECT_TRUE (r.unobserved);
 }
 
 // Sparse table (spacing 10 sigma): a point between four samples, 3 sigma under the surface, is
@@ -260,6 +262,7 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   ASSERT_TRUE (collide (*ball, *big, shift (2.0, 0.0, 0.0), surfaceRequest (), outside));
   EXPECT_EQ (inside.verdict, Verdict::InCollision);
   EXPECT_LT (inside.signed_distance, -0.5);  // about 0.75 deep: at least half of it
+  EXPECT_FALSE (inside.unobserved);          // inside a closed surface, not behind a sheet
   EXPECT_EQ (outside.verdict, Verdict::Free);
   EXPECT_TRUE (outside.no_leaf_tested);
 }
@@ -376,4 +379,29 @@ TEST (SurfaceLayer, ThinSheetsCrossingWithoutDeepSamples)
   // The depth is a bound: the wall's thickness and the smaller clearance.
   EXPECT_LT (crossing.signed_distance, -0.03) << crossing.signed_distance;
   EXPECT_EQ (clear.verdict, Verdict::Free) << clear.probability << " d " << clear.signed_distance;
+}
+
+// A closed slab (given normals) whose top face has a hole 4 spacings wide (an occlusion
+// shadow): a point just under the top face reads inside both over the hole (the surface bridges
+// it; the point 1.2 spacings from the rim, within the query's reach) and under sampled top; only
+// the first answer rests on surface no sample showed.
+TEST (SurfaceLayer, AnswersOverABridgedHoleAreUnobserved)
+{
+  const double h = 0.01, sigma = 0.001;
+  pcl::PointCloud<pcl::PointNormal> holed;
+  for (const auto& p : slab (0.4, 0.05, h))
+    if (!(p.normal_z > 0.0f && std::abs (p.x) < 0.015f && std::abs (p.y) < 0.015f))
+      holed.push_back (p);
+  const auto box = buildCloudModel (holed, noisy (sigma));
+  pcl::PointCloud<pcl::PointXYZ> probe;
+  probe.push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
+  const auto point = buildCloudModel (probe, withSurface ());
+  CollisionResult hole, sampled;
+  // 8 sigma under the top face (z = 0.05): over the hole, and 0.1 away from it.
+  ASSERT_TRUE (collide (*point, *box, shift (-0.008, 0, -0.042), surfaceRequest (), hole));
+  ASSERT_TRUE (collide (*point, *box, shift (-0.1, 0, -0.042), surfaceRequest (), sampled));
+  EXPECT_EQ (hole.verdict, Verdict::InCollision) << hole.probability << " d " << hole.signed_distance << " +- " << hole.signed_distance_std;
+  EXPECT_EQ (sampled.verdict, Verdict::InCollision) << sampled.probability;
+  EXPECT_TRUE (hole.unobserved);
+  EXPECT_FALSE (sampled.unobserved);
 }

@@ -53,9 +53,10 @@ struct CollisionResult
   /** \brief True when the answer rests on surface the samples do not show (the surface layer
     * only; docs/SURFACE.md): the deciding point lies over a hole in the other cloud's samples
     * that the surface bridges (an occlusion shadow, wider than a sample spacing, with samples on
-    * its far rim), or behind a scanned sheet whose far side was never seen (the winding number
-    * of an open sheet, about 1/2, not that of a closed surface). P and the verdict then say what
-    * the bridged or occupied surface implies; a planner may treat such a pose as unknown. */
+    * its far rim), or clearly behind (beyond its noise) a surface oriented by its viewpoint
+    * (NormalOrientation::Viewpoint: a scan from one sensor, which never sees behind it). P and
+    * the verdict then say what the bridged or occupied surface implies; a planner may treat
+    * such a pose as unknown. */
   bool unobserved = false;
 
   /** \brief The point attaining P: side +1 = input (A), -1 = target (B), 0 = none. */
