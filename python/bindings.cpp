@@ -806,6 +806,12 @@ PYBIND11_MODULE (_core, m)
                      "the discretisation between samples); NaN with it.")
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
       .def_readonly ("no_leaf_tested", &CollisionResult::no_leaf_tested)
+      .def_readonly ("unobserved", &CollisionResult::unobserved,
+                     "True when the surface layer's answer rests on surface the samples do not show\n"
+                     "(docs/SURFACE.md): the deciding point lies over a hole in the other cloud's samples that the\n"
+                     "surface bridges (an occlusion shadow), or behind a scanned sheet whose far side was never seen.\n"
+                     "P and the verdict then say what the bridged or occupied surface implies; a planner may treat\n"
+                     "such a pose as unknown. Always False without request.surface.")
       .def_readonly ("witness_side", &CollisionResult::witness_side)
       .def_readonly ("witness_index", &CollisionResult::witness_index)
       .def_property_readonly ("witness_point", [] (const CollisionResult& r) { return vec3 (r.witness_point); })
@@ -830,6 +836,8 @@ PYBIND11_MODULE (_core, m)
           s += ", signed_distance=" + num (r.signed_distance);
         if (!std::isnan (r.signed_distance_std))
           s += ", signed_distance_std=" + num (r.signed_distance_std);
+        if (r.unobserved)  // shown only when set, like the signed distance only when computed
+          s += ", unobserved=True";
         s = s + ", lower_bound=" + (r.lower_bound ? "True" : "False") +
             ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
             ", witness_side=" + std::to_string (r.witness_side) +

@@ -294,6 +294,9 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("probability").number (r.probability);
   j.key ("signed_distance").number (r.signed_distance);
   j.key ("signed_distance_std").number (r.signed_distance_std);
+  // Always a boolean (false without -surface): the surface layer's answer rests on surface the
+  // samples do not show (CollisionResult::unobserved).
+  j.key ("unobserved").boolean (r.unobserved);
   j.key ("lower_bound").boolean (r.lower_bound);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
   j.key ("points_a").unsignedInteger (r.points_a);
@@ -380,11 +383,14 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
   char distance[96] = "";
   if (std::isfinite (r.signed_distance))
     std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f", r.signed_distance, r.signed_distance_std);
+  // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
+  const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   std::snprintf (buf, sizeof (buf),
-                 "%s%-9s P %s %.6f%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "%s%-9s P %s %.6f%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
                  "query %.1f ms]",
                  prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
-                 r.probability, distance, r.points_a, r.points_b, r.points_skipped_nonfinite, r.leaf_pairs_tested,
+                 r.probability, distance, unobserved, r.points_a, r.points_b, r.points_skipped_nonfinite,
+                 r.leaf_pairs_tested,
                  std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
   return buf;
 }

@@ -108,6 +108,10 @@ class CollisionResult:
     @property
     def no_leaf_tested(self) -> bool: ...
     @property
+    def unobserved(self) -> bool:
+        """True when the surface layer's answer rests on surface the samples do not show (a bridged hole or
+        occlusion shadow, or space behind a scanned sheet); always False without request.surface."""
+    @property
     def witness_side(self) -> int: ...
     @property
     def witness_index(self) -> int: ...

@@ -22,7 +22,7 @@ def same_result(r, s):
     assert r.probability == s.probability  # exact, not approx
     # The surface layer's distance: exact too, NaN (not computed) on both sides alike.
     np.testing.assert_array_equal([r.signed_distance, r.signed_distance_std], [s.signed_distance, s.signed_distance_std])
-    for f in ("lower_bound", "no_leaf_tested", "witness_side", "witness_index", "points_a", "points_b",
+    for f in ("lower_bound", "no_leaf_tested", "unobserved", "witness_side", "witness_index", "points_a", "points_b",
               "points_skipped_nonfinite", "bv_tests", "leaf_pairs_tested", "kernel_leaf_pairs",
               "degenerate_leaf_pairs", "classifier_iterations"):
         assert getattr(r, f) == getattr(s, f), f
@@ -289,6 +289,27 @@ def test_surface_signed_distance_is_nan_when_off(sheets):
     same_result(r, pc.collide(A0, B0, T))
     # The surface only adds to the points' model: the separators' answer is unchanged by it.
     same_result(off, r)
+
+
+def test_unobserved_is_false_without_the_surface_layer(sheets):
+    # CollisionResult.unobserved: a read-only bool, set only by the surface layer (an answer that
+    # rests on surface the samples do not show); shown in the repr only when True.
+    a, b, A, B = sheets
+    assert pc.CollisionResult().unobserved is False
+    T = translation(0.005, -0.003, -0.002)
+    near, far = pc.collide(A, B, T), pc.collide(A, B, translation(0, 0, 0.2))
+    assert near.ok and near.leaf_pairs_tested > 0 and far.no_leaf_tested
+    for r in (near, far, *pc.collide_batch(A, B, np.stack([T, T]), threads=1)):
+        assert r.unobserved is False
+        assert "unobserved" not in repr(r)
+    with pytest.raises(AttributeError):
+        near.unobserved = True
+    assert "surface" in type(near).unobserved.__doc__
+    # With the surface layer the attribute is a bool either way; whether it is set depends on the
+    # surface layer's detection (tested with it), so only the repr's consistency is asserted here.
+    on = pc.collide(A, B, T, pc.CollisionRequest(surface=True))
+    assert isinstance(on.unobserved, bool)
+    assert ("unobserved=True" in repr(on)) == on.unobserved
 
 
 def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):

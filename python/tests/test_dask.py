@@ -162,12 +162,12 @@ TIMING_KEYS = {"build_ms", "query_ms", "timings_ms"}
 
 
 def _compare_json_lines(cpp_text, py_text):
-    """Every key but the timings equal, signed_distance(_std) and parameters.surface included."""
+    """Every key but the timings equal, signed_distance(_std), unobserved and parameters.surface included."""
     cpp = [json.loads(line) for line in cpp_text.splitlines()]
     py = [json.loads(line) for line in py_text.splitlines()]
     assert len(cpp) == len(py) > 0
     for c, p in zip(cpp, py):
-        assert {"signed_distance", "signed_distance_std"} <= set(c) and "surface" in c["parameters"]
+        assert {"signed_distance", "signed_distance_std", "unobserved"} <= set(c) and "surface" in c["parameters"]
         keys = set(c) - TIMING_KEYS
         assert keys <= set(p), f"missing keys {keys - set(p)}"
         for k in sorted(keys):
@@ -212,6 +212,7 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     assert {a["verdict"] for a in answers} >= {"free", "collision"}
     assert answers[0]["points_skipped_nonfinite"] == 1
     distances = [a["signed_distance"] for a in answers]
+    assert all(isinstance(a["unobserved"], bool) for a in answers)  # never null
     assert all(a["parameters"]["surface_pooled"] == ("-surface_pooled" in flags) for a in answers)
     if "-surface" in flags or "-surface_pooled" in flags:
         assert all(a["parameters"]["surface"] for a in answers)
@@ -219,6 +220,7 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
         assert any(d is not None and d < 0 for d in distances)
     else:
         assert distances == [None] * 61
+        assert not any(a["unobserved"] for a in answers)  # only the surface layer sets it
 
 
 def test_cli_surface_with_a_mesh_equals_pcd_collision():
@@ -254,12 +256,15 @@ def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     np.testing.assert_array_equal(r.signed_distance, [x.signed_distance for x in ref])
     np.testing.assert_array_equal(r.signed_distance_std, [x.signed_distance_std for x in ref])
     np.testing.assert_array_equal(r.probability, [x.probability for x in ref])
+    assert r.unobserved.dtype == bool
+    np.testing.assert_array_equal(r.unobserved, [x.unobserved for x in ref])
     assert np.isfinite(r.signed_distance[:4]).all() and np.isnan(r.signed_distance[4])
     # Sheets oriented by propagation have no known outside: only |d| is meaningful here; the
     # sign is asserted with oriented sheets in test_bindings.py and with the mesh above.
     np.testing.assert_allclose(np.abs(r.signed_distance[:4]), np.abs(z[:4]), atol=1.5e-3)
     off = pcd.collide_poses(a, b, P, sigma=0.001)
     assert np.isnan(off.signed_distance).all() and np.isnan(off.signed_distance_std).all()
+    assert off.unobserved.dtype == bool and not off.unobserved.any()
 
 
 def test_cli_errors_match_pcd_collision(tmp_path):

@@ -327,6 +327,62 @@ TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
   EXPECT_EQ (v[0]["witness"].type, Value::Type::Null);
 }
 
+// "unobserved" (CollisionResult::unobserved): always a boolean, right after the signed distance;
+// false without -surface. The human summary carries the marker exactly on the poses whose JSON
+// says true. Whether the surface layer sets it here is its own test's business: with -surface
+// only the member and the agreement of both outputs are asserted.
+TEST_F (PcdCollisionTool, JsonUnobservedIsAlwaysABoolean)
+{
+  const std::string marker = "  (unobserved: across a hole or behind a sheet)   [points ";
+  auto check = [&] (const std::vector<std::string>& extra, bool surface) {
+    std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses", kPoses.string ()};
+    args.insert (args.end (), extra.begin (), extra.end ());
+    const ToolRun text = run (args);
+    args.push_back ("-json");
+    const ToolRun r = run (args);
+    ASSERT_EQ (r.status, 0) << r.err;
+    ASSERT_EQ (text.status, 0) << text.err;
+    const auto out = lines (r.out);
+    ASSERT_EQ (out.size (), 3u) << r.out;
+    const auto human = lines (text.out);  // batch: one "pose i:" line per pose, no witness line
+    ASSERT_EQ (human.size (), out.size ()) << text.out;
+    for (std::size_t i = 0; i < out.size (); ++i)
+    {
+      SCOPED_TRACE (out[i]);
+      const Value j = mini_json::parse (out[i]);
+      ASSERT_TRUE (j.has ("unobserved"));
+      ASSERT_EQ (j["unobserved"].type, Value::Type::Bool);
+      const bool unobserved = j["unobserved"].boolean;
+      if (!surface)
+      {
+        EXPECT_FALSE (unobserved);
+        EXPECT_NE (out[i].find ("\"signed_distance_std\":null,\"unobserved\":false,\"lower_bound\":"),
+                   std::string::npos);
+      }
+      // Next to the signed distance, in the documented order.
+      const std::size_t std_at = out[i].find ("\"signed_distance_std\":"),
+                        at = out[i].find (std::string ("\"unobserved\":") + (unobserved ? "true" : "false")),
+                        lower_at = out[i].find ("\"lower_bound\":");
+      ASSERT_NE (at, std::string::npos);
+      EXPECT_LT (std_at, at);
+      EXPECT_LT (at, lower_at);
+      EXPECT_EQ (human[i].find (marker) != std::string::npos, unobserved) << human[i];
+      if (!unobserved)
+      {
+        EXPECT_EQ (human[i].find ("unobserved"), std::string::npos) << human[i];
+      }
+    }
+  };
+  {
+    SCOPED_TRACE ("without -surface");
+    check ({}, false);
+  }
+  {
+    SCOPED_TRACE ("-surface");
+    check ({"-surface", "-sigma", "0.0015"}, true);
+  }
+}
+
 TEST_F (PcdCollisionTool, DemoPosesVerdicts)
 {
   const auto v = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string ()});

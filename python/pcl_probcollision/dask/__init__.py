@@ -288,6 +288,8 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         # NaN without surface (or where the surfaces never came within reach), as in CollisionResult.
         "signed_distance": np.array([r.signed_distance for r in results], dtype=np.float64),
         "signed_distance_std": np.array([r.signed_distance_std for r in results], dtype=np.float64),
+        # The surface layer's answer rests on surface the samples do not show; False without surface.
+        "unobserved": np.array([r.unobserved for r in results], dtype=bool),
         "witness_side": np.array([r.witness_side for r in results], dtype=np.int8),
         "query_ms": np.array([r.query_ms for r in results], dtype=np.float64),
     }
@@ -311,6 +313,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
 class BatchResults:
     """Answers in pose order, one numpy array per field: probability, verdict (int8 of Verdict),
     status, lower_bound, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
+    unobserved (bool: with surface=True, the answer rests on surface the samples do not show; False otherwise),
     the counters (points_a, points_b, points_skipped_nonfinite, leaf_pairs_tested, bv_tests,
     kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
     witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; chunk_size
@@ -393,7 +396,8 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
         sigma_max, epsilon, split, mesh_density) and threads (collide_batch threads per task).
         surface=True is pcd_collision's -surface: both models get the oriented surface (meshes
         by their faces' normals) and signed_distance / signed_distance_std are filled (NaN
-        otherwise, and for poses where the surfaces never came within reach).
+        otherwise, and for poses where the surfaces never came within reach), and unobserved may
+        be True (the answer rests on surface the samples do not show; always False otherwise).
     Returns BatchResults in pose order, identical to the single-process answers."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)

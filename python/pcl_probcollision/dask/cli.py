@@ -213,9 +213,11 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
     inputs = f'{{"a":{_input_json(a)},"b":{_input_json(b)}}}'
     sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
-    # The surface layer's signed distance: null without -surface or out of reach, as pcd_collision.
+    # The surface layer's signed distance: null without -surface or out of reach, as pcd_collision;
+    # unobserved always a boolean (false without -surface).
     def surface(i):
-        return f'"signed_distance":{_num(r.signed_distance[i])},"signed_distance_std":{_num(r.signed_distance_std[i])},'
+        return (f'"signed_distance":{_num(r.signed_distance[i])},"signed_distance_std":{_num(r.signed_distance_std[i])},'
+                f'"unobserved":{_bool(r.unobserved[i])},')
 
     for i in range(len(r)):
         build = r.build_ms if i == 0 else 0.0
