@@ -51,6 +51,16 @@ sphere (int n, double r, const Eigen::Vector3d& c, bool flipped = false)
   return cloud;
 }
 
+/** \brief A point at (x, y, z) with normal n. */
+pcl::PointNormal
+pointNormal (double x, double y, double z, const Eigen::Vector3f& n)
+{
+  pcl::PointNormal p;
+  p.getVector3fMap () = Eigen::Vector3d (x, y, z).cast<float> ();
+  p.getNormalVector3fMap () = n;
+  return p;
+}
+
 pcl::PointCloud<pcl::PointXYZ>
 xyz (const pcl::PointCloud<pcl::PointNormal>& in)
 {
@@ -177,15 +187,8 @@ slab (double size, double thickness, double h)
   for (const double z : {0.0, thickness})
     for (int i = 0; i <= n; ++i)
       for (int j = 0; j <= n; ++j)
-      {
-        pcl::PointNormal p;
-        p.x = static_cast<float> (-0.5 * size + i * h);
-        p.y = static_cast<float> (-0.5 * size + j * h);
-        p.z = static_cast<float> (z);
-        p.normal_x = p.normal_y = 0.0f;
-        p.normal_z = z > 0.0 ? 1.0f : -1.0f;
-        cloud.push_back (p);
-      }
+        cloud.push_back (pointNormal (-0.5 * size + i * h, -0.5 * size + j * h, z,
+                                      Eigen::Vector3f (0.0f, 0.0f, z > 0.0 ? 1.0f : -1.0f)));
   return cloud;
 }
 
@@ -349,15 +352,7 @@ plate (double x0, const std::vector<double>& zs)
   for (const double y : {-0.01, 0.01})
     for (int i = 0; i <= 10; ++i)
       for (const double z : zs)
-      {
-        pcl::PointNormal p;
-        p.x = static_cast<float> (x0 + 0.04 * i);
-        p.y = static_cast<float> (y);
-        p.z = static_cast<float> (z);
-        p.normal_x = p.normal_z = 0.0f;
-        p.normal_y = y > 0.0 ? 1.0f : -1.0f;
-        cloud.push_back (p);
-      }
+        cloud.push_back (pointNormal (x0 + 0.04 * i, y, z, Eigen::Vector3f (0.0f, y > 0.0 ? 1.0f : -1.0f, 0.0f)));
   return cloud;
 }
 
