@@ -23,12 +23,7 @@ namespace
 class CloudInput : public ::testing::Test
 {
 protected:
-  void SetUp () override
-  {
-    dir_ = fs::path (TEST_WORK_DIR) / ("cloud_input_" + std::string (::testing::UnitTest::GetInstance ()->current_test_info ()->name ()));
-    fs::remove_all (dir_);
-    fs::create_directories (dir_);
-  }
+  void SetUp () override { dir_ = test_files::freshTestDir ("cloud_input_"); }
   std::string path (const char* name) const { return (dir_ / name).string (); }
   fs::path dir_;
 };

@@ -2,6 +2,8 @@
 #pragma once
 // Small file helpers shared by the CLI tests.
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -35,4 +37,16 @@ lines (const std::string& text)
     out.push_back (l);
   return out;
 }
+#ifdef TEST_WORK_DIR
+/** \brief An empty directory for the running test: TEST_WORK_DIR/<prefix><test name>. */
+inline std::filesystem::path
+freshTestDir (const std::string& prefix)
+{
+  const std::filesystem::path dir =
+    std::filesystem::path (TEST_WORK_DIR) / (prefix + ::testing::UnitTest::GetInstance ()->current_test_info ()->name ());
+  std::filesystem::remove_all (dir);
+  std::filesystem::create_directories (dir);
+  return dir;
+}
+#endif
 } // namespace test_files

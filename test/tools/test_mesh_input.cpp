@@ -48,12 +48,7 @@ lowercase (std::string s)
 class MeshInput : public ::testing::Test
 {
 protected:
-  void SetUp () override
-  {
-    dir_ = fs::path (TEST_WORK_DIR) / ("mesh_input_" + std::string (::testing::UnitTest::GetInstance ()->current_test_info ()->name ()));
-    fs::remove_all (dir_);
-    fs::create_directories (dir_);
-  }
+  void SetUp () override { dir_ = test_files::freshTestDir ("mesh_input_"); }
   fs::path dir_;
 };
 } // namespace
