@@ -127,7 +127,7 @@ fillCovariances (const py::array& arr, pcl::PointCloud<Covariance>& covs)
   * a row with a NaN or a zero normal has none (the surface model orients it from its neighbours). */
 template <typename T>
 void
-fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud)
+fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud, bool any_length)
 {
   const auto a = arr.unchecked<T, 2> ();
   for (py::ssize_t i = 0; i < a.shape (0); ++i)
@@ -137,7 +137,7 @@ fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud)
     p.normal_y = static_cast<float> (a (i, 1));
     p.normal_z = static_cast<float> (a (i, 2));
     const Eigen::Vector3f n (p.normal_x, p.normal_y, p.normal_z);
-    if (n.allFinite () && n.squaredNorm () > 0.0f && std::abs (n.norm () - 1.0f) > 1e-3f)
+    if (!any_length && n.allFinite () && n.squaredNorm () > 0.0f && std::abs (n.norm () - 1.0f) > 1e-3f)
       throw py::value_error ("normals: row " + std::to_string (i) + " is not of unit length (norm " +
                              std::to_string (n.norm ()) + "); give unit normals, or NaN / 0 for none");
   }
@@ -146,7 +146,7 @@ fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud)
 std::shared_ptr<const CloudModel>
 buildModel (const py::object& points, const py::object& covariances, const py::object& params_obj,
             const std::string& name, const py::object& viewpoint = py::none (),
-            const py::object& normals = py::none ())
+            const py::object& normals = py::none (), bool any_length_normals = false)
 {
   const py::array pts = floatArray (points, "points", 2, "(N, 3)");
   pcl::PointCloud<pcl::PointXYZ> cloud;
@@ -202,9 +202,9 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
     for (std::size_t i = 0; i < cloud.size (); ++i)
       oriented[i].getVector3fMap () = cloud[i].getVector3fMap ();
     if (py::isinstance<py::array_t<float>> (nrm))
-      fillNormals<float> (nrm, oriented);
+      fillNormals<float> (nrm, oriented, any_length_normals);
     else
-      fillNormals<double> (nrm, oriented);
+      fillNormals<double> (nrm, oriented, any_length_normals);
     py::gil_scoped_release release;
     return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, have_covs ? &covs : nullptr, name);
   }
@@ -482,6 +482,49 @@ readCloud (const std::filesystem::path& path)
   v[5] = cloud.sensor_orientation_.y ();
   v[6] = cloud.sensor_orientation_.z ();
   return py::make_tuple (points, viewpoint, cloud.width, cloud.height);
+}
+
+/** read_cloud with the file's normal_x normal_y normal_z (io::loadCloudWithNormals, as pcd_collision
+  * -surface reads them): (points, normals (N, 3) float32 as stored, NaN for none; None when the file
+  * has no normals), viewpoint, width, height). */
+py::tuple
+readCloudWithNormals (const std::filesystem::path& path)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  bool has_normals = false;
+  std::string error;
+  bool loaded = false;
+  {
+    py::gil_scoped_release release;
+    loaded = pcl_probcollision::io::loadCloudWithNormals (path.string (), cloud, has_normals, error);
+  }
+  if (!loaded)
+    throw py::value_error ("path: " + error);
+  const auto n = static_cast<py::ssize_t> (cloud.size ());
+  py::array_t<float> points ({n, static_cast<py::ssize_t> (3)});
+  auto p = points.mutable_unchecked<2> ();
+  for (py::ssize_t i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      p (i, d) = cloud[static_cast<std::size_t> (i)].data[d];
+  py::object normals = py::none ();
+  if (has_normals)
+  {
+    py::array_t<float> nrm ({n, static_cast<py::ssize_t> (3)});
+    auto q = nrm.mutable_unchecked<2> ();
+    for (py::ssize_t i = 0; i < n; ++i)
+      for (int d = 0; d < 3; ++d)
+        q (i, d) = cloud[static_cast<std::size_t> (i)].normal[d];
+    normals = nrm;
+  }
+  py::array_t<double> viewpoint (7);
+  double* v = viewpoint.mutable_data ();
+  for (int d = 0; d < 3; ++d)
+    v[d] = cloud.sensor_origin_[d];
+  v[3] = cloud.sensor_orientation_.w ();
+  v[4] = cloud.sensor_orientation_.x ();
+  v[5] = cloud.sensor_orientation_.y ();
+  v[6] = cloud.sensor_orientation_.z ();
+  return py::make_tuple (points, normals, viewpoint, cloud.width, cloud.height);
 }
 
 pcl_probcollision::io::TriangleMesh
@@ -885,11 +928,13 @@ PYBIND11_MODULE (_core, m)
   // --- functions ----------------------------------------------------------------------------------
   m.def ("build_model",
          [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
-             const py::object& viewpoint, const py::object& normals) {
-           return std::const_pointer_cast<CloudModel> (buildModel (points, covariances, params, name, viewpoint, normals));
+             const py::object& viewpoint, const py::object& normals, bool any_length_normals) {
+           return std::const_pointer_cast<CloudModel> (
+               buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
          py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
+         py::kw_only (), py::arg ("any_length_normals") = false,
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
          "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
          "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
@@ -900,6 +945,8 @@ PYBIND11_MODULE (_core, m)
          "normals: optional (N, 3) float32/float64 outward unit normals (a mesh's: sample_mesh_with_normals), used by\n"
          "    the surface model (params.surface) under the Auto and PointNormals orientations; a row with NaN or 0 has\n"
          "    none. The points' model is the same with or without them (pcl::PointNormal instead of pcl::PointXYZ).\n"
+         "any_length_normals: keyword only; True takes the normals of any length, as a file stores them (read_cloud_with_normals)\n"
+         "    and as pcd_collision -surface reads them: the surface model normalizes them. False: not unit length is a ValueError.\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
@@ -933,6 +980,11 @@ PYBIND11_MODULE (_core, m)
          "Reads a .pcd (or face-less .ply) file as pcd_collision does.\n\n"
          "Returns (points (N, 3) float32 with NaN rows kept, viewpoint (7,) tx ty tz qw qx qy qz, width, height).\n"
          "ValueError with pcd_collision's message for a file it cannot read.");
+  m.def ("read_cloud_with_normals", &readCloudWithNormals, py::arg ("path"),
+         "read_cloud with the file's normal_x normal_y normal_z, as pcd_collision -surface reads them.\n\n"
+         "Returns (points (N, 3) float32, normals (N, 3) float32 as stored (any length; NaN rows: none) or None when the\n"
+         "file has no normal fields, viewpoint (7,), width, height). ValueError with pcd_collision's message for a file\n"
+         "it cannot read, or with only some of the three normal fields.");
   m.def ("is_faceless_ply", [] (const std::filesystem::path& p) { return pcl_probcollision::io::isFacelessPly (p.string ()); },
          py::arg ("path"), "True for a .ply whose header declares no face (pcd_collision reads it as a cloud).");
   m.def ("read_mesh",

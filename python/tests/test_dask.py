@@ -241,6 +241,48 @@ def test_cli_surface_with_a_mesh_equals_pcd_collision():
     assert touching["signed_distance_std"] > 0 and penetrating["parameters"]["surface"] is True
 
 
+def _sphere_with_normals(n=600, radius=0.1, normal_length=1.0):
+    """n points on a sphere (a Fibonacci lattice) and their outward normals of normal_length."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    r = np.sqrt(1.0 - z * z)
+    phi = np.pi * (3.0 - np.sqrt(5.0)) * i
+    u = np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+    return radius * u, normal_length * u
+
+
+def test_cli_surface_with_stored_normals_equals_pcd_collision(tmp_path):
+    # A cloud file with normal_x normal_y normal_z (of length 2: the surface model normalizes
+    # them, as pcd_collision reads them): with -surface both CLIs orient the sphere by them (the
+    # probe inside it collides) and print the same JSON lines; with -ignore_normals too.
+    points, normals = _sphere_with_normals(normal_length=2.0)
+    rows = "\n".join(" ".join(f"{v:.9g}" for v in (*p, *q)) for p, q in zip(points, normals))
+    (tmp_path / "sphere.pcd").write_text(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n"
+        f"TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+        f"POINTS {len(points)}\nDATA ascii\n{rows}\n")
+    g = np.linspace(-0.01, 0.01, 5)
+    probe = np.array([[x, y, 0.0] for x in g for y in g], dtype=np.float32)
+    write_pcd(tmp_path / "probe.pcd", probe)
+    # probe at the centre (inside), on the surface, just outside, far away
+    (tmp_path / "poses.txt").write_text("0 0 0 0 0 0\n0 0 0.1 0 0 0\n0 0 0.12 0 0 0\n0.5 0 0 0 0 0\n")
+    args = [str(tmp_path / "probe.pcd"), str(tmp_path / "sphere.pcd")]
+    poses = str(tmp_path / "poses.txt")
+    answers = {}
+    for extra in ([], ["-ignore_normals"]):
+        cpp = subprocess.run([_pcd_collision(), *args, "-poses", poses, "-json", "-surface", "-sigma", "0.001", *extra],
+                             capture_output=True, text=True, timeout=300)
+        assert cpp.returncode == 0, cpp.stderr
+        assert ("[point_normals:" in cpp.stderr) != bool(extra), cpp.stderr
+        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, poses, "--scheduler", "local:1",
+                             "-surface", "-json", "-sigma", "0.001", *extra], capture_output=True, text=True, timeout=300)
+        assert py.returncode == 0, py.stderr
+        answers[bool(extra)] = _compare_json_lines(cpp.stdout, py.stdout)
+    inside = answers[False][0]
+    assert inside["verdict"] == "collision" and inside["signed_distance"] < -0.05
+    assert answers[False][3]["verdict"] == "free"
+
+
 def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     # Two noisy sheets, b under and over a: surface=True gives the surface models' answers and
     # signed distances (in b's frame a pose moves a: a above b is a gap); off, NaN as before.

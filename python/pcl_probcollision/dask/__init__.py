@@ -56,6 +56,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "surface": _REQUEST.surface,
     # The surface layer pooled with the separators (the mean of the two P); implies surface.
     "surface_pooled": _REQUEST.surface_pooled,
+    # With surface: a cloud file's normal_x normal_y normal_z are not read (pcd_collision's
+    # -ignore_normals); the cloud is oriented as one without them.
+    "ignore_normals": False,
     "nmax": _MODEL.n_max,
     "sigma_max": _MODEL.sigma_max,
     "epsilon": _MODEL.epsilon,
@@ -140,10 +143,12 @@ def _is_open3d_cloud(x) -> bool:
     return t.__name__ == "PointCloud" and t.__module__.startswith("open3d")
 
 
-def prepare_input(x, name: Optional[str] = None) -> Dict[str, Any]:
+def prepare_input(x, name: Optional[str] = None, normals: bool = False) -> Dict[str, Any]:
     """An input as pcd_collision reads it: a path (.pcd, face-less .ply: a cloud; .ply .obj .stl
     .vtk: a mesh, sampled later against the other input), an (N, 3) numpy array or an Open3D
-    PointCloud (a cloud whose viewpoint is the origin)."""
+    PointCloud (a cloud whose viewpoint is the origin). normals (pcd_collision's -surface without
+    -ignore_normals): a cloud file's normal_x normal_y normal_z too, as stored (the surface model
+    takes them as outward and normalizes them); "normals" is None when the file has none."""
     if isinstance(x, dict) and "kind" in x:
         return x
     if isinstance(x, (str, os.PathLike)):
@@ -153,13 +158,16 @@ def prepare_input(x, name: Optional[str] = None) -> Dict[str, Any]:
         low = path.lower()
         if low.endswith(".pcd") or (low.endswith(".ply") and core.is_faceless_ply(path)):
             t0 = time.perf_counter()
-            points, viewpoint, width, height = core.read_cloud(path)
+            if normals:
+                points, stored, viewpoint, width, height = core.read_cloud_with_normals(path)
+            else:
+                (points, viewpoint, width, height), stored = core.read_cloud(path), None
             finite = int(np.isfinite(points).all(axis=1).sum())
             if finite == 0:
                 raise ValueError(f"'{path}' has no finite point ({len(points)} points, all NaN or Inf)")
             return {"kind": "cloud", "path": path, "name": name or os.path.basename(path), "points": points,
                     "viewpoint": viewpoint, "width": int(width), "height": int(height), "finite": finite,
-                    "load_ms": (time.perf_counter() - t0) * 1e3}
+                    "normals": stored, "load_ms": (time.perf_counter() - t0) * 1e3}
         if low.endswith(_MESH_EXTENSIONS):
             t0 = time.perf_counter()
             vertices, triangles = core.read_mesh(path)
@@ -258,8 +266,10 @@ def _model(spec: Dict[str, Any], o: Dict[str, Any], side: str):
         if model is None:
             points = spec["points"]
             covariances = np.zeros((len(points), 3, 3), dtype=np.float32) if exact else None
+            # A cloud file's stored normals are of any length, as pcd_collision reads them.
             model = core.build_model(points, covariances=covariances, params=model_params(o, side, exact),
-                                     name=spec["name"], viewpoint=spec["viewpoint"], normals=spec.get("normals"))
+                                     name=spec["name"], viewpoint=spec["viewpoint"], normals=spec.get("normals"),
+                                     any_length_normals=not exact)
             with _cache_lock:
                 _cache[key] = model
                 _builds[spec["token"]] += 1
@@ -393,15 +403,17 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     chunk_size: poses per task (default: about 8 tasks per worker thread, 32 to 2000 poses).
     options: pcd_collision's flags without the dash (sensor, sensor_a, sensor_b, sigma, sigma_a,
         sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, surface, nmax,
-        sigma_max, epsilon, split, mesh_density) and threads (collide_batch threads per task).
+        sigma_max, epsilon, split, mesh_density, ignore_normals) and threads (collide_batch threads per task).
         surface=True is pcd_collision's -surface: both models get the oriented surface (meshes
-        by their faces' normals) and signed_distance / signed_distance_std are filled (NaN
+        by their faces' normals, a cloud file with normal_x normal_y normal_z by them unless
+        ignore_normals) and signed_distance / signed_distance_std are filled (NaN
         otherwise, and for poses where the surfaces never came within reach), and unobserved may
         be True (the answer rests on surface the samples do not show; always False otherwise).
     Returns BatchResults in pose order, identical to the single-process answers."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)
-    A, B = prepare_input(a, "a"), prepare_input(b, "b")
+    stored = o["surface"] and not o["ignore_normals"]
+    A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
     _sample_meshes(A, B, o)
     sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)

@@ -23,7 +23,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   --timeout S                    seconds to reach the scheduler (default 10)
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
-  -measured -deterministic -stochastic -seed -exhaustive -surface -surface_pooled -nmax -sigma_max -epsilon -split
+  -measured -deterministic -stochastic -seed -exhaustive -surface -surface_pooled -ignore_normals -nmax -sigma_max -epsilon -split
   -mesh_density -json (accepted; the output is always JSON lines) -v. A value is the next argument
   or follows '='. -surface (experimental) adds the signed distance between the surfaces.
 """
@@ -31,7 +31,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
           "split": str, "mesh_density": float}
-_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "surface", "surface_pooled", "json", "v")
+_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "surface", "surface_pooled", "ignore_normals", "json", "v")
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
 _FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
 _INT = re.compile(r"[+-]?\d+\Z")
@@ -248,8 +248,10 @@ def main(argv):
         path_a, path_b, poses_path = positional
         pose_rows = read_poses(poses_path)  # a malformed file fails before the (slow) loading
         try:
-            a = prepare_input(path_a, "a")
-            b = prepare_input(path_b, "b")
+            # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
+            stored = bool(options.get("surface") or options.get("surface_pooled")) and not options.get("ignore_normals")
+            a = prepare_input(path_a, "a", stored)
+            b = prepare_input(path_b, "b", stored)
         except FileNotFoundError as e:
             raise Failure(f"cannot read '{e.filename}': No such file or directory") from None
         except ValueError as e:
