@@ -455,6 +455,35 @@ noiseFactory (const SensorNoiseModel& n)
   return "?";
 }
 
+/** A loaded cloud's x y z as an (N, 3) float32 array. */
+template <typename PointT>
+py::array_t<float>
+pointsOf (const pcl::PointCloud<PointT>& cloud)
+{
+  py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
+  auto p = points.mutable_unchecked<2> ();
+  for (std::size_t i = 0; i < cloud.size (); ++i)
+    for (int d = 0; d < 3; ++d)
+      p (static_cast<py::ssize_t> (i), d) = cloud[i].data[d];
+  return points;
+}
+
+/** A loaded cloud's VIEWPOINT as 7 numbers: tx ty tz qw qx qy qz. */
+template <typename PointT>
+py::array_t<double>
+viewpointOf (const pcl::PointCloud<PointT>& cloud)
+{
+  py::array_t<double> viewpoint (7);
+  double* v = viewpoint.mutable_data ();
+  for (int d = 0; d < 3; ++d)
+    v[d] = cloud.sensor_origin_[d];
+  v[3] = cloud.sensor_orientation_.w ();
+  v[4] = cloud.sensor_orientation_.x ();
+  v[5] = cloud.sensor_orientation_.y ();
+  v[6] = cloud.sensor_orientation_.z ();
+  return viewpoint;
+}
+
 /** The file as pcd_collision reads it: io::loadCloud (PCD, face-less PLY), NaN rows kept. */
 py::tuple
 readCloud (const std::filesystem::path& path)
@@ -468,20 +497,7 @@ readCloud (const std::filesystem::path& path)
   }
   if (!loaded)
     throw py::value_error ("path: " + error);
-  py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
-  auto p = points.mutable_unchecked<2> ();
-  for (std::size_t i = 0; i < cloud.size (); ++i)
-    for (int d = 0; d < 3; ++d)
-      p (static_cast<py::ssize_t> (i), d) = cloud[i].data[d];
-  py::array_t<double> viewpoint (7);
-  double* v = viewpoint.mutable_data ();
-  for (int d = 0; d < 3; ++d)
-    v[d] = cloud.sensor_origin_[d];
-  v[3] = cloud.sensor_orientation_.w ();
-  v[4] = cloud.sensor_orientation_.x ();
-  v[5] = cloud.sensor_orientation_.y ();
-  v[6] = cloud.sensor_orientation_.z ();
-  return py::make_tuple (points, viewpoint, cloud.width, cloud.height);
+  return py::make_tuple (pointsOf (cloud), viewpointOf (cloud), cloud.width, cloud.height);
 }
 
 /** read_cloud with the file's normal_x normal_y normal_z (io::loadCloudWithNormals, as pcd_collision
@@ -501,11 +517,6 @@ readCloudWithNormals (const std::filesystem::path& path)
   if (!loaded)
     throw py::value_error ("path: " + error);
   const auto n = static_cast<py::ssize_t> (cloud.size ());
-  py::array_t<float> points ({n, static_cast<py::ssize_t> (3)});
-  auto p = points.mutable_unchecked<2> ();
-  for (py::ssize_t i = 0; i < n; ++i)
-    for (int d = 0; d < 3; ++d)
-      p (i, d) = cloud[static_cast<std::size_t> (i)].data[d];
   py::object normals = py::none ();
   if (has_normals)
   {
@@ -516,15 +527,7 @@ readCloudWithNormals (const std::filesystem::path& path)
         q (i, d) = cloud[static_cast<std::size_t> (i)].normal[d];
     normals = nrm;
   }
-  py::array_t<double> viewpoint (7);
-  double* v = viewpoint.mutable_data ();
-  for (int d = 0; d < 3; ++d)
-    v[d] = cloud.sensor_origin_[d];
-  v[3] = cloud.sensor_orientation_.w ();
-  v[4] = cloud.sensor_orientation_.x ();
-  v[5] = cloud.sensor_orientation_.y ();
-  v[6] = cloud.sensor_orientation_.z ();
-  return py::make_tuple (points, normals, viewpoint, cloud.width, cloud.height);
+  return py::make_tuple (pointsOf (cloud), normals, viewpointOf (cloud), cloud.width, cloud.height);
 }
 
 pcl_probcollision::io::TriangleMesh

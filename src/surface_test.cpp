@@ -94,7 +94,6 @@ struct Scratch
     int index;
     Eigen::Vector3d x, normal, own_normal;  ///< the other's face normal; the point's own normal
     double distance, sigma, spacing;
-    const PackedCovariance* covariance;     ///< the point's own, in its model's frame
   };
   std::vector<Outside> outside;
 
@@ -129,18 +128,25 @@ struct Evaluation
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
   double nearest = 0.0;  ///< distance to the nearest sample
   double spacing = 0.0;  ///< that sample's spacing
-  /** \brief x lies past the surface's edge (distance to the edge, not to a plane). */
-  bool past_edge = false;
   /** \brief The surface spans a hole in the samples here (far rim found beyond a spacing). */
   bool bridged = false;
   int first = -1;          ///< the nearest sample (index into the samples)
-  double along = 0.0;      ///< x's offset from it along its normal
-  double tangential = 0.0; ///< and across it
+  double tangential = 0.0; ///< x's distance from it across its normal
 };
+
+/** \brief The quarter of the plane (spanned by unit u and w) that v points into, as a bit:
+  * about +u 1, -u 2, +w 4, -w 8. Samples in all four quarters (15) surround a point. */
+int
+quarterBit (const Eigen::Vector3d& v, const Eigen::Vector3d& u, const Eigen::Vector3d& w)
+{
+  const double cu = v.dot (u), cw = v.dot (w);
+  return std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
+}
 
 /** \brief True when samples of the surface lie beyond x, seen from its nearest sample `first`
   * (offset along its normal `along`, `tangential` across it, > 0): in its plane, farther along
-  * the same direction (within 60 degrees), on the same face, within `reach` of its spacings. x then lies over a hole, not past an edge. */
+  * the same direction (within 60 degrees), on the same face, within `reach` of its spacings. x
+  * then lies over a hole, not past an edge. */
 bool
 farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tangential, double reach,
         const std::vector<int>& pool, const std::vector<Sample>& samples)
@@ -189,8 +195,7 @@ surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const s
     const Eigen::Vector3d v = s.position - x;
     if (s.normal.dot (n) <= kSameFaceCosine || v.squaredNorm () >= reach2 || std::abs (n.dot (v) + along) >= thickness)
       continue;
-    const double cu = v.dot (u), cw = v.dot (w);
-    quarters |= std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
+    quarters |= quarterBit (v, u, w);
     if (quarters == 15)
       return true;
   }
@@ -242,7 +247,6 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   // hole (samples of the far rim lie beyond x, in the plane, within the bridging reach) or has
   // ended at an edge (every sample lies behind x). Only a hole is bridged.
   out.first = nearest[0];
-  out.along = along;
   out.tangential = tangential;
   const bool past_edge =
     tangential > kBridgeSpacings * h || (tangential > h && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
@@ -255,7 +259,6 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     out.distance = std::sqrt (beyond * beyond + along * along);
     out.normal = offset / std::max (offset.norm (), 1e-300);
     out.sigma = std::sqrt (variance_of (out.normal) + first.variance) + kDiscretisationPerDistance * h;
-    out.past_edge = true;
     return true;
   }
   // The samples split into faces by their normals (up to kMaxFaces: the faces of a box's edge
@@ -370,9 +373,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     {
       if (face[static_cast<std::size_t> (j)] != 0)
         continue;
-      const Eigen::Vector3d v = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])].position - x;
-      const double cu = v.dot (u), cw = v.dot (w);
-      quarters |= std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
+      quarters |= quarterBit (samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (j)])].position - x, u, w);
     }
     inside_face = quarters == 15;
   }
@@ -574,7 +575,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const double z = e.distance / sigma;
       if (e.distance > 0.0 && !e.normal.isZero ())
         scratch.outside.push_back ({i, x, e.normal, R_q * q_model.normals ()[qi].cast<double> (), e.distance, sigma,
-                                    static_cast<double> (q_model.spacing ()[qi]), &cov});
+                                    static_cast<double> (q_model.spacing ()[qi])});
       if (per_point)
       {
         float& slot = (*per_point)[qi];
