@@ -87,7 +87,8 @@ struct Scratch
   std::vector<double> keys;
   std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
-  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs, grouped;
+  std::vector<std::size_t> group_start;  ///< groupByFirst's counts, then offsets
   /** \brief The current query leaf's points found outside the other surface, for crossings. */
   struct Outside
   {
@@ -601,6 +602,25 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   }
 }
 
+/** \brief Sorts the leaf pairs by their first leaf (ids below `nodes`), keeping the order
+  * within a leaf: a counting sort, linear where std::sort cost 5 % of a query. testSide needs
+  * them grouped, in ascending order (which leaf comes first decides where decision mode stops);
+  * the order within a group does not matter (the pool is sorted by distance). */
+void
+groupByFirst (std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::size_t nodes, Scratch& scratch)
+{
+  auto& start = scratch.group_start;
+  start.assign (nodes + 1, 0);
+  for (const auto& p : pairs)
+    ++start[static_cast<std::size_t> (p.first) + 1];
+  for (std::size_t i = 0; i < nodes; ++i)
+    start[i + 1] += start[i];
+  scratch.grouped.resize (pairs.size ());
+  for (const auto& p : pairs)
+    scratch.grouped[start[static_cast<std::size_t> (p.first)]++] = p;
+  pairs.swap (scratch.grouped);
+}
+
 /** \brief Distance from x (in `model`'s local frame) to its nearest sample. */
 double
 nearestSampleDistance (const CloudModel& model, const Eigen::Vector3d& x)
@@ -734,11 +754,11 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   const double stop_z = may_stop ? -normalQuantile (request.collision_above) : -std::numeric_limits<double>::infinity ();
   if (!pairs.empty ())
   {
-    std::sort (pairs.begin (), pairs.end ());
+    groupByFirst (pairs, bvh_a.nodes ().size (), scratch);
     testSide (a, Eigen::Isometry3d::Identity (), b, T_a_b, pairs, scratch, +1, per_point_a, stop_z, answer, best_z);
     for (auto& p : pairs)
       std::swap (p.first, p.second);
-    std::sort (pairs.begin (), pairs.end ());
+    groupByFirst (pairs, bvh_b.nodes ().size (), scratch);
     if (!answer.stopped_early)
       testSide (b, T_a_b, a, Eigen::Isometry3d::Identity (), pairs, scratch, -1, per_point_b, stop_z, answer, best_z);
   }
