@@ -39,7 +39,7 @@ fmt (double v)
 // Flags that take one value, and flags that take none.
 const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
-  "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o"};
+  "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-ignore_normals", "-v"};
 
@@ -325,6 +325,13 @@ parseCommandLine (const std::vector<std::string>& args)
         return usage ("option -poses needs a file name");
       o.poses_file = v;
     }
+    else if (a == "-threads")
+    {
+      if (!parseInt (v, o.threads))
+        return usage (bad + "is not an integer");
+      if (o.threads < 0)
+        return usage (bad + "must be >= 0 (0: one per hardware thread)");
+    }
     else if (a == "-sigma")
     {
       if (auto e = nonNegative (sigma))
@@ -473,6 +480,10 @@ helpText ()
        "  -pose tx,ty,tz,roll,pitch,yaw   = 0,0,0,0,0,0\n"
        "  -poses FILE     batch mode: one pose per line, six numbers separated by spaces or commas,\n"
        "                  '#' comments and blank lines allowed; hierarchies are built once\n"
+       "  -threads N      = "
+    << D::threads
+    << "       worker threads answering -poses (0: one per hardware thread); answers\n"
+       "                  stream in pose order and are the same whatever N (timings aside)\n"
        "\n"
        "Uncertainty (mesh inputs are exact: zero covariance, no noise):\n"
        "  -sensor isotropic|kinect|stereo|lidar|none   = "

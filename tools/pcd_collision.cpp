@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace pcd_collision
@@ -618,16 +620,40 @@ run (int argc, char** argv)
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));
   // Summary lines on a terminal that also shows the progress: erase the progress first.
   const bool shares_terminal = !o.json && ::isatty (STDOUT_FILENO);
+  // The poses are answered by computeBatch in chunks of a few per thread, each chunk printed in
+  // pose order as soon as it is done: answers stream, and a chunk's slowest pose idles the
+  // other threads only briefly. Which thread answers a pose changes nothing in its answer.
+  const unsigned workers = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
+  const std::size_t chunk = std::size_t{16} * workers;
+  std::vector<Eigen::Isometry3d> chunk_poses;
+  std::vector<pcl_probcollision::CollisionResult> chunk_results;
   for (std::size_t i = 0; i < poses.size (); ++i)
   {
-    const Eigen::Isometry3d T = toIsometry (poses[i]);
-    pcl_probcollision::CollisionResult result;
-    const bool ok = pc.compute (T, result);
-    if (!ok || !result.ok () || shares_terminal)
+    const std::size_t k = i % chunk;
+    if (k == 0)
+    {
+      const std::size_t end = std::min (poses.size (), i + chunk);
+      chunk_poses.clear ();
+      for (std::size_t j = i; j < end; ++j)
+        chunk_poses.push_back (toIsometry (poses[j]));
+      pc.computeBatch (chunk_poses, chunk_results, static_cast<int> (workers));
+    }
+    const Eigen::Isometry3d& T = chunk_poses[k];
+    pcl_probcollision::CollisionResult& result = chunk_results[k];
+    if (!result.ok () || shares_terminal)
       progress.clear ();
-    if (!ok || !result.ok ())
+    if (!result.ok ())
+    {
+      // computeBatch names the pose within its chunk: name it within the file instead.
+      const std::string prefix = "pose " + std::to_string (k) + ": ";
+      std::string message = result.message.rfind (prefix, 0) == 0 ? result.message.substr (prefix.size ()) : result.message;
       throw Failure{kRuntimeFailure, (batch ? "pose " + std::to_string (i) + ": " : std::string ()) + "query failed: " +
-                                         (result.message.empty () ? std::string ("compute() returned false") : result.message)};
+                                         (message.empty () ? std::string ("the query failed") : message)};
+    }
+    // The models are built once, by the first chunk, whose every answer carries that time: it
+    // belongs to the first pose, as a serial loop of compute() would report it.
+    if (i > 0 && std::isfinite (result.build_ms))
+      result.build_ms = 0.0;
     if (i == 0)
       result.build_ms += cloud_build_ms;
     // With -surface, how each surface was oriented, once both models exist.

@@ -40,6 +40,8 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (o.input_b, "b.obj");
   EXPECT_FALSE (o.pose);
   EXPECT_FALSE (o.poses_file);
+  EXPECT_EQ (o.threads, 0);  // one per hardware thread
+  EXPECT_EQ (parse ({"-threads", "3"}).options.threads, 3);
   EXPECT_EQ (o.sensor_a, "isotropic");
   EXPECT_EQ (o.sensor_b, "isotropic");
   EXPECT_EQ (o.sigma_a, 0.005);
@@ -151,6 +153,8 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-sensor", "sonar"}, "-sensor");
   expectUsageError ({"-split", "kd"}, "-split");
   expectUsageError ({"-o", "out.ply"}, "-o");
+  expectUsageError ({"-threads", "-1"}, "-threads");
+  expectUsageError ({"-threads", "two"}, "-threads");
 }
 
 TEST (CliOptions, FlagsAndPositionals)

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -433,6 +434,47 @@ TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)
   // Hierarchies are built once: every pose after the first reuses them.
   for (std::size_t i = 1; i < batch.size (); ++i)
     EXPECT_EQ (batch[i]["build_ms"].number, 0.0) << i;
+}
+
+// -threads: every line the same as one thread's, in pose order, timings aside; 2 threads answer
+// in chunks of 32 poses, so 45 poses cross a chunk boundary.
+TEST_F (PcdCollisionTool, ThreadsGiveOneThreadsOutputInPoseOrder)
+{
+  std::ostringstream poses;
+  for (int i = 0; i < 45; ++i)
+    poses << -0.15 + 0.01 * (i % 7) << " 0.05 " << 0.25 - 0.006 * i << " " << 0.02 * (i % 5) << " 0 " << 0.1 * i << "\n";
+  writeFile (dir_ / "poses.txt", poses.str ());
+  // The timing members and the human line's timings are the only parts allowed to differ.
+  const std::regex timings ("\"(build_ms|query_ms)\":[^,]*,|,\"timings_ms\":\\{[^}]*\\}|build [0-9.]+ ms, query [0-9.]+ ms");
+  auto answers = [&] (const std::string& threads, bool json) {
+    std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses", (dir_ / "poses.txt").string (),
+                                     "-surface_pooled", "-threads", threads};
+    if (json)
+      args.push_back ("-json");
+    const ToolRun r = run (args);
+    EXPECT_EQ (r.status, 0) << r.err;
+    std::vector<std::string> out;
+    for (const auto& l : lines (r.out))
+      out.push_back (std::regex_replace (l, timings, ""));
+    return out;
+  };
+  for (const bool json : {true, false})
+  {
+    const std::vector<std::string> one = answers ("1", json);
+    ASSERT_EQ (one.size (), 45u);
+    for (const char* threads : {"2", "3", "0"})
+      EXPECT_EQ (answers (threads, json), one) << "-threads " << threads << (json ? " -json" : "");
+    if (!json)
+      continue;
+    // In pose order, with the timings really removed (the regex matched).
+    for (std::size_t i = 0; i < one.size (); ++i)
+    {
+      const Value v = mini_json::parse (one[i]);
+      EXPECT_EQ (v["pose_index"].number, static_cast<double> (i));
+      EXPECT_EQ (v.object.count ("query_ms"), 0u);
+      EXPECT_EQ (v.object.count ("timings_ms"), 0u);
+    }
+  }
 }
 
 TEST_F (PcdCollisionTool, OutputCloudLoadsInPclWithFields)
