@@ -208,7 +208,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     {
       mean /= static_cast<double> (count);
       const Eigen::Matrix3d cov = second / static_cast<double> (count) - mean * mean.transpose ();
-      const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> (cov, Eigen::EigenvaluesOnly).eigenvalues ();
+      // Closed form (computeDirect): the iterative solver was a fifth of the surface model's build.
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      const Eigen::Vector3d l = solver.computeDirect (cov, Eigen::EigenvaluesOnly).eigenvalues ();
       const double area = 4.0 * kPi * std::sqrt (std::max (0.0, l[1]) * std::max (0.0, l[2]));
       s = std::min (s, std::sqrt (area / static_cast<double> (count)));
     }
