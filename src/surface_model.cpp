@@ -220,6 +220,22 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     std::vector<float> sorted (spacing_);
     std::nth_element (sorted.begin (), sorted.begin () + static_cast<std::ptrdiff_t> (n / 2), sorted.end ());
     median_spacing_ = n ? sorted[n / 2] : 0.0;
+    // Weighted by area: half the surface's area lies on samples at most this far apart.
+    std::sort (sorted.begin (), sorted.end ());
+    double total = 0.0;
+    for (const float v : sorted)
+      total += static_cast<double> (v) * v;
+    double sum = 0.0;
+    surface_spacing_ = median_spacing_;
+    for (const float v : sorted)
+    {
+      sum += static_cast<double> (v) * v;
+      if (sum >= 0.5 * total)
+      {
+        surface_spacing_ = v;
+        break;
+      }
+    }
   }
 
   // Resolve Auto: the caller's normals, else a viewpoint outside the cloud (a scan), else

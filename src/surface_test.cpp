@@ -74,6 +74,11 @@ struct Sample
   Eigen::Vector3d normal;
   double spacing;
   double variance;  ///< the sample's variance along its own normal
+  /** \brief The gap over which the surface may run unsampled here: the larger of the sample's
+    * spacing and its surface's (SurfaceModel::surfaceSpacing). A sample in a cluster (a
+    * triangle soup's repeated vertex, a scan's dense patch) has a spacing far below the gaps of
+    * the surface around it; an empty disc no wider than those gaps says nothing about an edge. */
+  double gap;
 };
 
 /** \brief Per-thread buffers: a query allocates nothing once they have grown. */
@@ -145,9 +150,9 @@ quarterBit (const Eigen::Vector3d& v, const Eigen::Vector3d& u, const Eigen::Vec
 }
 
 /** \brief True when samples of the surface lie beyond x, seen from its nearest sample `first`
-  * (offset along its normal `along`, `tangential` across it, > 0): in its plane, farther along
-  * the same direction (within 60 degrees), on the same face, within `reach` of its spacings. x
-  * then lies over a hole, not past an edge. */
+  * (offset along its normal `along`, `tangential` across it, > 0): in its plane (within half its
+  * spacing and the noise), farther along the same direction (within 60 degrees), on the same
+  * face, within `reach` of its gaps. x then lies over a hole, not past an edge. */
 bool
 farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tangential, double reach,
         const std::vector<int>& pool, const std::vector<Sample>& samples)
@@ -155,7 +160,7 @@ farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tang
   const double h = std::max (first.spacing, 1e-12);
   const Eigen::Vector3d offset = x - first.position;
   const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
-  const double reach2 = (reach * h) * (reach * h);
+  const double reach2 = (reach * first.gap) * (reach * first.gap);
   const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
   for (const int j : pool)
   {
@@ -238,20 +243,22 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     return false;
   const Sample& first = samples[static_cast<std::size_t> (nearest[0])];
   const double h = std::max (first.spacing, 1e-12);
+  const double g = std::max (first.gap, h);
   // Tangential distance to the nearest sample: how far the surface is extrapolated.
   const Eigen::Vector3d offset = x - first.position;
   out.nearest = std::sqrt (d2[0]);
   out.spacing = h;
   const double along = first.normal.dot (offset);
   const double tangential = std::sqrt (std::max (0.0, offset.squaredNorm () - along * along));
-  // More than a spacing along the surface from its nearest sample, the surface either spans a
-  // hole (samples of the far rim lie beyond x, in the plane, within the bridging reach) or has
-  // ended at an edge (every sample lies behind x). Only a hole is bridged.
+  // More than a gap along the surface from its nearest sample, the surface either spans a hole
+  // (samples of the far rim lie beyond x, in the plane, within the bridging reach) or has ended
+  // at an edge (every sample lies behind x). Only a hole is bridged. The gap, not the nearest
+  // sample's own spacing: a cluster's spacing is not the surface's.
   out.first = nearest[0];
   out.tangential = tangential;
   const bool past_edge =
-    tangential > kBridgeSpacings * h || (tangential > h && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
-  out.bridged = !past_edge && tangential > h;
+    tangential > kBridgeSpacings * g || (tangential > g && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
+  out.bridged = !past_edge && tangential > g;
   if (past_edge)
   {
     // Past the surface's edge: outside. The edge lies anywhere within a spacing beyond the last
@@ -360,8 +367,8 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     if (concave == (other.f < chosen.f))
       chosen = other;
   }
-  // Where the surface runs between samples is uncertain within one spacing of the last one
-  // (an edge may lie there); a bridged hole continues the fitted plane. Inside a face, its
+  // Where the surface runs between samples is uncertain within one gap of the last one (an
+  // edge may lie there); a bridged hole continues the fitted plane. Inside a face, its
   // samples among the nearest on all four sides of x (quarters about u = across from the
   // nearest sample to x, and n x u), no edge lies between them: the plane holds there.
   bool inside_face = false;
@@ -378,7 +385,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     }
     inside_face = quarters == 15;
   }
-  const double disc = inside_face ? 0.0 : kDiscretisationPerDistance * std::min (tangential, h);
+  const double disc = inside_face ? 0.0 : kDiscretisationPerDistance * std::min (tangential, g);
   out.distance = chosen.f;
   out.normal = chosen.normal;
   out.sigma = std::sqrt (variance_of (out.normal) + chosen.fit_var + disc * disc);
@@ -526,7 +533,8 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
           scratch.cached[sj] = cache_stamp;
           const Eigen::Vector3d n = s_model.normals ()[sj].cast<double> ();
           scratch.cache[sj] = {T_s * s_bvh.means ()[sj], R_s * n, s_model.spacing ()[sj],
-                               std::max (0.0, s_bvh.covariances ()[sj].quadratic (n))};
+                               std::max (0.0, s_bvh.covariances ()[sj].quadratic (n)),
+                               std::max<double> (s_model.spacing ()[sj], s_model.surfaceSpacing ())};
         }
         scratch.pool.push_back (j);
       }

@@ -71,6 +71,11 @@ public:
   const std::vector<float>& spacing () const { return spacing_; }
   /** \brief Median of spacing(): the cloud's typical sample spacing. */
   double medianSpacing () const { return median_spacing_; }
+  /** \brief The spacing at a typical place of the surface (not of a typical sample): the median
+    * of spacing() weighted by each sample's area s_i^2. Equal to medianSpacing() on a uniformly
+    * sampled surface; far larger where most samples crowd into clusters (a triangle soup's
+    * repeated vertices) and the surface between them is sampled sparsely. */
+  double surfaceSpacing () const { return surface_spacing_; }
   /** \brief The orientation used (never Auto). */
   NormalOrientation orientation () const { return orientation_; }
   /** \brief Points without a normal (too few distinct neighbours): they bound nothing. */
@@ -98,6 +103,7 @@ private:
   std::vector<std::int32_t> owner_;
   std::vector<Dipole> dipoles_;
   double median_spacing_ = 0.0;
+  double surface_spacing_ = 0.0;
   NormalOrientation orientation_ = NormalOrientation::Auto;
   std::size_t unoriented_ = 0;
   std::size_t propagated_ = 0;
