@@ -218,10 +218,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   }
   {
     std::vector<float> sorted (spacing_);
-    std::nth_element (sorted.begin (), sorted.begin () + static_cast<std::ptrdiff_t> (n / 2), sorted.end ());
+    std::sort (sorted.begin (), sorted.end ());
     median_spacing_ = n ? sorted[n / 2] : 0.0;
     // Weighted by area: half the surface's area lies on samples at most this far apart.
-    std::sort (sorted.begin (), sorted.end ());
     double total = 0.0;
     for (const float v : sorted)
       total += static_cast<double> (v) * v;
