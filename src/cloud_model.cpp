@@ -21,6 +21,10 @@ CloudModelParams::validate () const
   if (k < 1)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::CloudModelParams::validate] k = " << k << " must be >= 1");
+  if (threads < 0)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::CloudModelParams::validate] threads = "
+                             << threads << " must be >= 0 (0: one per hardware thread)");
   hierarchy.validate ();
 }
 
@@ -61,7 +65,7 @@ CloudModel::buildSurfaceFromPoints (NormalOrientation orientation, int k)
 }
 
 void
-CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size)
+CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size, int threads)
 {
   if (source_size == 0)
   {
@@ -81,7 +85,7 @@ CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std
       m -= centroid;
     origin_ = centroid;
   }
-  bvh_.build (std::move (points), hierarchy);
+  bvh_.build (std::move (points), hierarchy, threads);
   source_size_ = source_size;
 }
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/exceptions.h>
 
@@ -461,26 +462,280 @@ splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsil
   }
   return false;
 }
+
+using Node = ProbabilisticBVH::Node;
+
+/** \brief What a worker reuses from node to node. */
+struct NodeScratch
+{
+  NodeGeometry g;
+  std::vector<double> tmp;
+  std::vector<std::vector<int>> children;
+};
+
+/** \brief Fills node from its task's points (box, leakage, counts, depth) and splits them.
+  * \return true when the node is split: its children's points are then in s.children, and
+  *         node.num_children is set (node.first_child is left to the caller). */
+bool
+makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& task, Node& node, NodeScratch& s)
+{
+  const std::vector<int>& pts = task.points;
+  const std::size_t m = pts.size ();
+  NodeGeometry& g = s.g;
+  computeGeometry (points, pts, params.k_sigma, g);
+  node.box.axes = g.axes;
+  node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
+  node.box.half_extents = 0.5 * (g.hi - g.lo);
+  for (int k = 0; k < 3; ++k)
+    node.max_sigma (k) = static_cast<float> (g.s_max (k));
+  node.leakage = nodeLeakage (points, pts, g, params.leakage_bound);
+  node.variation = static_cast<float> (g.variation);
+  node.num_points = static_cast<std::int32_t> (m);
+  node.depth = task.depth;
+  node.first_child = -1;
+  node.num_children = 0;
+
+  const bool stop_rule = m <= static_cast<std::size_t> (params.n_max) && g.variation <= params.sigma_max;
+  bool split = false;
+  if (stop_rule)
+    node.leaf_reason = ProbabilisticBVH::LeafReason::StopRule;
+  else if (m <= static_cast<std::size_t> (params.n_min))
+    node.leaf_reason = ProbabilisticBVH::LeafReason::MinSize;
+  else
+  {
+    split = params.split_style == BVHParams::SplitStyle::Pca ? splitPca (pts, g, params.epsilon, s.tmp, s.children)
+                                                             : splitOctree (pts, g, params.epsilon, s.tmp, s.children);
+    if (!split)
+      node.leaf_reason = ProbabilisticBVH::LeafReason::NoProgress;
+  }
+  if (split)
+  {
+    node.leaf_reason = ProbabilisticBVH::LeafReason::NotLeaf;
+    node.num_children = static_cast<std::uint8_t> (s.children.size ());
+  }
+  return split;
+}
+
+/** \brief A hierarchy under construction: nodes, leaf point indices, counts. */
+struct Tree
+{
+  std::vector<Node> nodes;
+  std::vector<int> indices;
+  std::size_t leaf_count = 0;
+  int max_depth = -1;
+};
+
+/** \brief Builds the subtree of root (whose node, root.node, already exists in out) one node
+  * at a time, depth-first, first child first: a node's children get consecutive ids when it
+  * is made, and its leaves' points go to out.indices in left-to-right order, so every
+  * subtree's leaves are contiguous. Internal nodes' ranges are left to the caller. */
+void
+buildSubtree (const BuildPoints& points, const BVHParams& params, BuildTask root, Tree& out, NodeScratch& s)
+{
+  std::vector<BuildTask> stack;
+  stack.push_back (std::move (root));
+  while (!stack.empty ())
+  {
+    BuildTask task = std::move (stack.back ());
+    stack.pop_back ();
+    Node& node = out.nodes[static_cast<std::size_t> (task.node)];
+    out.max_depth = std::max (out.max_depth, task.depth);
+    if (!makeNode (points, params, task, node, s))
+    {
+      node.begin = static_cast<std::int32_t> (out.indices.size ());
+      out.indices.insert (out.indices.end (), task.points.begin (), task.points.end ());
+      node.end = static_cast<std::int32_t> (out.indices.size ());
+      ++out.leaf_count;
+      continue;
+    }
+    const std::int32_t first = static_cast<std::int32_t> (out.nodes.size ());
+    const std::size_t nc = s.children.size ();
+    node.first_child = first;
+    // `node` may dangle after this resize.
+    out.nodes.resize (out.nodes.size () + nc);
+    // Reverse push: the first child is processed next.
+    for (std::size_t c = nc; c-- > 0;)
+      stack.push_back ({first + static_cast<std::int32_t> (c), task.depth + 1, std::move (s.children[c])});
+  }
+}
+
+/** \brief A node of the top of the hierarchy, which is made level by level with the nodes of a
+  * level on several threads, or a subtree below it, built whole on one thread. */
+struct TopPart
+{
+  BuildTask task;                      ///< its points (a subtree's are moved into its build)
+  Node node;                           ///< a node made at the top
+  std::vector<std::size_t> children;   ///< its children's parts; empty for a leaf
+  bool whole = false;                  ///< built whole in `subtree`
+  Tree subtree;                        ///< local ids, its root at 0; leaf ranges into its own indices
+};
+
+/** \brief The build on several threads, in parts (joinParts() joins them). The top is made
+  * level by level, each level's nodes on the workers, down to nodes of at most `whole_size`
+  * points, whose subtrees are then built whole, one per worker at a time. */
+std::vector<TopPart>
+buildParts (const BuildPoints& points, const BVHParams& params, BuildTask root, std::size_t whole_size,
+            std::size_t workers)
+{
+  std::vector<NodeScratch> scratch (workers);
+  std::vector<TopPart> parts (1);
+  parts[0].task = std::move (root);
+  std::vector<std::size_t> level {0}, wholes;
+  while (!level.empty ())
+  {
+    std::vector<std::size_t> to_make;
+    for (const std::size_t p : level)
+    {
+      if (parts[p].task.points.size () > whole_size)
+        to_make.push_back (p);
+      else
+      {
+        parts[p].whole = true;
+        wholes.push_back (p);
+      }
+    }
+    std::vector<std::vector<std::vector<int>>> kids (to_make.size ());
+    detail::parallelFor (to_make.size (), workers, [&] (std::size_t i, std::size_t w) {
+      TopPart& part = parts[to_make[i]];
+      if (makeNode (points, params, part.task, part.node, scratch[w]))
+      {
+        kids[i] = std::move (scratch[w].children);
+        part.task.points = std::vector<int> ();
+      }
+    });
+    // Children become parts only now: `parts` must not grow while the workers hold references.
+    std::vector<std::size_t> next;
+    for (std::size_t i = 0; i < to_make.size (); ++i)
+      for (std::vector<int>& child : kids[i])
+      {
+        const std::size_t id = parts.size ();
+        parts.emplace_back ();
+        parts[id].task = {-1, parts[to_make[i]].task.depth + 1, std::move (child)};
+        parts[to_make[i]].children.push_back (id);
+        next.push_back (id);
+      }
+    level = std::move (next);
+  }
+
+  // Largest subtrees first, so that no worker is left with a big one at the end.
+  std::stable_sort (wholes.begin (), wholes.end (), [&] (std::size_t a, std::size_t b) {
+    return parts[a].task.points.size () > parts[b].task.points.size ();
+  });
+  detail::parallelFor (wholes.size (), workers, [&] (std::size_t i, std::size_t w) {
+    TopPart& part = parts[wholes[i]];
+    part.subtree.nodes.emplace_back ();
+    BuildTask task = std::move (part.task);
+    task.node = 0;
+    buildSubtree (points, params, std::move (task), part.subtree, scratch[w]);
+  });
+
+  return parts;
+}
+
+/** \brief Joins the parts of buildParts() into out, visiting them as buildSubtree visits nodes,
+  * so that the hierarchy is the one a single thread builds, node ids included. Each subtree is
+  * freed once copied. */
+void
+joinParts (std::vector<TopPart>& parts, Tree& out)
+{
+  std::size_t total_nodes = 0, total_indices = 0;
+  for (const TopPart& part : parts)
+  {
+    total_nodes += part.whole ? part.subtree.nodes.size () : 1;
+    total_indices += part.whole ? part.subtree.indices.size () : part.task.points.size ();
+  }
+  out.nodes.reserve (total_nodes);
+  out.indices.reserve (total_indices);
+  out.nodes.emplace_back ();
+  std::vector<std::pair<std::size_t, std::int32_t>> stack {{0, 0}};  // part, its node's id
+  while (!stack.empty ())
+  {
+    const auto [p, slot] = stack.back ();
+    stack.pop_back ();
+    TopPart& part = parts[p];
+    if (part.whole)
+    {
+      Tree& sub = part.subtree;
+      const std::int32_t base = static_cast<std::int32_t> (out.nodes.size ());
+      const std::int32_t offset = static_cast<std::int32_t> (out.indices.size ());
+      const auto global = [&] (std::int32_t j) { return j == 0 ? slot : base + j - 1; };
+      for (std::size_t j = 0; j < sub.nodes.size (); ++j)
+      {
+        Node nd = sub.nodes[j];
+        if (nd.isLeaf ())
+        {
+          nd.begin += offset;
+          nd.end += offset;
+        }
+        else
+          nd.first_child = global (nd.first_child);
+        if (j == 0)
+          out.nodes[static_cast<std::size_t> (slot)] = nd;
+        else
+          out.nodes.push_back (nd);
+      }
+      out.indices.insert (out.indices.end (), sub.indices.begin (), sub.indices.end ());
+      out.leaf_count += sub.leaf_count;
+      out.max_depth = std::max (out.max_depth, sub.max_depth);
+      sub = Tree ();
+      continue;
+    }
+    Node nd = part.node;
+    out.max_depth = std::max (out.max_depth, nd.depth);
+    if (part.children.empty ())
+    {
+      nd.begin = static_cast<std::int32_t> (out.indices.size ());
+      out.indices.insert (out.indices.end (), part.task.points.begin (), part.task.points.end ());
+      nd.end = static_cast<std::int32_t> (out.indices.size ());
+      ++out.leaf_count;
+      out.nodes[static_cast<std::size_t> (slot)] = nd;
+      part.task.points = std::vector<int> ();
+      continue;
+    }
+    const std::int32_t first = static_cast<std::int32_t> (out.nodes.size ());
+    nd.first_child = first;
+    out.nodes[static_cast<std::size_t> (slot)] = nd;
+    out.nodes.resize (out.nodes.size () + part.children.size ());
+    for (std::size_t c = part.children.size (); c-- > 0;)
+      stack.emplace_back (part.children[c], first + static_cast<std::int32_t> (c));
+  }
+}
+
+// A subtree of fewer points than this is not worth a thread of its own.
+constexpr std::size_t kMinWholeSize = 4096;
+
+/** \brief The workers a build's `threads` asks for (0: every core); throws for a negative one. */
+std::size_t
+checkedThreads (int threads, const char* where)
+{
+  if (threads < 0)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::" << where << "] threads = " << threads
+                                                                  << " must be >= 0 (0: one per hardware thread)");
+  return detail::threadCount (threads);
+}
 } // namespace
 
 bool
-ProbabilisticBVH::build (const UncertainCloud& cloud, const BVHParams& params)
+ProbabilisticBVH::build (const UncertainCloud& cloud, const BVHParams& params, int threads)
 {
   params.validate ();
+  const std::size_t workers = checkedThreads (threads, "build");
   validateCloud (cloud);
-  return buildValidated (UncertainCloud (cloud), params);
+  return buildValidated (UncertainCloud (cloud), params, workers);
 }
 
 bool
-ProbabilisticBVH::build (UncertainCloud&& cloud, const BVHParams& params)
+ProbabilisticBVH::build (UncertainCloud&& cloud, const BVHParams& params, int threads)
 {
   params.validate ();
+  const std::size_t workers = checkedThreads (threads, "build");
   validateCloud (cloud);
-  return buildValidated (std::move (cloud), params);
+  return buildValidated (std::move (cloud), params, workers);
 }
 
 bool
-ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& params)
+ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers)
 {
   const auto t0 = std::chrono::steady_clock::now ();
   UncertainCloud copy = std::move (cloud);
@@ -493,98 +748,44 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
     covariances.emplace_back (c);
   copy.covariances = std::vector<Eigen::Matrix3d> ();
   const BuildPoints points {copy.means, covariances, copy.area_weights};
-  std::vector<Node> nodes;
-  std::vector<int> indices;
-  std::size_t leaf_count = 0;
-  int max_depth = -1;
+  Tree tree;
   const std::size_t n = copy.size ();
 
   if (n > 0)
   {
-    // Rough sizes: about n / 5 nodes, a few percent of duplicated indices.
-    nodes.reserve (n / 4 + 8);
-    indices.reserve (n + n / 4 + 8);
-    std::vector<BuildTask> stack;
-    stack.push_back ({0, 0, std::vector<int> (n)});
+    BuildTask root {0, 0, std::vector<int> (n)};
     for (std::size_t i = 0; i < n; ++i)
-      stack.back ().points[i] = static_cast<int> (i);
-    nodes.emplace_back ();
-
-    NodeGeometry g;
-    std::vector<double> tmp;
-    std::vector<std::vector<int>> children;
-    while (!stack.empty ())
+      root.points[i] = static_cast<int> (i);
+    // Subtrees of at most whole_size points are built whole on one thread: eight per worker
+    // for balance. The hierarchy does not depend on it, nor on the thread count.
+    const std::size_t whole_size = std::max (kMinWholeSize, n / (8 * workers));
+    if (workers > 1 && n > whole_size)
     {
-      BuildTask task = std::move (stack.back ());
-      stack.pop_back ();
-      const std::vector<int>& pts = task.points;
-      const std::size_t m = pts.size ();
-      computeGeometry (points, pts, params.k_sigma, g);
-
-      Node& node = nodes[task.node];
-      node.box.axes = g.axes;
-      node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
-      node.box.half_extents = 0.5 * (g.hi - g.lo);
-      for (int k = 0; k < 3; ++k)
-        node.max_sigma (k) = static_cast<float> (g.s_max (k));
-      node.leakage = nodeLeakage (points, pts, g, params.leakage_bound);
-      node.variation = static_cast<float> (g.variation);
-      node.num_points = static_cast<std::int32_t> (m);
-      node.depth = task.depth;
-      max_depth = std::max (max_depth, task.depth);
-
-      const bool stop_rule = m <= static_cast<std::size_t> (params.n_max) &&
-                             g.variation <= params.sigma_max;
-      bool split = false;
-      if (stop_rule)
-        node.leaf_reason = LeafReason::StopRule;
-      else if (m <= static_cast<std::size_t> (params.n_min))
-        node.leaf_reason = LeafReason::MinSize;
-      else
-      {
-        split = params.split_style == BVHParams::SplitStyle::Pca
-                    ? splitPca (pts, g, params.epsilon, tmp, children)
-                    : splitOctree (pts, g, params.epsilon, tmp, children);
-        if (!split)
-          node.leaf_reason = LeafReason::NoProgress;
-      }
-
-      if (!split)
-      {
-        node.first_child = -1;
-        node.num_children = 0;
-        node.begin = static_cast<std::int32_t> (indices.size ());
-        indices.insert (indices.end (), pts.begin (), pts.end ());
-        node.end = static_cast<std::int32_t> (indices.size ());
-        ++leaf_count;
-        continue;
-      }
-
-      const std::int32_t first = static_cast<std::int32_t> (nodes.size ());
-      const std::size_t nc = children.size ();
-      node.leaf_reason = LeafReason::NotLeaf;
-      node.first_child = first;
-      node.num_children = static_cast<std::uint8_t> (nc);
-      // `node` may dangle after this resize.
-      nodes.resize (nodes.size () + nc);
-      // Reverse push: the first child is processed next, so leaves come out depth-first, left
-      // to right, and every subtree's leaves are contiguous in `indices`.
-      for (std::size_t c = nc; c-- > 0;)
-        stack.push_back ({first + static_cast<std::int32_t> (c), task.depth + 1,
-                          std::move (children[c])});
+      std::vector<TopPart> parts = buildParts (points, params, std::move (root), whole_size, workers);
+      copy.area_weights = std::vector<double> ();  // only the leakage read them: free before the join
+      joinParts (parts, tree);
+    }
+    else
+    {
+      // Rough sizes: about n / 5 nodes, a few percent of duplicated indices.
+      tree.nodes.reserve (n / 4 + 8);
+      tree.indices.reserve (n + n / 4 + 8);
+      tree.nodes.emplace_back ();
+      NodeScratch scratch;
+      buildSubtree (points, params, std::move (root), tree, scratch);
+      tree.nodes.shrink_to_fit ();
+      tree.indices.shrink_to_fit ();
     }
 
     // Internal ranges: children have larger ids than their parent, so one backward pass.
-    for (std::size_t id = nodes.size (); id-- > 0;)
+    for (std::size_t id = tree.nodes.size (); id-- > 0;)
     {
-      Node& nd = nodes[id];
+      Node& nd = tree.nodes[id];
       if (nd.isLeaf ())
         continue;
-      nd.begin = nodes[nd.first_child].begin;
-      nd.end = nodes[nd.first_child + nd.num_children - 1].end;
+      nd.begin = tree.nodes[static_cast<std::size_t> (nd.first_child)].begin;
+      nd.end = tree.nodes[static_cast<std::size_t> (nd.first_child + nd.num_children - 1)].end;
     }
-    nodes.shrink_to_fit ();
-    indices.shrink_to_fit ();
   }
 
   // Keep what queries read; the area weights only served the leakage above.
@@ -592,10 +793,10 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
   covariances_ = std::move (covariances);
   source_indices_ = std::move (copy.source_indices);
   params_ = params;
-  nodes_ = std::move (nodes);
-  indices_ = std::move (indices);
-  leaf_count_ = leaf_count;
-  depth_ = max_depth + 1;
+  nodes_ = std::move (tree.nodes);
+  indices_ = std::move (tree.indices);
+  leaf_count_ = tree.leaf_count;
+  depth_ = tree.max_depth + 1;
   build_milliseconds_ =
       std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - t0).count ();
   return !nodes_.empty ();

@@ -176,6 +176,17 @@ TEST (CloudModel, BadInputIsRefusedByName)
   CloudModelParams params;
   params.k = 0;
   EXPECT_THROW (buildCloudModel (*a, params), pcl::BadArgumentException);
+  params = CloudModelParams ();
+  params.threads = -1;
+  try
+  {
+    buildCloudModel (*a, params);
+    FAIL () << "threads = -1 was accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("threads = -1"), std::string::npos) << e.what ();
+  }
   const pcl::Indices outside {0, static_cast<int> (a->size ())};
   try
   {
@@ -190,6 +201,46 @@ TEST (CloudModel, BadInputIsRefusedByName)
   empty.push_back (pcl::PointXYZ (NAN, 0.0f, 0.0f));
   EXPECT_THROW (buildCloudModel (empty), pcl::BadArgumentException);
   EXPECT_THROW (CloudModel {UncertainCloud ()}, pcl::BadArgumentException);
+}
+
+// The build's threads (covariance estimation and hierarchy) change nothing in the model, so
+// nothing in an answer: an exhaustive query over two 22,500-point noisy sheets 1 mm apart.
+TEST (CloudModel, AnyBuildThreadCountGivesTheSameAnswers)
+{
+  const Cloud::Ptr a = sheet (0.3, 0.002, 0.001, 3);
+  const Cloud::Ptr b = sheet (0.3, 0.002, 0.001, 4, Eigen::Vector3d (0.0005, 0.0005, 0.001));
+  ASSERT_GT (a->size (), 20000u);
+  CollisionRequest request;
+  request.exhaustive = true;
+  request.per_point = true;
+  request.surface = true;
+  auto answer = [&] (int threads) {
+    CloudModelParams params;
+    params.noise = SensorNoiseModel::isotropic (0.001);
+    params.surface = true;
+    params.threads = threads;
+    const CloudModel::ConstPtr ma = buildCloudModel (*a, params, nullptr, nullptr, "a");
+    const CloudModel::ConstPtr mb = buildCloudModel (*b, params, nullptr, nullptr, "b");
+    CollisionResult r;
+    EXPECT_TRUE (collide (*ma, *mb, Eigen::Isometry3d::Identity (), request, r)) << r.message;
+    return r;
+  };
+  const CollisionResult one = answer (1);
+  EXPECT_GT (one.leaf_pairs_tested, 100u);
+  EXPECT_EQ (one.probabilities_a.size (), a->size ());
+  for (const int threads : {2, 0})
+  {
+    const CollisionResult many = answer (threads);
+    EXPECT_EQ (many.probability, one.probability) << threads;
+    EXPECT_EQ (many.leaf_pairs_tested, one.leaf_pairs_tested) << threads;
+    const auto same = [] (const std::vector<float>& x, const std::vector<float>& y) {
+      return x.size () == y.size () &&
+             std::equal (x.begin (), x.end (), y.begin (), [] (float u, float v) { return u == v || (u != u && v != v); });
+    };
+    EXPECT_TRUE (same (many.probabilities_a, one.probabilities_a)) << threads;
+    EXPECT_TRUE (same (many.probabilities_b, one.probabilities_b)) << threads;
+    EXPECT_EQ (many.signed_distance, one.signed_distance) << threads;
+  }
 }
 
 TEST (CloudModel, BuiltFromPointsKeepsSourceIndicesForPerPointResults)

@@ -533,3 +533,47 @@ TEST (CovarianceEstimation, DefaultSearchAnswersSingleQueriesLikePclKdTree)
     }
   }
 }
+
+// Blocks of points go to several threads; every output must be what one thread gives, bit for
+// bit, including the NaN rows and is_dense.
+TEST (CovarianceEstimation, AnyThreadCountGivesTheOneThreadOutput)
+{
+  const Cloud::Ptr cloud = scrambledPlaneWithNaN ();  // 1,600 points: 7 blocks of 256
+  auto run = [&] (int threads, CovarianceEstimation<pcl::PointXYZ>& est) {
+    est.setInputCloud (cloud);
+    est.setSensorNoise (SensorNoiseModel::kinect ());
+    est.setComputeSurface (true);
+    est.setNumberOfThreads (threads);
+    EXPECT_EQ (est.getNumberOfThreads (), threads);
+    pcl::PointCloud<Covariance> out;
+    est.compute (out);
+    return out;
+  };
+  CovarianceEstimation<pcl::PointXYZ> one;
+  const auto ref = run (1, one);
+  ASSERT_EQ (ref.size (), cloud->size ());
+  EXPECT_FALSE (ref.is_dense);
+  for (const int threads : {2, 3, 0})
+  {
+    CovarianceEstimation<pcl::PointXYZ> est;
+    const auto out = run (threads, est);
+    ASSERT_EQ (out.size (), ref.size ());
+    EXPECT_EQ (out.is_dense, ref.is_dense);
+    std::size_t finite = 0;
+    for (std::size_t i = 0; i < out.size (); ++i)
+    {
+      ASSERT_EQ (out[i].isFinite (), ref[i].isFinite ()) << threads << " " << i;
+      if (!out[i].isFinite ())
+        continue;
+      ++finite;
+      EXPECT_TRUE (out[i].matrix () == ref[i].matrix ()) << threads << " " << i;
+      EXPECT_EQ (est.getNeighbourRadii ()[i], one.getNeighbourRadii ()[i]);
+      EXPECT_TRUE (est.getSurfaceDisplacements ()[i] == one.getSurfaceDisplacements ()[i]);
+      EXPECT_TRUE (est.getNormals ()[i] == one.getNormals ()[i]);
+    }
+    EXPECT_EQ (finite, cloud->size () - 17u);  // every 97th point is NaN
+    EXPECT_EQ (est.getNeighbours (), one.getNeighbours ());
+  }
+  CovarianceEstimation<pcl::PointXYZ> est;
+  EXPECT_THROW (est.setNumberOfThreads (-1), pcl::BadArgumentException);
+}

@@ -656,3 +656,42 @@ TEST (ProbabilisticBVH, LargeEpsilonKeepsTheHierarchyLinearInSize)
   const ProbabilisticBVH defaults (cloud, BVHParams ());
   EXPECT_GT (defaults.storedPoints (), cloud.size ());
 }
+
+// The build makes the top of the tree level by level on several threads and the subtrees below
+// whole: the hierarchy must be the one-thread hierarchy, node ids, boxes and leakage included.
+TEST (ProbabilisticBVH, AnyThreadCountBuildsTheOneThreadHierarchy)
+{
+  // 40,000 points: subtrees of at most 5,000 (2 threads) or 4,096 points are built whole, so
+  // several top levels are made in parallel.
+  const UncertainCloud cloud = shapeCloud (Shape::Sphere, 40000, 93, 0.003);
+  for (const auto style : {BVHParams::SplitStyle::Pca, BVHParams::SplitStyle::Octree})
+  {
+    BVHParams params;
+    params.split_style = style;
+    const ProbabilisticBVH one (cloud, params, 1);
+    ASSERT_GT (one.nodes ().size (), 1000u);
+    for (const int threads : {2, 3, 8, 0})
+    {
+      const ProbabilisticBVH many (cloud, params, threads);
+      ASSERT_EQ (many.nodes ().size (), one.nodes ().size ()) << threads;
+      EXPECT_EQ (many.pointIndices (), one.pointIndices ()) << threads;
+      EXPECT_EQ (many.leafCount (), one.leafCount ());
+      EXPECT_EQ (many.depth (), one.depth ());
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < one.nodes ().size (); ++i)
+      {
+        const Node& a = one.nodes ()[i];
+        const Node& b = many.nodes ()[i];
+        const bool same = a.first_child == b.first_child && a.num_children == b.num_children &&
+                          a.begin == b.begin && a.end == b.end && a.num_points == b.num_points &&
+                          a.depth == b.depth && a.leaf_reason == b.leaf_reason && a.leakage == b.leakage &&
+                          a.variation == b.variation && a.max_sigma == b.max_sigma && a.box.axes == b.box.axes &&
+                          a.box.center == b.box.center && a.box.half_extents == b.box.half_extents;
+        differing += same ? 0 : 1;
+      }
+      EXPECT_EQ (differing, 0u) << "threads " << threads;
+    }
+  }
+  ProbabilisticBVH bvh;
+  EXPECT_THROW (bvh.build (cloud, BVHParams (), -1), pcl::BadArgumentException);
+}

@@ -112,7 +112,7 @@ public:
 private:
   CloudModel () = default;
   /** \brief Centres the points on their centroid (origin()) and builds the hierarchy there. */
-  void buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size);
+  void buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size, int threads = 1);
 
   template <typename PointT>
   friend std::shared_ptr<const CloudModel>

@@ -61,6 +61,9 @@ struct CloudModelParams
   NormalOrientation orientation = NormalOrientation::Auto;
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
+  /** \brief Threads of the build (covariance estimation and hierarchy): 0 = one per hardware
+    * thread (default), as for collideBatch(). The model is the same for any count. */
+  int threads = 0;
 
   /** \brief Throws pcl::BadArgumentException naming the first member out of range. */
   void validate () const;

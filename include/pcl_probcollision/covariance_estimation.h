@@ -115,6 +115,13 @@ public:
     * output point (row-major, -1 where fewer neighbours exist), the point itself excluded. */
   const std::vector<int>& getNeighbours () const { return neighbours_; }
 
+  /** \brief Threads of compute(): 0 = one per hardware thread; default 1, as for
+    * pcl::NormalEstimation. The output is the same for any count. Used only with the default
+    * search (no setSearchMethod), whose concurrent queries are known to be safe. Throws
+    * pcl::BadArgumentException for a negative count. */
+  void setNumberOfThreads (int threads);
+  int getNumberOfThreads () const { return threads_; }
+
 protected:
   bool initCompute () override;
   void computeFeature (PointCloudOut& output) override;
@@ -138,6 +145,7 @@ private:
   bool compute_surface_ = false;
   std::vector<Eigen::Vector3f> normals_;
   std::vector<int> neighbours_;
+  int threads_ = 1;
 };
 } // namespace pcl_probcollision
 

@@ -151,9 +151,9 @@ public:
   ProbabilisticBVH () = default;
 
   /** \brief Builds at construction; see build(). */
-  explicit ProbabilisticBVH (const UncertainCloud& cloud, const BVHParams& params = BVHParams ())
+  explicit ProbabilisticBVH (const UncertainCloud& cloud, const BVHParams& params = BVHParams (), int threads = 1)
   {
-    build (cloud, params);
+    build (cloud, params, threads);
   }
 
   /** \brief Builds the hierarchy over a copy of cloud, replacing any previous one.
@@ -161,18 +161,20 @@ public:
     *            area_weights (empty = equal weights) weight the leakage; it is copied
     *            (means, packed covariances and source indices are kept, see means())
     * \param[in] params construction parameters
+    * \param[in] threads threads of the build: 0 = one per hardware thread; default 1. The
+    *            hierarchy is the same for any count, node ids included.
     * \return true when a hierarchy was built; false for an empty cloud, which leaves an empty
     *         hierarchy (empty() == true, no nodes).
-    * \throws pcl::BadArgumentException for invalid params, sizes that disagree (covariances,
+    * \throws pcl::BadArgumentException for invalid params, a negative thread count, sizes that disagree (covariances,
     *         non-empty area_weights or source_indices not matching means), a non-finite mean
     *         or covariance, a negative or non-finite area weight, or more than 2^28 points.
     *         On throw the previous hierarchy is left untouched. */
-  bool build (const UncertainCloud& cloud, const BVHParams& params = BVHParams ());
+  bool build (const UncertainCloud& cloud, const BVHParams& params = BVHParams (), int threads = 1);
 
-  /** \brief As build(const UncertainCloud&, const BVHParams&), but takes the cloud over
+  /** \brief As build(const UncertainCloud&, const BVHParams&, int), but takes the cloud over
     * instead of copying it. The cloud is moved from only after validation succeeds; on throw
     * it is left untouched. */
-  bool build (UncertainCloud&& cloud, const BVHParams& params = BVHParams ());
+  bool build (UncertainCloud&& cloud, const BVHParams& params = BVHParams (), int threads = 1);
 
   /** \brief Drops the hierarchy and the stored cloud. */
   void clear ();
@@ -255,7 +257,7 @@ public:
                              std::vector<Eigen::Matrix3d>& covariances) const;
 
 private:
-  bool buildValidated (UncertainCloud&& cloud, const BVHParams& params);
+  bool buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers);
 
   // The points, in the cloud's own frame: 76 bytes a point.
   std::vector<Eigen::Vector3d> means_;

@@ -80,6 +80,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     if (indices)
       estimation.setIndices (pcl::IndicesConstPtr (indices, [] (const pcl::Indices*) {}));
     estimation.setKSearch (params.k);
+    estimation.setNumberOfThreads (params.threads);
     if (!covariances)
     {
       estimation.setSensorNoise (params.noise);
@@ -128,9 +129,15 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     err << name << " cloud has no finite point (" << n << " given, " << skipped << " non-finite)";
     throw pcl::BadArgumentException (err.str ());
   }
+  // What the points took over is freed before the hierarchy's build, which is the peak of memory
+  // (5,000,000 points: 52 bytes a point less).
+  pcl::PointCloud<Covariance> ().swap (estimated);
+  std::vector<Eigen::Vector3d> ().swap (displacements);
+  if (!params.surface)
+    std::vector<float> ().swap (radii);
 
   std::shared_ptr<CloudModel> model (new CloudModel);
-  model->buildLocal (std::move (points), params.hierarchy, cloud.size ());
+  model->buildLocal (std::move (points), params.hierarchy, cloud.size (), params.threads);
   if (params.surface)
   {
     // The surface model's inputs, re-indexed from estimation slots / cloud indices to model

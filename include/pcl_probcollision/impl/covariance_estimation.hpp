@@ -2,6 +2,7 @@
 #pragma once
 
 #include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/exceptions.h>
@@ -282,6 +283,17 @@ CovarianceEstimation<PointInT, PointOutT>::setKSearch (int k)
 
 template <typename PointInT, typename PointOutT>
 void
+CovarianceEstimation<PointInT, PointOutT>::setNumberOfThreads (int threads)
+{
+  if (threads < 0)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::CovarianceEstimation::setNumberOfThreads] threads = "
+                             << threads << " must be >= 0 (0: one per hardware thread)");
+  threads_ = threads;
+}
+
+template <typename PointInT, typename PointOutT>
+void
 CovarianceEstimation<PointInT, PointOutT>::setScale (double tau)
 {
   if (!(std::isfinite (tau) && tau > 0.0))
@@ -405,118 +417,131 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   // Neighbours are searched a block of points at a time: one FLANN call per block, and the
   // buffers stay small enough for the cache.
   constexpr std::size_t kBlockSize = 256;
-  detail::NeighbourBlock block;
-  pcl::Indices block_queries, nn_indices (this->k_);
-  bool dense = true;
-  // Points are visited along a Z-order curve (see zOrder); each fills only its own output slot.
+  // Points are visited along a Z-order curve (see zOrder), a block at a time; each fills only its
+  // own output slot, so blocks may run on several threads with the same result. Threads only
+  // with BatchKdTree, whose concurrent queries are known to be safe.
   const std::vector<std::size_t> order = detail::zOrder (input, indices);
-
-  for (std::size_t o = 0; o < order.size (); ++o)
+  const std::size_t blocks = (order.size () + kBlockSize - 1) / kBlockSize;
+  const bool batch_search = dynamic_cast<const detail::BatchKdTree<PointInT>*> (this->tree_.get ()) != nullptr;
+  const std::size_t workers = batch_search ? detail::threadCount (threads_) : 1;
+  struct Scratch
   {
-    const std::size_t b = o % kBlockSize;
-    if (b == 0)
-    {
-      block_queries.clear ();
-      for (std::size_t q = o; q < std::min (order.size (), o + kBlockSize); ++q)
-        block_queries.push_back (indices[order[q]]);
-      detail::findNeighbours (*this->tree_, input, block_queries, k_ask, block);
-    }
-    const std::size_t out = order[o];
-    const int index = indices[out];
-    const PointInT& query = input[index];
-    if (!pcl::isXYZFinite (query))
-    {
-      output[out] = PointOutT (Covariance::nan ());
-      dense = false;
-      continue;
-    }
-    const Eigen::Vector3d xi = query.getVector3fMap ().template cast<double> ();
+    detail::NeighbourBlock block;
+    pcl::Indices block_queries, nn_indices;
+  };
+  std::vector<Scratch> scratch (std::min (workers, std::max<std::size_t> (blocks, 1)));
+  std::vector<char> block_dense (blocks, 1);
 
-    // Keep at most k neighbours other than the query point itself.
-    const std::size_t* row = block.indices.data () + block.offset[b];
-    const float* row_sqr_dists = block.sqr_distances.data () + block.offset[b];
-    std::size_t kept = 0;
-    double r = 0.0;
-    for (int j = 0; j < block.found[b] && kept < static_cast<std::size_t> (this->k_); ++j)
+  detail::parallelFor (blocks, workers, [&] (std::size_t blk, std::size_t worker) {
+    Scratch& s = scratch[worker];
+    detail::NeighbourBlock& block = s.block;
+    pcl::Indices& nn_indices = s.nn_indices;
+    nn_indices.resize (static_cast<std::size_t> (this->k_));
+    const std::size_t o_begin = blk * kBlockSize, o_end = std::min (order.size (), o_begin + kBlockSize);
+    s.block_queries.clear ();
+    for (std::size_t q = o_begin; q < o_end; ++q)
+      s.block_queries.push_back (indices[order[q]]);
+    detail::findNeighbours (*this->tree_, input, s.block_queries, k_ask, block);
+    for (std::size_t o = o_begin; o < o_end; ++o)
     {
-      const auto neighbour = static_cast<pcl::index_t> (row[j]);
-      if (same_cloud && neighbour == index)
+      const std::size_t b = o - o_begin;
+      const std::size_t out = order[o];
+      const int index = indices[out];
+      const PointInT& query = input[index];
+      if (!pcl::isXYZFinite (query))
+      {
+        output[out] = PointOutT (Covariance::nan ());
+        block_dense[blk] = 0;
         continue;
-      if (!pcl::isXYZFinite (surface[neighbour]))
-        continue;
-      nn_indices[kept] = neighbour;
-      ++kept;
-      r = std::max (r, std::sqrt (static_cast<double> (row_sqr_dists[j])));
-    }
-    radii_[out] = static_cast<float> (r);
-    if (compute_surface_)
-      std::copy (nn_indices.begin (), nn_indices.begin () + static_cast<std::ptrdiff_t> (kept),
-                 neighbours_.begin () + static_cast<std::ptrdiff_t> (out * static_cast<std::size_t> (this->k_)));
+      }
+      const Eigen::Vector3d xi = query.getVector3fMap ().template cast<double> ();
 
-    Eigen::Matrix3d psi = Eigen::Matrix3d::Zero ();
-    // Weighted mean offset of the neighbours and their effective number (surface projection).
-    Eigen::Vector3d first = Eigen::Vector3d::Zero ();
-    double k_eff = 0.0, weight_sq_sum = 0.0;
-    if (kept > 0 && r > 0.0)
-    {
-      const double tau_i = tau * r / std::sqrt (static_cast<double> (kept));
-      const double inv_tau2 = 1.0 / (tau_i * tau_i);
-      double weight_sum = 0.0;
-      for (std::size_t j = 0; j < kept; ++j)
+      // Keep at most k neighbours other than the query point itself.
+      const std::size_t* row = block.indices.data () + block.offset[b];
+      const float* row_sqr_dists = block.sqr_distances.data () + block.offset[b];
+      std::size_t kept = 0;
+      double r = 0.0;
+      for (int j = 0; j < block.found[b] && kept < static_cast<std::size_t> (this->k_); ++j)
       {
-        // Differences in double: exact for float inputs even far from the origin.
-        const Eigen::Vector3d d = surface[nn_indices[j]].getVector3fMap ().template cast<double> () - xi;
-        const double w = std::exp (-d.squaredNorm () * inv_tau2);
-        psi.noalias () += w * d * d.transpose ();
-        first += w * d;
-        weight_sum += w;
-        weight_sq_sum += w * w;
+        const auto neighbour = static_cast<pcl::index_t> (row[j]);
+        if (same_cloud && neighbour == index)
+          continue;
+        if (!pcl::isXYZFinite (surface[neighbour]))
+          continue;
+        nn_indices[kept] = neighbour;
+        ++kept;
+        r = std::max (r, std::sqrt (static_cast<double> (row_sqr_dists[j])));
       }
-      if (weight_sum > 0.0)
-      {
-        psi /= weight_sum;
-        first /= weight_sum;
-        k_eff = weight_sum * weight_sum / weight_sq_sum;
-      }
-    }
+      radii_[out] = static_cast<float> (r);
+      if (compute_surface_)
+        std::copy (nn_indices.begin (), nn_indices.begin () + static_cast<std::ptrdiff_t> (kept),
+                   neighbours_.begin () + static_cast<std::ptrdiff_t> (out * static_cast<std::size_t> (this->k_)));
 
-    if (compute_surface_)
-    {
-      Eigen::Vector3d n = Eigen::Vector3d::Zero ();
-      double lambda0 = 0.0;
-      if (kept >= 2 && psi.trace () > 0.0)
-        detail::smallestEigenpair (psi, lambda0, n);
-      normals_[out] = n.cast<float> ();
-    }
-    Eigen::Matrix3d total = use_discretization_ ? psi : Eigen::Matrix3d::Zero ();
-    if (noise_.type () != SensorNoiseModel::Type::None)
-    {
-      Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
-      if (noise_.usesNormal () && kept >= 2 && psi.trace () > 0.0)
+      Eigen::Matrix3d psi = Eigen::Matrix3d::Zero ();
+      // Weighted mean offset of the neighbours and their effective number (surface projection).
+      Eigen::Vector3d first = Eigen::Vector3d::Zero ();
+      double k_eff = 0.0, weight_sq_sum = 0.0;
+      if (kept > 0 && r > 0.0)
       {
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (psi);
-        normal = eig.eigenvectors ().col (0);
+        const double tau_i = tau * r / std::sqrt (static_cast<double> (kept));
+        const double inv_tau2 = 1.0 / (tau_i * tau_i);
+        double weight_sum = 0.0;
+        for (std::size_t j = 0; j < kept; ++j)
+        {
+          // Differences in double: exact for float inputs even far from the origin.
+          const Eigen::Vector3d d = surface[nn_indices[j]].getVector3fMap ().template cast<double> () - xi;
+          const double w = std::exp (-d.squaredNorm () * inv_tau2);
+          psi.noalias () += w * d * d.transpose ();
+          first += w * d;
+          weight_sum += w;
+          weight_sq_sum += w * w;
+        }
+        if (weight_sum > 0.0)
+        {
+          psi /= weight_sum;
+          first /= weight_sum;
+          k_eff = weight_sum * weight_sum / weight_sq_sum;
+        }
       }
-      const Eigen::Matrix3d sensor_cov = noise_.covariance (xi, normal, sensor);
-      Eigen::Vector3d delta, n;
-      Eigen::Matrix3d psi_moved;
-      double shrink = 1.0;
-      if (project_ && kept >= 2 && projectOntoSurface (first, psi, k_eff, sensor_cov, delta, psi_moved, n, shrink))
+
+      if (compute_surface_)
       {
-        displacements_[out] = delta;
-        total = (use_discretization_ ? psi_moved : Eigen::Matrix3d::Zero ()) + sensor_cov;
-        const Eigen::Matrix3d A = Eigen::Matrix3d::Identity () - (1.0 - std::sqrt (shrink)) * n * n.transpose ();
-        total = A * total * A.transpose ();
+        Eigen::Vector3d n = Eigen::Vector3d::Zero ();
+        double lambda0 = 0.0;
+        if (kept >= 2 && psi.trace () > 0.0)
+          detail::smallestEigenpair (psi, lambda0, n);
+        normals_[out] = n.cast<float> ();
       }
-      else
-        total += sensor_cov;
+      Eigen::Matrix3d total = use_discretization_ ? psi : Eigen::Matrix3d::Zero ();
+      if (noise_.type () != SensorNoiseModel::Type::None)
+      {
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
+        if (noise_.usesNormal () && kept >= 2 && psi.trace () > 0.0)
+        {
+          const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig (psi);
+          normal = eig.eigenvectors ().col (0);
+        }
+        const Eigen::Matrix3d sensor_cov = noise_.covariance (xi, normal, sensor);
+        Eigen::Vector3d delta, n;
+        Eigen::Matrix3d psi_moved;
+        double shrink = 1.0;
+        if (project_ && kept >= 2 && projectOntoSurface (first, psi, k_eff, sensor_cov, delta, psi_moved, n, shrink))
+        {
+          displacements_[out] = delta;
+          total = (use_discretization_ ? psi_moved : Eigen::Matrix3d::Zero ()) + sensor_cov;
+          const Eigen::Matrix3d A = Eigen::Matrix3d::Identity () - (1.0 - std::sqrt (shrink)) * n * n.transpose ();
+          total = A * total * A.transpose ();
+        }
+        else
+          total += sensor_cov;
+      }
+      if (project_ && !displacements_[out].allFinite ())
+        displacements_[out].setZero ();
+      total = 0.5 * (total + total.transpose ());
+      output[out] = PointOutT (Covariance (total));
     }
-    if (project_ && !displacements_[out].allFinite ())
-      displacements_[out].setZero ();
-    total = 0.5 * (total + total.transpose ());
-    output[out] = PointOutT (Covariance (total));
-  }
-  output.is_dense = dense;
+  });
+  output.is_dense = std::all_of (block_dense.begin (), block_dense.end (), [] (char d) { return d != 0; });
 }
 } // namespace pcl_probcollision
 

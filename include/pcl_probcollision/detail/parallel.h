@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <exception>
+#include <limits>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief The number of threads a `threads` setting asks for: itself when > 0, else one per
+  * hardware thread (at least one). The one reading of the library's "0 = every core". */
+inline std::size_t
+threadCount (int threads)
+{
+  return threads > 0 ? static_cast<std::size_t> (threads) : std::max (1u, std::thread::hardware_concurrency ());
+}
+
+/** \brief Runs task(i, worker) for every i in [0, count) on at most `workers` threads, the
+  * calling one included (worker 0), so one worker starts no thread. Items are handed out one at
+  * a time in increasing order, since their costs may differ widely; a task may use per-worker
+  * scratch indexed by `worker` (< workers). Callers keep results deterministic by writing each
+  * item's result to its own slot. When tasks throw, the remaining items are abandoned and the
+  * exception of the lowest failing item is rethrown. When no more threads can be started the
+  * running ones take the remaining items. */
+template <typename Task>
+void
+parallelFor (std::size_t count, std::size_t workers, Task&& task)
+{
+  workers = std::max<std::size_t> (1, std::min (workers, count));
+  if (count == 0)
+    return;
+  if (workers == 1)
+  {
+    for (std::size_t i = 0; i < count; ++i)
+      task (i, std::size_t{0});
+    return;
+  }
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max ();
+  std::atomic<std::size_t> next (0);
+  std::vector<std::exception_ptr> errors (workers);
+  std::vector<std::size_t> error_item (workers, kNone);
+  auto work = [&] (std::size_t worker) {
+    std::size_t i = kNone;
+    try
+    {
+      while ((i = next.fetch_add (1, std::memory_order_relaxed)) < count)
+        task (i, worker);
+    }
+    catch (...)
+    {
+      // Escaping a std::thread would terminate the program: keep it for the caller.
+      errors[worker] = std::current_exception ();
+      error_item[worker] = i;
+      next.store (count, std::memory_order_relaxed);
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve (workers - 1);
+  for (std::size_t w = 1; w < workers; ++w)
+  {
+    try
+    {
+      pool.emplace_back (work, w);
+    }
+    catch (const std::system_error&)
+    {
+      break;
+    }
+  }
+  work (0);
+  for (std::thread& t : pool)
+    t.join ();
+  std::size_t first = kNone;
+  for (std::size_t w = 0; w < workers; ++w)
+    if (errors[w] && (first == kNone || error_item[w] < error_item[first]))
+      first = w;
+  if (first != kNone)
+    std::rethrow_exception (errors[first]);
+}
+} // namespace detail
+} // namespace pcl_probcollision
