@@ -737,6 +737,8 @@ PYBIND11_MODULE (_core, m)
                       "Build the surface model CollisionRequest.surface queries (default False).")
       .def_readwrite ("orientation", &CloudModelParams::orientation,
                       "How the surface model's normals are oriented (NormalOrientation, default Auto).")
+      .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
+                      "Merge samples closer than this many sensor-noise sigmas into one (issue #17; default 0: off).")
       .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
                      [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
       .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },

@@ -374,7 +374,7 @@ TEST (NoiseResolution, MergesSamplesWhenTheNoiseExceedsTheSpacing)
   // 1,681 samples 5 mm apart, noise 10 mm: merge radius 10 mm.
   const Cloud::Ptr a = sheet (0.2, 0.005, 0.01, 3);
   const CloudModel::ConstPtr model = buildCloudModel (*a, merging (0.01, 1.0));
-  EXPECT_LT (model->size (), a->size () / 4);
+  EXPECT_LT (model->size (), a->size () / 2);
   EXPECT_EQ (model->mergedSamples (), a->size () - model->size ());
   EXPECT_EQ (model->skippedPoints (), 0u);
   ASSERT_EQ (model->pointOfSource ().size (), a->size ());
