@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 namespace pcl_probcollision_eval
@@ -20,7 +21,7 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 std::vector<OursSetting>
-oursSettings (bool full)
+oursSettings (bool full, const std::vector<double>& merge)
 {
   std::vector<OursSetting> s;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
@@ -48,6 +49,20 @@ oursSettings (bool full)
   s.push_back (surface);
   s.push_back (pooled);
   s.push_back (other);
+  for (const double c : merge)
+  {
+    // Issue #17 item 1: samples closer than c noise sigmas merged, separators and surface.
+    std::ostringstream name;
+    name << c;
+    OursSetting merged = classifier;
+    merged.name = "merge" + name.str ();
+    merged.model.noise_resolution = c;
+    s.push_back (merged);
+    merged = surface;
+    merged.name = "surface-merge" + name.str ();
+    merged.model.noise_resolution = c;
+    s.push_back (merged);
+  }
   if (!full)
     return s;
   auto add = [&] (const std::string& name, auto change) {
@@ -126,6 +141,7 @@ buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env,
   build.build_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   build.memory_bytes = static_cast<double> (m.robot->bytes () + m.env->bytes ());
   build.nodes = static_cast<double> (m.robot->hierarchy ().nodes ().size () + m.env->hierarchy ().nodes ().size ());
+  build.points = static_cast<double> (m.robot->size () + m.env->size ());
   return m;
 }
 

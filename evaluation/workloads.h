@@ -45,6 +45,7 @@ struct BuildRow
   double memory_bytes = 0.0;
   // Our model size (0 for the baselines).
   double nodes = 0.0, leaf_pairs_mean = 0.0, kernel_share = 0.0, features_mean = 0.0;
+  double points = 0.0;  ///< model points of both clouds (fewer than samples when merged)
 };
 
 /** \brief One configuration of our method in the sweep. */
@@ -62,8 +63,9 @@ struct OursSetting
   * separators alone), then one change at a time from the defaults. One of classifier and
   * surface answers as default does (the surface layer is off by default while experimental).
   * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled).
-  * full = false keeps default, classifier, surface, pooled and max. */
-std::vector<OursSetting> oursSettings (bool full);
+  * full = false keeps default, classifier, surface, pooled and max. Each c of merge adds "merge<c>"
+  * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c. */
+std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {});
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and
   * its std (NaN when not computed, e.g. before the surface layer or with surface off) and the

@@ -737,6 +737,11 @@ PYBIND11_MODULE (_core, m)
                       "Build the surface model CollisionRequest.surface queries (default False).")
       .def_readwrite ("orientation", &CloudModelParams::orientation,
                       "How the surface model's normals are oriented (NormalOrientation, default Auto).")
+      .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
+                      "Merge samples closer than this many sensor-noise sigmas into one (issue #17; default 0: off).")
+      .def_readwrite ("threads", &CloudModelParams::threads,
+                      "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
+                      "hardware thread. The model is the same for any count.")
       .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
                      [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
       .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },

@@ -25,6 +25,9 @@ CloudModelParams::validate () const
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::CloudModelParams::validate] threads = "
                              << threads << " must be >= 0 (0: one per hardware thread)");
+  if (!(noise_resolution >= 0.0 && std::isfinite (noise_resolution)))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CloudModelParams::validate] noise_resolution = "
+                                                         << noise_resolution << " must be finite and >= 0");
   hierarchy.validate ();
 }
 
@@ -87,6 +90,29 @@ CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std
   }
   bvh_.build (std::move (points), hierarchy, threads);
   source_size_ = source_size;
+}
+
+void
+CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
+                        const std::vector<int>& cluster_of, std::vector<int>&& seeds)
+{
+  // The hierarchy's source indices are merged points (the merged cloud's indices).
+  std::vector<int> point_of_merged (seeds.size (), -1);
+  for (std::size_t j = 0; j < bvh_.size (); ++j)
+    point_of_merged[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
+  point_of_source_.assign (source_size, -1);
+  std::size_t mapped = 0;
+  for (std::size_t i = 0; i < cluster_of.size () && i < source_size; ++i)
+    if (cluster_of[i] >= 0 && point_of_merged[static_cast<std::size_t> (cluster_of[i])] >= 0)
+    {
+      point_of_source_[i] = point_of_merged[static_cast<std::size_t> (cluster_of[i])];
+      ++mapped;
+    }
+  representatives_ = std::move (seeds);
+  merged_samples_ = mapped - bvh_.size ();
+  skipped_ = candidates - mapped;
+  source_size_ = source_size;
+  params_ = params;
 }
 
 void

@@ -227,14 +227,25 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
 
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
   if (result.witness_side != 0)
+  {
     result.witness_point += a.origin ();
+    result.witness_index = (result.witness_side > 0 ? a : b).sourceIndex (result.witness_index);
+  }
   if (request.per_point)
   {
     auto scatter = [] (std::vector<float>& values, const CloudModel& model) {
       std::vector<float> out (model.sourceSize (), kNotReached);
       const ProbabilisticBVH& bvh = model.hierarchy ();
-      for (std::size_t j = 0; j < values.size (); ++j)
-        out[static_cast<std::size_t> (bvh.sourceIndex (static_cast<int> (j)))] = values[j];
+      const std::vector<int>& point_of = model.pointOfSource ();
+      if (!point_of.empty ())  // merged samples: each one reports its merged point's value
+      {
+        for (std::size_t i = 0; i < out.size (); ++i)
+          if (point_of[i] >= 0 && static_cast<std::size_t> (point_of[i]) < values.size ())
+            out[i] = values[static_cast<std::size_t> (point_of[i])];
+      }
+      else
+        for (std::size_t j = 0; j < values.size (); ++j)
+          out[static_cast<std::size_t> (bvh.sourceIndex (static_cast<int> (j)))] = values[j];
       values.swap (out);
     };
     scatter (result.probabilities_a, a);

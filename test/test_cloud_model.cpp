@@ -370,3 +370,204 @@ TEST (ProbabilisticCollisionRebuild, PrebuiltModelsAreUsedAsGiven)
   EXPECT_FALSE (pc.compute (none));
   EXPECT_NE (none.message.find ("setInputCloud"), std::string::npos) << none.message;
 }
+
+// ---- Resolution tied to the noise (CloudModelParams::noise_resolution, issue #17 item 1) ---
+
+namespace
+{
+/** n random points on a square of side `size` at z = 0, noise sigma along z (seeded). */
+Cloud::Ptr
+randomSquare (int n, double size, double sigma, unsigned seed)
+{
+  std::mt19937 rng (seed);
+  std::uniform_real_distribution<double> u (-size / 2, size / 2);
+  std::normal_distribution<double> noise (0.0, sigma);
+  Cloud::Ptr c (new Cloud);
+  for (int i = 0; i < n; ++i)
+  {
+    const double x = u (rng), y = u (rng);
+    c->push_back (pcl::PointXYZ (static_cast<float> (x), static_cast<float> (y), static_cast<float> (noise (rng))));
+  }
+  return c;
+}
+
+CloudModelParams
+merging (double sigma, double factor)
+{
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (sigma);
+  params.noise_resolution = factor;
+  return params;
+}
+} // namespace
+
+TEST (NoiseResolution, OffByDefaultAndValidatedByName)
+{
+  EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
+  for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
+  {
+    CloudModelParams params;
+    params.noise_resolution = bad;
+    try
+    {
+      params.validate ();
+      FAIL () << "noise_resolution = " << bad << " was accepted";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find ("noise_resolution"), std::string::npos) << e.what ();
+    }
+  }
+}
+
+TEST (NoiseResolution, MergesSamplesWhenTheNoiseExceedsTheSpacing)
+{
+  // 1,681 samples 5 mm apart, noise 10 mm: merge radius 10 mm.
+  const Cloud::Ptr a = sheet (0.2, 0.005, 0.01, 3);
+  const CloudModel::ConstPtr model = buildCloudModel (*a, merging (0.01, 1.0));
+  EXPECT_LT (model->size (), a->size () / 2);
+  EXPECT_EQ (model->mergedSamples (), a->size () - model->size ());
+  EXPECT_EQ (model->skippedPoints (), 0u);
+  ASSERT_EQ (model->pointOfSource ().size (), a->size ());
+  std::vector<int> members (model->size (), 0);
+  for (const int p : model->pointOfSource ())
+  {
+    ASSERT_GE (p, 0);
+    ASSERT_LT (static_cast<std::size_t> (p), model->size ());
+    ++members[static_cast<std::size_t> (p)];
+  }
+  for (const int m : members)
+    EXPECT_GE (m, 1);  // every model point stands for at least one sample
+  // A larger radius merges more.
+  EXPECT_LT (buildCloudModel (*a, merging (0.01, 2.0))->size (), model->size ());
+}
+
+TEST (NoiseResolution, MergesNothingWhenTheNoiseIsBelowTheSpacing)
+{
+  // Samples 10 mm apart, noise 1 mm, radius 2 mm: the model is the unmerged one.
+  const Cloud::Ptr a = sheet (0.2, 0.01, 0.001, 4);
+  const CloudModel::ConstPtr merged = buildCloudModel (*a, merging (0.001, 2.0));
+  const CloudModel::ConstPtr plain = buildCloudModel (*a, merging (0.001, 0.0));
+  EXPECT_EQ (merged->size (), a->size ());
+  EXPECT_EQ (merged->mergedSamples (), 0u);
+  EXPECT_TRUE (merged->pointOfSource ().empty ());
+  ASSERT_EQ (merged->hierarchy ().means ().size (), plain->hierarchy ().means ().size ());
+  for (std::size_t i = 0; i < plain->hierarchy ().means ().size (); ++i)
+    EXPECT_EQ (merged->hierarchy ().means ()[i], plain->hierarchy ().means ()[i]);
+  EXPECT_EQ (merged->hierarchy ().nodes ().size (), plain->hierarchy ().nodes ().size ());
+  // No noise model: nothing to tie the resolution to.
+  CloudModelParams none;
+  none.noise_resolution = 5.0;
+  EXPECT_EQ (buildCloudModel (*sheet (0.2, 0.005, 0.0, 5), none)->mergedSamples (), 0u);
+}
+
+TEST (NoiseResolution, AMergedPointIsItsMembersCentroid)
+{
+  const Cloud::Ptr a = randomSquare (2000, 0.2, 0.004, 6);
+  CloudModelParams params = merging (0.004, 2.0);
+  params.surface_projection = false;  // the means are then the merged positions themselves
+  const CloudModel::ConstPtr model = buildCloudModel (*a, params);
+  ASSERT_GT (model->mergedSamples (), 0u);
+  std::vector<Eigen::Vector3d> sums (model->size (), Eigen::Vector3d::Zero ());
+  std::vector<int> counts (model->size (), 0);
+  for (std::size_t i = 0; i < a->size (); ++i)
+  {
+    const int p = model->pointOfSource ()[i];
+    ASSERT_GE (p, 0);
+    sums[static_cast<std::size_t> (p)] += (*a)[i].getVector3fMap ().cast<double> ();
+    ++counts[static_cast<std::size_t> (p)];
+  }
+  const ProbabilisticBVH& bvh = model->hierarchy ();
+  double worst = 0.0;
+  double radius = 0.0;  // the largest distance of a member from its merged point
+  for (std::size_t j = 0; j < model->size (); ++j)
+    worst = std::max (worst, (bvh.means ()[j] + model->origin () - sums[j] / counts[j]).norm ());
+  for (std::size_t i = 0; i < a->size (); ++i)
+  {
+    const auto j = static_cast<std::size_t> (model->pointOfSource ()[i]);
+    radius = std::max (radius, (bvh.means ()[j] + model->origin () - (*a)[i].getVector3fMap ().cast<double> ()).norm ());
+  }
+  EXPECT_LT (worst, 1e-6);
+  EXPECT_LE (radius, 2.0 * 2.0 * 0.004);  // members lie within the radius of their seed
+  // The seed a merged point names is one of its members.
+  for (std::size_t j = 0; j < model->size (); ++j)
+  {
+    const int seed = model->sourceIndex (bvh.sourceIndex (static_cast<int> (j)));
+    ASSERT_GE (seed, 0);
+    EXPECT_EQ (model->pointOfSource ()[static_cast<std::size_t> (seed)], static_cast<int> (j));
+  }
+}
+
+TEST (NoiseResolution, PerPointValuesCoverEverySampleAndTheWitnessIsOne)
+{
+  // Two noisy sheets 4 mm apart with 10 mm noise: in contact; a non-finite sample and a sample
+  // outside the indices get no value.
+  const Cloud::Ptr a = sheet (0.1, 0.004, 0.01, 7);
+  Cloud::Ptr b = sheet (0.1, 0.004, 0.01, 8, Eigen::Vector3d (0.0, 0.0, 0.004));
+  (*a)[5].x = NAN;
+  pcl::Indices indices;
+  for (int i = 1; i < static_cast<int> (b->size ()); ++i)
+    indices.push_back (i);  // b's first sample left out
+  const CloudModelParams params = merging (0.01, 2.0);
+  const CloudModel::ConstPtr ma = buildCloudModel (*a, params, nullptr, nullptr, "a");
+  const CloudModel::ConstPtr mb = buildCloudModel (*b, params, &indices, nullptr, "b");
+  ASSERT_GT (ma->mergedSamples (), 0u);
+  EXPECT_EQ (ma->skippedPoints (), 1u);
+  CollisionRequest request;
+  request.per_point = true;
+  request.exhaustive = true;
+  CollisionResult r;
+  ASSERT_TRUE (collide (*ma, *mb, Eigen::Isometry3d::Identity (), request, r)) << r.message;
+  EXPECT_GT (r.probability, 0.5);
+  ASSERT_EQ (r.probabilities_a.size (), a->size ());
+  ASSERT_EQ (r.probabilities_b.size (), b->size ());
+  EXPECT_TRUE (std::isnan (r.probabilities_a[5]));
+  EXPECT_TRUE (std::isnan (r.probabilities_b[0]));
+  std::size_t reached = 0;
+  for (std::size_t i = 0; i < a->size (); ++i)
+  {
+    const int p = ma->pointOfSource ()[i];
+    if (i == 5)
+    {
+      EXPECT_EQ (p, -1);
+      continue;
+    }
+    ASSERT_GE (p, 0);
+    reached += std::isnan (r.probabilities_a[i]) ? 0 : 1;
+    // Every member reports its merged point's value: the seed's.
+    const int seed = ma->sourceIndex (ma->hierarchy ().sourceIndex (p));
+    const float v = r.probabilities_a[i], s = r.probabilities_a[static_cast<std::size_t> (seed)];
+    EXPECT_TRUE ((std::isnan (v) && std::isnan (s)) || v == s) << i;
+  }
+  EXPECT_GT (reached, a->size () / 2);
+  // The witness is a sample of the caller's cloud that stands in the model.
+  ASSERT_NE (r.witness_side, 0);
+  const CloudModel& witness_model = r.witness_side > 0 ? *ma : *mb;
+  ASSERT_GE (r.witness_index, 0);
+  ASSERT_LT (static_cast<std::size_t> (r.witness_index), witness_model.sourceSize ());
+  EXPECT_GE (witness_model.pointOfSource ()[static_cast<std::size_t> (r.witness_index)], 0);
+}
+
+TEST (NoiseResolution, DeterministicAndInvariantUnderRigidMotion)
+{
+  const Cloud::Ptr a = randomSquare (3000, 0.3, 0.006, 9);
+  const CloudModelParams params = merging (0.006, 1.5);
+  const CloudModel::ConstPtr first = buildCloudModel (*a, params);
+  const CloudModel::ConstPtr again = buildCloudModel (*a, params);
+  ASSERT_GT (first->mergedSamples (), 0u);
+  EXPECT_EQ (first->pointOfSource (), again->pointOfSource ());
+  EXPECT_EQ (first->hierarchy ().means (), again->hierarchy ().means ());
+  // The clusters grow from samples in input order by distance alone: a turned and moved cloud
+  // merges the same samples together (up to float rounding at exact ties, none here).
+  Cloud turned;
+  Eigen::Affine3f T = Eigen::Affine3f::Identity ();
+  T.translate (Eigen::Vector3f (0.3f, -0.2f, 0.1f));
+  T.rotate (Eigen::AngleAxisf (0.7f, Eigen::Vector3f (1.0f, 2.0f, 3.0f).normalized ()));
+  pcl::transformPointCloud (*a, turned, T);
+  const CloudModel::ConstPtr moved = buildCloudModel (turned, params);
+  EXPECT_EQ (moved->size (), first->size ());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a->size (); ++i)
+    differ += moved->pointOfSource ()[i] != first->pointOfSource ()[i] ? 1 : 0;
+  EXPECT_LE (differ, a->size () / 100);
+}

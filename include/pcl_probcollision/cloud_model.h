@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -93,8 +94,27 @@ public:
   /** \brief The oriented surface (METHOD.md 10a), in the local frame; empty() when built
     * with CloudModelParams::surface off. */
   const SurfaceModel& surface () const { return surface_; }
-  /** \brief Memory held in bytes (the hierarchy, its points and the surface model). */
-  std::size_t bytes () const { return bvh_.bytes () + surface_.bytes (); }
+  /** \brief Memory held in bytes (the hierarchy, its points, the surface model and the map of
+    * merged samples). */
+  std::size_t bytes () const
+  {
+    return bvh_.bytes () + surface_.bytes () + (point_of_source_.capacity () + representatives_.capacity ()) * sizeof (int);
+  }
+  /** \brief Samples merged into another (CloudModelParams::noise_resolution): the finite
+    * samples in the model minus size(); 0 when none merged. */
+  std::size_t mergedSamples () const { return merged_samples_; }
+  /** \brief When samples were merged: per index of the caller's cloud, the model point (index
+    * into hierarchy().means()) that stands for it, -1 when none does (non-finite, outside the
+    * indices). Empty when none merged: point j then stands for hierarchy().sourceIndex(j) alone. */
+  const std::vector<int>& pointOfSource () const { return point_of_source_; }
+  /** \brief The caller's index of the sample a model point's hierarchy source index names:
+    * hierarchy().sourceIndex(j) itself when none merged, else the index of the sample its
+    * merge was seeded from. */
+  int sourceIndex (int hierarchy_source) const
+  {
+    return representatives_.empty () || hierarchy_source < 0 ? hierarchy_source
+                                                             : representatives_[static_cast<std::size_t> (hierarchy_source)];
+  }
   /** \brief A warning about the input, empty when there is none: today, coordinates so far
     * from the origin that their float spacing exceeds a tenth of the points' typical standard
     * deviation (the input itself has then lost precision; the model cannot restore it).
@@ -119,6 +139,10 @@ private:
   buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
                    const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
                    const std::string& name);
+  /** \brief Takes a model built from a merged cloud (impl/resolution.hpp) back to the caller's
+    * cloud: cluster_of maps its indices to merged points, seeds the merged points to its indices. */
+  void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
+                   const std::vector<int>& cluster_of, std::vector<int>&& seeds);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
   void assessPrecision (double max_abs_coordinate, const std::string& name);
 
@@ -131,6 +155,9 @@ private:
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero ();
   std::size_t source_size_ = 0;
   std::size_t skipped_ = 0;
+  std::size_t merged_samples_ = 0;
+  std::vector<int> point_of_source_;
+  std::vector<int> representatives_;
   CloudModelParams params_;
   double build_ms_ = 0.0;
   double precision_ratio_ = 0.0;

@@ -59,6 +59,13 @@ struct CloudModelParams
   bool surface = false;
   /** \brief How the surface's normals are oriented. Default Auto. */
   NormalOrientation orientation = NormalOrientation::Auto;
+  /** \brief Resolution tied to the noise (issue #17): samples closer than noise_resolution
+    * times the sensor noise's smallest standard deviation (at the sample seeding a merge, see
+    * detail::noiseClusters) are merged into one sample at their centroid, whose covariance is
+    * then estimated at the merged spacing; every merged sample reports its merged point's
+    * per-point values. In noise standard deviations, >= 0; 0 (default) merges nothing. No
+    * effect without a noise model (noise None) or with covariances given by the caller. */
+  double noise_resolution = 0.0;
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
   /** \brief Threads of the build (covariance estimation and hierarchy): 0 = one per hardware

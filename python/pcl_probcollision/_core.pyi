@@ -58,6 +58,8 @@ class CloudModelParams:
     split: str
     surface: bool
     orientation: NormalOrientation
+    noise_resolution: float
+    threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
                  k_sigma: float = ..., surface: bool = False,

@@ -4,6 +4,7 @@
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/detail/input_checks.h>
+#include <pcl_probcollision/impl/resolution.hpp>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/point_types.h>
@@ -60,6 +61,23 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       throw pcl::BadArgumentException (err.str ());
     }
     max_abs = std::max (max_abs, m);
+  }
+
+  // Samples closer than their noise, merged (CloudModelParams::noise_resolution): the model of
+  // the merged cloud, mapped back to every sample of this one.
+  if (params.noise_resolution > 0.0 && !covariances)
+  {
+    pcl::PointCloud<PointT> merged;
+    std::vector<int> cluster_of, seeds;
+    if (detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution, merged, cluster_of, seeds))
+    {
+      CloudModelParams once = params;
+      once.noise_resolution = 0.0;
+      const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
+      model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
+      model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+      return model;
+    }
   }
 
   // Estimate what the caller did not give: covariances, neighbour radii (area weights) and the

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#pragma once
+
+#include <pcl_probcollision/detail/resolution.h>
+#include <pcl_probcollision/sensor_noise.h>
+
+#include <pcl/common/point_tests.h>
+#include <pcl/point_cloud.h>
+#include <pcl/type_traits.h>
+#include <pcl/types.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief Merges the samples of a cloud that lie closer than factor times their sensor noise
+  * (CloudModelParams::noise_resolution; clusters by noiseClusters(), each seed's radius factor
+  * times the smallest standard deviation of noise's covariance there, the normal unknown).
+  * \param[in] cloud, indices the samples (non-finite ones are left out)
+  * \param[in] noise the sensor noise model (None merges nothing)
+  * \param[in] factor merge radius in noise standard deviations (> 0)
+  * \param[out] merged one point per cluster: the seed's fields, at the members' centroid, with
+  *             the members' mean normal for point types with normals; the cloud's viewpoint
+  * \param[out] cluster_of per index of cloud, its merged point (-1 when not a sample)
+  * \param[out] seeds per merged point, the index in cloud of its seed
+  * \return false, leaving the outputs unspecified, when no two samples merged */
+template <typename PointT>
+bool
+mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices, const SensorNoiseModel& noise,
+              double factor, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds)
+{
+  if (noise.type () == SensorNoiseModel::Type::None || !(factor > 0.0))
+    return false;
+  const std::size_t n = indices ? indices->size () : cloud.size ();
+  std::vector<int> source;
+  std::vector<Eigen::Vector3f> positions;
+  source.reserve (n);
+  positions.reserve (n);
+  for (std::size_t j = 0; j < n; ++j)
+  {
+    const int i = indices ? (*indices)[j] : static_cast<int> (j);
+    if (pcl::isXYZFinite (cloud[i]))
+    {
+      source.push_back (i);
+      positions.push_back (cloud[i].getVector3fMap ());
+    }
+  }
+  const SensorPose sensor = SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_);
+  std::vector<float> radii (positions.size (), 0.0f);
+  for (std::size_t p = 0; p < positions.size (); ++p)
+  {
+    const Eigen::Matrix3d sigma = noise.covariance (positions[p].cast<double> (), Eigen::Vector3d::Zero (), sensor);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect (sigma, Eigen::EigenvaluesOnly);
+    const double smallest = eig.eigenvalues ()(0);
+    radii[p] = std::isfinite (smallest) ? static_cast<float> (factor * std::sqrt (std::max (0.0, smallest))) : 0.0f;
+  }
+  const NoiseClusters clusters = noiseClusters (positions, radii);
+  if (!clusters.merged ())
+    return false;
+
+  const std::size_t m = clusters.seeds.size ();
+  std::vector<Eigen::Vector3d> sums (m, Eigen::Vector3d::Zero ());  // about the seed, for precision
+  std::vector<Eigen::Vector3f> normals (m, Eigen::Vector3f::Zero ());
+  std::vector<int> counts (m, 0);
+  cluster_of.assign (cloud.size (), -1);
+  for (std::size_t p = 0; p < positions.size (); ++p)
+  {
+    const int c = clusters.cluster_of[p];
+    const std::size_t cu = static_cast<std::size_t> (c);
+    cluster_of[static_cast<std::size_t> (source[p])] = c;
+    sums[cu] += (positions[p] - positions[static_cast<std::size_t> (clusters.seeds[cu])]).template cast<double> ();
+    ++counts[cu];
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+    {
+      const PointT& pt = cloud[source[p]];
+      const Eigen::Vector3f nrm (pt.normal_x, pt.normal_y, pt.normal_z);
+      if (nrm.allFinite ())
+        normals[cu] += nrm;
+    }
+  }
+  merged.clear ();
+  merged.resize (m);
+  merged.width = static_cast<std::uint32_t> (m);
+  merged.height = 1;
+  merged.is_dense = true;
+  merged.header = cloud.header;
+  merged.sensor_origin_ = cloud.sensor_origin_;
+  merged.sensor_orientation_ = cloud.sensor_orientation_;
+  seeds.resize (m);
+  for (std::size_t c = 0; c < m; ++c)
+  {
+    const std::size_t seed = static_cast<std::size_t> (clusters.seeds[c]);
+    seeds[c] = source[seed];
+    PointT pt = cloud[source[seed]];
+    pt.getVector3fMap () = (positions[seed].template cast<double> () + sums[c] / counts[c]).template cast<float> ();
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+    {
+      // The members' mean normal; a cluster whose normals cancel (both faces of a thin sheet)
+      // keeps its seed's.
+      const float norm = normals[c].norm ();
+      if (norm > 1e-3f * counts[c])
+      {
+        pt.normal_x = normals[c].x () / norm;
+        pt.normal_y = normals[c].y () / norm;
+        pt.normal_z = normals[c].z () / norm;
+      }
+    }
+    merged[c] = pt;
+  }
+  return true;
+}
+} // namespace detail
+} // namespace pcl_probcollision
