@@ -574,6 +574,26 @@ TEST (CovarianceEstimation, AnyThreadCountGivesTheOneThreadOutput)
     EXPECT_EQ (finite, cloud->size () - 17u);  // every 97th point is NaN
     EXPECT_EQ (est.getNeighbours (), one.getNeighbours ());
   }
+  // With indices: the order computed beside the k-d tree's build follows them.
+  pcl::IndicesPtr some (new pcl::Indices);
+  for (std::size_t i = 0; i < cloud->size (); i += 3)
+    some->push_back (static_cast<int> ((i * 7) % cloud->size ()));
+  pcl::PointCloud<Covariance> by_indices[2];
+  for (const int threads : {1, 2})
+  {
+    CovarianceEstimation<pcl::PointXYZ> est;
+    est.setInputCloud (cloud);
+    est.setIndices (some);
+    est.setSensorNoise (SensorNoiseModel::isotropic (0.002));
+    est.setNumberOfThreads (threads);
+    est.compute (by_indices[threads - 1]);
+  }
+  ASSERT_EQ (by_indices[0].size (), some->size ());
+  ASSERT_EQ (by_indices[1].size (), some->size ());
+  for (std::size_t i = 0; i < some->size (); ++i)
+    EXPECT_TRUE (by_indices[0][i].matrix () == by_indices[1][i].matrix () ||
+                 (!by_indices[0][i].isFinite () && !by_indices[1][i].isFinite ()))
+        << i;
   CovarianceEstimation<pcl::PointXYZ> est;
   EXPECT_THROW (est.setNumberOfThreads (-1), pcl::BadArgumentException);
 }

@@ -146,6 +146,10 @@ private:
   std::vector<Eigen::Vector3f> normals_;
   std::vector<int> neighbours_;
   int threads_ = 1;
+  /** \brief The threads compute() runs on (see setNumberOfThreads). */
+  std::size_t threadCount () const;
+  /** \brief The visiting order, when initCompute computed it beside the k-d tree's build. */
+  std::vector<std::size_t> order_;
 };
 } // namespace pcl_probcollision
 
