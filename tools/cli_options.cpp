@@ -482,8 +482,9 @@ helpText ()
        "                  '#' comments and blank lines allowed; hierarchies are built once\n"
        "  -threads N      = "
     << D::threads
-    << "       worker threads answering -poses (0: one per hardware thread); answers\n"
-       "                  stream in pose order and are the same whatever N (timings aside)\n"
+    << "       threads building the models and answering -poses (0: one per hardware\n"
+       "                  thread); answers stream in pose order and are the same whatever N\n"
+       "                  (timings aside)\n"
        "\n"
        "Uncertainty (mesh inputs are exact: zero covariance, no noise):\n"
        "  -sensor isotropic|kinect|stereo|lidar|none   = "

@@ -52,8 +52,8 @@ struct Defaults
   /** \brief Mesh spacing when both inputs are meshes: this fraction of the larger bounding-box
     * diagonal. */
   static constexpr double mesh_spacing_fraction = 0.01;
-  /** \brief -threads: one worker per hardware thread (collideBatch's 0). */
-  static constexpr int threads = 0;
+  /** \brief -threads: one worker per hardware thread (CloudModelParams's and collideBatch's 0). */
+  static inline const int threads = model.threads;
   /** \brief Seed of the mesh surface sampling (fixed; -seed does not change it). */
   static constexpr std::uint64_t mesh_sampling_seed = 20111;
 };
@@ -67,8 +67,8 @@ struct Options
   std::optional<Pose> pose;
   /** \brief -poses FILE (batch mode). */
   std::optional<std::string> poses_file;
-  /** \brief -threads N: worker threads answering the poses, >= 0, 0 = one per hardware thread.
-    * The output is the same whatever N (timings aside). */
+  /** \brief -threads N: threads of the build (covariances, hierarchies) and of the poses, >= 0,
+    * 0 = one per hardware thread. The output is the same whatever N (timings aside). */
   int threads = Defaults::threads;
 
   /** \brief Sensor noise model of each input: none, isotropic, kinect, stereo, lidar; -sensor

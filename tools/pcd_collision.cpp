@@ -253,6 +253,7 @@ modelParamsFor (const Options& o)
   m.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
   m.hierarchy.sigma_max = o.sigma_max;
   m.hierarchy.epsilon = o.epsilon;
+  m.threads = o.threads;
   return m;
 }
 
