@@ -10,8 +10,8 @@
 // of the noisy room cloud at 2 sigma resolution (what MoveIt does), and FCL on the exact meshes.
 //
 // Benchmarks (the figures are counters; nothing is asserted):
-//   BM_Build/N          covariance estimation + hierarchy of the room sampled to N points (mean
-//                       over the iterations; bytes per point of the built hierarchy)
+//   BM_Build/N/T        covariance estimation + hierarchy of the room sampled to N points on T
+//                       threads (mean over the iterations; bytes per point of the built hierarchy)
 //   BM_Covariances/N, BM_Hierarchy/N   the two parts alone
 //   BM_Query/near:0     per-pose times (median, p99) of ours, the octomap and exact FCL on the
 //   BM_Query/near:1     uniform (0) or near-contact (1) poses, with our accuracy on the same poses
@@ -174,6 +174,7 @@ BM_Build (benchmark::State& state)
   const CloudXYZ::Ptr room = noisySamples (w.env_mesh, target, w.sigma, 805);
   CloudModelParams params;
   params.noise = SensorNoiseModel::isotropic (w.sigma);
+  params.threads = static_cast<int> (state.range (1));
   double ms = 0.0;  // summed over the iterations
   double hierarchy_ms = 0.0;
   std::size_t bytes = 0, stored = 0, nodes = 0;
@@ -191,6 +192,7 @@ BM_Build (benchmark::State& state)
   ms /= runs;
   hierarchy_ms /= runs;
   state.counters["points"] = n;
+  state.counters["threads"] = static_cast<double> (params.threads);
   state.counters["build_ms"] = ms;
   state.counters["ms_per_10k_points"] = ms / n * 1e4;
   state.counters["hierarchy_ms"] = hierarchy_ms;
@@ -198,9 +200,10 @@ BM_Build (benchmark::State& state)
   state.counters["stored_per_point"] = static_cast<double> (stored) / n;
   state.counters["nodes"] = static_cast<double> (nodes);
 }
-BENCHMARK (BM_Build)->Arg (10000)->Unit (benchmark::kMillisecond)->Iterations (20);
-BENCHMARK (BM_Build)->Arg (100000)->Unit (benchmark::kMillisecond)->Iterations (3);
-BENCHMARK (BM_Build)->Arg (1000000)->Unit (benchmark::kMillisecond)->Iterations (1);
+// One thread (the targets are per core), then two (CloudModelParams::threads; the same model).
+BENCHMARK (BM_Build)->Args ({10000, 1})->Args ({10000, 2})->Unit (benchmark::kMillisecond)->Iterations (20);
+BENCHMARK (BM_Build)->Args ({100000, 1})->Args ({100000, 2})->Unit (benchmark::kMillisecond)->Iterations (3);
+BENCHMARK (BM_Build)->Args ({1000000, 1})->Args ({1000000, 2})->Unit (benchmark::kMillisecond)->Iterations (1);
 
 /** \brief The covariance estimation alone, as ProbabilisticCollision runs it (k = 10, the
   * isotropic sensor noise, surface projection on). */
