@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Manual measurement of issue #7 (docs/RELIABILITY.md, "5,000,000-point cloud"): pcd_collision
+# Manual measurement of issues #7 and #17 (docs/RELIABILITY.md, "5,000,000-point cloud"): pcd_collision
 # with a 5,000,000-point cloud against the small demo objects, under /usr/bin/time -v (wall time,
 # peak RSS). Not part of CI: it takes minutes and about 2 GB (see the figures in the doc).
 #
@@ -39,8 +39,10 @@ measure () {  # label, pcd_collision arguments...
   /usr/bin/time -v "$exe" "$@" 2> "$work/time.txt" | tee "$work/out.txt"
   grep -E "Elapsed \(wall clock\)|Maximum resident set size|Exit status" "$work/time.txt"
 }
-# The gripper mesh (sampled at the cloud's 2 mm spacing) in three poses, hierarchies built once.
+# The gripper mesh (sampled at the cloud's 2 mm spacing) in three poses, hierarchies built once:
+# on every core (the default), then on one.
 measure "gripper vs 5M floor" data/gripper.obj "$cloud" -poses data/demo_poses.txt -json
+measure "gripper vs 5M floor, one thread" data/gripper.obj "$cloud" -poses data/demo_poses.txt -json -threads 1
 # A 10,848-point cloud (table and mug), moved 1 m sideways so that the mug stands on the floor.
 measure "table_mug vs 5M floor" data/table_mug.pcd "$cloud" -pose 1,0,0.0005,0,0,0 -json
 # The big cloud moved instead of the small one, with the per-point output of all 5,010,848 points.
