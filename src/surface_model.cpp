@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/surface_model.h>
+#include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/exceptions.h>
 
@@ -124,25 +125,36 @@ private:
   std::vector<int>& component_;
   std::priority_queue<std::tuple<float, int, int>> queue_;
 };
+/** \brief fn(i) for every point i < n, in chunks on `workers` threads; fn writes only slot i. */
+template <typename Fn>
+void
+forEachPoint (std::size_t n, std::size_t workers, Fn&& fn)
+{
+  constexpr std::size_t kChunk = 4096;
+  detail::parallelFor ((n + kChunk - 1) / kChunk, workers, [&] (std::size_t c, std::size_t) {
+    for (std::size_t i = c * kChunk; i < std::min (n, (c + 1) * kChunk); ++i)
+      fn (i);
+  });
+}
+
 /** \brief Bilateral smoothing of oriented normals over the neighbour graph: each normal
   * becomes the mean of its own and its neighbours' that lie within kSmoothCosine of it (the
   * same face), kSmoothPasses times. A plane fitted to k noisy neighbours tilts by about
   * sigma / spacing; averaging the normals of one face cuts that without rounding its edges. */
 void
-smoothNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals)
+smoothNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals, std::size_t workers)
 {
   constexpr int kSmoothPasses = 2;
   constexpr float kSmoothCosine = 0.7071f;
   std::vector<Eigen::Vector3f> next (normals.size ());
   for (int pass = 0; pass < kSmoothPasses; ++pass)
   {
-    for (std::size_t i = 0; i < normals.size (); ++i)
-    {
+    forEachPoint (normals.size (), workers, [&] (std::size_t i) {
       const Eigen::Vector3f& n = normals[i];
       if (n.isZero ())
       {
         next[i] = n;
-        continue;
+        return;
       }
       Eigen::Vector3f sum = n;
       for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
@@ -152,7 +164,7 @@ smoothNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals)
           sum += m;
       }
       next[i] = sum.normalized ();
-    }
+    });
     normals.swap (next);
   }
 }
@@ -179,12 +191,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   spacing_.resize (n);
   const double scale = std::sqrt (kPi / in.k);
   const std::size_t k = static_cast<std::size_t> (in.k);
-  for (std::size_t i = 0; i < n; ++i)
-  {
+  const std::size_t workers = detail::threadCount (in.threads);
+  forEachPoint (n, workers, [&] (std::size_t i) {
     if (!std::isfinite (in.radii[i]))
     {
       spacing_[i] = 0.0f;
-      continue;
+      return;
     }
     double s = in.radii[i] * scale;
     // On a strip narrower than the neighbourhood (a board's edge, a leg, a thin rim) the k
@@ -215,7 +227,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       s = std::min (s, std::sqrt (area / static_cast<double> (count)));
     }
     spacing_[i] = static_cast<float> (s);
-  }
+  });
   {
     std::vector<float> sorted (spacing_);
     std::sort (sorted.begin (), sorted.end ());
@@ -342,7 +354,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       if (component[i] > 0 && volume[static_cast<std::size_t> (component[i])] < 0.0)
         normals_[i] = -normals_[i];
   }
-  smoothNormals (graph, normals_);
+  smoothNormals (graph, normals_, workers);
   unoriented_ = 0;
   propagated_ = 0;
   for (std::size_t i = 0; i < n; ++i)

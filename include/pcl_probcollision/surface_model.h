@@ -44,6 +44,9 @@ public:
     int k = 0;
     /** \brief The sensor origin in the local frame, when the cloud has one. */
     std::optional<Eigen::Vector3d> viewpoint;
+    /** \brief Threads of the per-point passes (CloudModelParams::threads: 0 = every core);
+      * the model is the same for any count. */
+    int threads = 1;
   };
 
   /** \brief One node's dipole: the area-weighted centre of its points, the sum of their

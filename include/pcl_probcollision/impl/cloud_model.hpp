@@ -167,6 +167,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     for (std::size_t p = 0; p < m; ++p)
       model_of[static_cast<std::size_t> (at (kept_slots[p]))] = static_cast<int> (p);
     in.k = params.k;
+    in.threads = params.threads;
     in.normals.resize (m);
     in.radii.resize (m);
     in.neighbours.assign (m * k, -1);
