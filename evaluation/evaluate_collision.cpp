@@ -19,7 +19,7 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--noise P,P,...] [--merge C,C,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...]
 //
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
@@ -76,6 +76,12 @@ struct Options
   /** \brief CloudModelParams::noise_resolution of the "merge<c>" and "surface-merge<c>"
     * settings (issue #17 item 1), one pair per value; empty leaves them out. */
   std::vector<double> merge {2.0};
+  /** \brief The same merge gated by the local spacing ("gate<c>", "surface-gate<c>"); empty
+    * (default) leaves them out. */
+  std::vector<double> gate;
+  /** \brief --only: the settings of ours run in the W1 cells (empty: all); the stability
+    * passes and the other workloads are not filtered. */
+  std::vector<std::string> only;
 };
 
 double
@@ -408,8 +414,10 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
-  for (const OursSetting& s : oursSettings (!o.quick && dense && pct == 0.5, o.merge))
+  for (const OursSetting& s : oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate))
   {
+    if (!o.only.empty () && std::find (o.only.begin (), o.only.end (), s.name) == o.only.end ())
+      continue;
     BuildRow b = buildRow ("ours", s.name);
     double leaf_pairs = 0, kernel = 0, features = 0, n = 0;
     const PoseQuery q = buildOurs (rob, env, sigma, s, b, [&] (std::size_t lp, std::size_t k, double f) {
@@ -1319,10 +1327,25 @@ parse (int argc, char** argv)
         if (std::stod (item) > 0.0)
           o.merge.push_back (std::stod (item));
     }
+    else if (a == "--gate")
+    {
+      std::stringstream list (value ());
+      std::string item;
+      while (std::getline (list, item, ','))
+        if (std::stod (item) > 0.0)
+          o.gate.push_back (std::stod (item));
+    }
+    else if (a == "--only")
+    {
+      std::stringstream list (value ());
+      std::string item;
+      while (std::getline (list, item, ','))
+        o.only.push_back (item);
+    }
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");
