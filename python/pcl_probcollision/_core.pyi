@@ -59,6 +59,8 @@ class CloudModelParams:
     surface: bool
     orientation: NormalOrientation
     noise_resolution: float
+    noise_resolution_gated: bool
+    noise_resolution_spread: bool
     threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
