@@ -19,7 +19,7 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...] [--gate-spread C,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...]
 //
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
@@ -85,8 +85,6 @@ struct Options
   /** \brief --drop: controls "drop<f>", the separators on clouds with f % of the samples left
     * out at random (how much the answers move for a model change unrelated to the noise). */
   std::vector<double> drop;
-  /** \brief --gate-spread: "gatespread<c>", the gated merge with noise_resolution_spread. */
-  std::vector<double> gate_spread;
 };
 
 double
@@ -430,20 +428,6 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
     d.name = name.str ();
     d.request.surface = false;
     d.model.surface = false;
-    settings.push_back (d);
-  }
-  for (const double c : o.gate_spread)
-  {
-    // The gated merge with the members' scatter added to each merged covariance.
-    std::ostringstream name;
-    name << "gatespread" << c;
-    OursSetting d = settings.front ();
-    d.name = name.str ();
-    d.request.surface = false;
-    d.model.surface = false;
-    d.model.noise_resolution = c;
-    d.model.noise_resolution_gate = pcl_probcollision::CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
-    d.model.noise_resolution_spread = true;
     settings.push_back (d);
   }
   auto dropped = [&] (const CloudXYZ::ConstPtr& c, double f, std::uint64_t seed) -> CloudXYZ::ConstPtr {
@@ -1379,13 +1363,6 @@ parse (int argc, char** argv)
         if (std::stod (item) > 0.0)
           o.gate.push_back (std::stod (item));
     }
-    else if (a == "--gate-spread")
-    {
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        o.gate_spread.push_back (std::stod (item));
-    }
     else if (a == "--drop")
     {
       std::stringstream list (value ());
@@ -1403,7 +1380,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...] [--gate-spread C,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

@@ -749,8 +749,6 @@ PYBIND11_MODULE (_core, m)
                      },
                      "Merge (noise_resolution) only samples whose local spacing is at most their noise sigma\n"
                      "(ResolutionGate.WhereNoiseExceedsSpacing; default False: Everywhere).")
-      .def_readwrite ("noise_resolution_spread", &CloudModelParams::noise_resolution_spread,
-                      "Add the merged samples' scatter to a merged covariance (default False).")
       .def_readwrite ("threads", &CloudModelParams::threads,
                       "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
                       "hardware thread. The model is the same for any count.")

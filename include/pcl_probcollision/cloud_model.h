@@ -41,18 +41,6 @@ std::shared_ptr<const CloudModel>
 buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params = CloudModelParams (),
                  const pcl::Indices* indices = nullptr, const pcl::PointCloud<Covariance>* covariances = nullptr,
                  const std::string& name = "cloud");
-
-namespace detail
-{
-/** \brief buildCloudModel() with, per point of cloud (indices must be null), a spread added to
-  * its estimated covariance (the members' scatter of a merged sample,
-  * CloudModelParams::noise_resolution_spread); spreads null adds nothing. */
-template <typename PointT>
-std::shared_ptr<const CloudModel>
-buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
-                           const pcl::PointCloud<Covariance>* covariances, const std::string& name,
-                           const std::vector<Eigen::Matrix3d>* spreads);
-} // namespace detail
 /** \brief The model of one object known from a point cloud: its uncertain points (one
   * Gaussian each) and their epsilon-overlap hierarchy, built once and then immutable.
   *
@@ -148,9 +136,9 @@ private:
 
   template <typename PointT>
   friend std::shared_ptr<const CloudModel>
-  detail::buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
-                                     const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
-                                     const std::string& name, const std::vector<Eigen::Matrix3d>* spreads);
+  buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
+                   const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
+                   const std::string& name);
   /** \brief Takes a model built from a merged cloud (impl/resolution.hpp) back to the caller's
     * cloud: cluster_of maps its indices to merged points, seeds the merged points to its indices. */
   void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,

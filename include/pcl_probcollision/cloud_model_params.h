@@ -79,10 +79,6 @@ struct CloudModelParams
     WhereNoiseExceedsSpacing
   };
   ResolutionGate noise_resolution_gate = ResolutionGate::Everywhere;
-  /** \brief A merged sample's covariance also gets its members' scatter about their centroid
-    * (the spread of the samples it stands for), so a merge that pulls a convex detail inward
-    * keeps the detail's extent in its Gaussian. Default off. */
-  bool noise_resolution_spread = false;
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
   /** \brief Threads of the build (covariance estimation and hierarchy): 0 = one per hardware

@@ -26,17 +26,6 @@ std::shared_ptr<const CloudModel>
 buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
                  const pcl::PointCloud<Covariance>* covariances, const std::string& name)
 {
-  return detail::buildCloudModelWithSpread (cloud, params, indices, covariances, name, nullptr);
-}
-
-namespace detail
-{
-template <typename PointT>
-std::shared_ptr<const CloudModel>
-buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
-                           const pcl::PointCloud<Covariance>* covariances, const std::string& name,
-                           const std::vector<Eigen::Matrix3d>* spreads)
-{
   const auto start = std::chrono::steady_clock::now ();
   params.validate ();
   std::ostringstream err;
@@ -80,17 +69,15 @@ buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudMode
   {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    std::vector<Eigen::Matrix3d> spread;
     if (detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution,
                               params.noise_resolution_gate == CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing
                                   ? params.k
                                   : 0,
-                              merged, cluster_of, seeds, params.noise_resolution_spread ? &spread : nullptr))
+                              merged, cluster_of, seeds))
     {
       CloudModelParams once = params;
       once.noise_resolution = 0.0;
-      const auto model = std::const_pointer_cast<CloudModel> (buildCloudModelWithSpread (
-          merged, once, nullptr, nullptr, name, params.noise_resolution_spread ? &spread : nullptr));
+      const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
       model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
       model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
       return model;
@@ -153,8 +140,6 @@ buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudMode
     if (!displacements.empty ())
       points.means.back () += displacements[j];
     points.covariances.push_back (c.matrix ());
-    if (spreads && !covariances)
-      points.covariances.back () += (*spreads)[static_cast<std::size_t> (i)];
     points.source_indices.push_back (i);
     if (!radii.empty () && !covariances)
       points.area_weights.push_back (static_cast<double> (radii[j]) * radii[j]);
@@ -227,7 +212,6 @@ buildCloudModelWithSpread (const pcl::PointCloud<PointT>& cloud, const CloudMode
     PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", model->warning_.c_str ());
   return model;
 }
-} // namespace detail
 } // namespace pcl_probcollision
 
 #define PCL_INSTANTIATE_buildCloudModel(T)                                                                   \

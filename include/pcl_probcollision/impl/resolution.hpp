@@ -32,14 +32,11 @@ namespace detail
   *             the members' mean normal for point types with normals; the cloud's viewpoint
   * \param[out] cluster_of per index of cloud, its merged point (-1 when not a sample)
   * \param[out] seeds per merged point, the index in cloud of its seed
-  * \param[out] spread when given, per merged point its members' scatter about their centroid
-  *             (1/m sum (x - centroid)(x - centroid)^T; zero for a single sample)
   * \return false, leaving the outputs unspecified, when no two samples merged */
 template <typename PointT>
 bool
 mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices, const SensorNoiseModel& noise,
-              double factor, int gate_k, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds,
-              std::vector<Eigen::Matrix3d>* spread = nullptr)
+              double factor, int gate_k, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds)
 {
   if (noise.type () == SensorNoiseModel::Type::None || !(factor > 0.0))
     return false;
@@ -104,17 +101,6 @@ mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
       const Eigen::Vector3f nrm (pt.normal_x, pt.normal_y, pt.normal_z);
       if (nrm.allFinite ())
         normals[cu] += nrm;
-    }
-  }
-  if (spread)
-  {
-    spread->assign (m, Eigen::Matrix3d::Zero ());
-    for (std::size_t p = 0; p < positions.size (); ++p)
-    {
-      const std::size_t c = static_cast<std::size_t> (clusters.cluster_of[p]);
-      const Eigen::Vector3d d = (positions[p] - positions[static_cast<std::size_t> (clusters.seeds[c])]).template cast<double> () -
-                                sums[c] / counts[c];
-      (*spread)[c] += d * d.transpose () / counts[c];
     }
   }
   merged.clear ();
