@@ -405,6 +405,8 @@ merging (double sigma, double factor)
 TEST (NoiseResolution, OffByDefaultAndValidatedByName)
 {
   EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
+  // The spacing gate stays an option (docs/PERFORMANCE.md, issue #17 item 1).
+  EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::Everywhere);
   for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
   {
     CloudModelParams params;
