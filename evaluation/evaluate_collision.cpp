@@ -19,7 +19,7 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--noise P,P,...] [--merge C,C,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...]
 //
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
@@ -76,6 +76,15 @@ struct Options
   /** \brief CloudModelParams::noise_resolution of the "merge<c>" and "surface-merge<c>"
     * settings (issue #17 item 1), one pair per value; empty leaves them out. */
   std::vector<double> merge {2.0};
+  /** \brief The same merge gated by the local spacing ("gate<c>", "surface-gate<c>"); empty
+    * (default) leaves them out. */
+  std::vector<double> gate;
+  /** \brief --only: the settings of ours run in the W1 cells (empty: all); the stability
+    * passes and the other workloads are not filtered. */
+  std::vector<std::string> only;
+  /** \brief --drop: controls "drop<f>", the separators on clouds with f % of the samples left
+    * out at random (how much the answers move for a model change unrelated to the noise). */
+  std::vector<double> drop;
 };
 
 double
@@ -408,16 +417,43 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
-  for (const OursSetting& s : oursSettings (!o.quick && dense && pct == 0.5, o.merge))
+  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate);
+  for (const double f : o.drop)
   {
+    // A control for model changes that do not follow the geometry: the separators with f % of
+    // each cloud's samples left out at random (seeded by the cell), then modelled as given.
+    std::ostringstream name;
+    name << "drop" << f;
+    OursSetting d = settings.front ();
+    d.name = name.str ();
+    d.request.surface = false;
+    d.model.surface = false;
+    settings.push_back (d);
+  }
+  auto dropped = [&] (const CloudXYZ::ConstPtr& c, double f, std::uint64_t seed) -> CloudXYZ::ConstPtr {
+    std::mt19937_64 rng (seed);
+    std::uniform_real_distribution<double> u (0.0, 100.0);
+    CloudXYZ::Ptr out (new CloudXYZ);
+    for (const auto& p : *c)
+      if (!(u (rng) < f))
+        out->push_back (p);
+    return out;
+  };
+  for (const OursSetting& s : settings)
+  {
+    if (!o.only.empty () && std::find (o.only.begin (), o.only.end (), s.name) == o.only.end ())
+      continue;
     BuildRow b = buildRow ("ours", s.name);
     double leaf_pairs = 0, kernel = 0, features = 0, n = 0;
-    const PoseQuery q = buildOurs (rob, env, sigma, s, b, [&] (std::size_t lp, std::size_t k, double f) {
+    const bool drop = s.name.rfind ("drop", 0) == 0;
+    const double f = drop ? std::stod (s.name.substr (4)) : 0.0;
+    const PoseQuery q = buildOurs (drop ? dropped (rob, f, noise_seed + 7) : rob, drop ? dropped (env, f, noise_seed + 8) : env,
+                                   sigma, s, b, [&] (std::size_t lp, std::size_t k, double f) {
       leaf_pairs += lp;
       kernel += k;
       features += f;
       n += 1;
-    }, den.sides ());
+    }, drop ? ScanSides () : den.sides ());
     proto.method = "ours";
     proto.setting = s.name;
     runQueries (results, proto, cell, q);
@@ -1319,10 +1355,32 @@ parse (int argc, char** argv)
         if (std::stod (item) > 0.0)
           o.merge.push_back (std::stod (item));
     }
+    else if (a == "--gate")
+    {
+      std::stringstream list (value ());
+      std::string item;
+      while (std::getline (list, item, ','))
+        if (std::stod (item) > 0.0)
+          o.gate.push_back (std::stod (item));
+    }
+    else if (a == "--drop")
+    {
+      std::stringstream list (value ());
+      std::string item;
+      while (std::getline (list, item, ','))
+        o.drop.push_back (std::stod (item));
+    }
+    else if (a == "--only")
+    {
+      std::stringstream list (value ());
+      std::string item;
+      while (std::getline (list, item, ','))
+        o.only.push_back (item);
+    }
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

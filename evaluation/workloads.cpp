@@ -21,7 +21,7 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 std::vector<OursSetting>
-oursSettings (bool full, const std::vector<double>& merge)
+oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate)
 {
   std::vector<OursSetting> s;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
@@ -61,6 +61,22 @@ oursSettings (bool full, const std::vector<double>& merge)
     merged = surface;
     merged.name = "surface-merge" + name.str ();
     merged.model.noise_resolution = c;
+    s.push_back (merged);
+  }
+  for (const double c : gate)
+  {
+    // The same, only where the noise is at least the local sample spacing.
+    std::ostringstream name;
+    name << c;
+    OursSetting merged = classifier;
+    merged.name = "gate" + name.str ();
+    merged.model.noise_resolution = c;
+    merged.model.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
+    s.push_back (merged);
+    merged = surface;
+    merged.name = "surface-gate" + name.str ();
+    merged.model.noise_resolution = c;
+    merged.model.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
     s.push_back (merged);
   }
   if (!full)

@@ -64,8 +64,11 @@ struct OursSetting
   * surface answers as default does (the surface layer is off by default while experimental).
   * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled).
   * full = false keeps default, classifier, surface, pooled and max. Each c of merge adds "merge<c>"
-  * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c. */
-std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {});
+  * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c;
+  * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
+  * (ResolutionGate::WhereNoiseExceedsSpacing). */
+std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {},
+                                       const std::vector<double>& gate = {});
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and
   * its std (NaN when not computed, e.g. before the surface layer or with surface off) and the

@@ -739,6 +739,16 @@ PYBIND11_MODULE (_core, m)
                       "How the surface model's normals are oriented (NormalOrientation, default Auto).")
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
                       "Merge samples closer than this many sensor-noise sigmas into one (issue #17; default 0: off).")
+      .def_property ("noise_resolution_gated",
+                     [] (const CloudModelParams& p) {
+                       return p.noise_resolution_gate == CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
+                     },
+                     [] (CloudModelParams& p, bool v) {
+                       p.noise_resolution_gate = v ? CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing
+                                                   : CloudModelParams::ResolutionGate::Everywhere;
+                     },
+                     "Merge (noise_resolution) only samples whose local spacing is at most their noise sigma\n"
+                     "(ResolutionGate.WhereNoiseExceedsSpacing; default False: Everywhere).")
       .def_readwrite ("threads", &CloudModelParams::threads,
                       "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
                       "hardware thread. The model is the same for any count.")

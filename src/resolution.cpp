@@ -5,6 +5,8 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 namespace pcl_probcollision
@@ -12,7 +14,8 @@ namespace pcl_probcollision
 namespace detail
 {
 NoiseClusters
-noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii)
+noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii,
+               const std::vector<char>* eligible)
 {
   NoiseClusters out;
   const std::size_t n = positions.size ();
@@ -38,10 +41,38 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
       continue;
     tree.radiusSearch ((*cloud)[i], static_cast<double> (radii[i]), found, distances);
     for (const int j : found)
-      if (out.cluster_of[static_cast<std::size_t> (j)] < 0)
+      if (out.cluster_of[static_cast<std::size_t> (j)] < 0 && (!eligible || (*eligible)[static_cast<std::size_t> (j)]))
         out.cluster_of[static_cast<std::size_t> (j)] = cluster;
   }
   return out;
+}
+
+std::vector<float>
+localSpacing (const std::vector<Eigen::Vector3f>& positions, int k)
+{
+  const std::size_t n = positions.size ();
+  std::vector<float> spacing (n, 0.0f);
+  if (n < 2 || k < 1)
+    return spacing;
+  const auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>> ();
+  cloud->resize (n);
+  for (std::size_t i = 0; i < n; ++i)
+    (*cloud)[i].getVector3fMap () = positions[i];
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;  // sorted: the last one found is the k-th
+  tree.setInputCloud (cloud);
+  const int want = static_cast<int> (std::min<std::size_t> (static_cast<std::size_t> (k) + 1, n));
+  const double per = std::sqrt (M_PI / static_cast<double> (want - 1));  // want - 1 others found
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    // The sample itself is among those found (distance 0), so want - 1 others; duplicates of it
+    // count as neighbours at distance 0.
+    if (tree.nearestKSearch ((*cloud)[i], want, found, distances) < want)
+      continue;
+    spacing[i] = static_cast<float> (per * std::sqrt (static_cast<double> (distances.back ())));
+  }
+  return spacing;
 }
 } // namespace detail
 } // namespace pcl_probcollision

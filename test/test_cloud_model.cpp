@@ -5,6 +5,7 @@
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
 #include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/detail/resolution.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
 #include <pcl/common/transforms.h>
@@ -404,6 +405,8 @@ merging (double sigma, double factor)
 TEST (NoiseResolution, OffByDefaultAndValidatedByName)
 {
   EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
+  // The spacing gate stays an option (docs/PERFORMANCE.md, issue #17 item 1).
+  EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::Everywhere);
   for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
   {
     CloudModelParams params;
@@ -570,4 +573,136 @@ TEST (NoiseResolution, DeterministicAndInvariantUnderRigidMotion)
   for (std::size_t i = 0; i < a->size (); ++i)
     differ += moved->pointOfSource ()[i] != first->pointOfSource ()[i] ? 1 : 0;
   EXPECT_LE (differ, a->size () / 100);
+}
+
+// ---- The spacing gate (CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing) ----------
+
+namespace
+{
+CloudModelParams
+gated (double sigma, double factor)
+{
+  CloudModelParams params = merging (sigma, factor);
+  params.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
+  return params;
+}
+} // namespace
+
+TEST (NoiseResolutionGate, LocalSpacingOfAGridIsItsSpacing)
+{
+  // A 41 x 41 grid, h = 5 mm: the 10th neighbour of an inner sample is at 2 h, so its spacing
+  // is sqrt(pi / 10) * 2 h = 1.12 h; a 4 x denser grid gives a quarter of it.
+  for (const double h : {0.005, 0.00125})
+  {
+    const Cloud::Ptr a = sheet (40 * h, h, 0.0, 1);
+    std::vector<Eigen::Vector3f> positions;
+    for (const auto& p : *a)
+      positions.push_back (p.getVector3fMap ());
+    const std::vector<float> s = detail::localSpacing (positions, 10);
+    ASSERT_EQ (s.size (), positions.size ());
+    const std::size_t centre = positions.size () / 2;
+    EXPECT_NEAR (s[centre], std::sqrt (M_PI / 10.0) * 2.0 * h, 1e-3 * h);
+    for (const float v : s)
+    {
+      EXPECT_GE (v, 0.9 * h);
+      EXPECT_LE (v, 2.5 * h);  // corners see their neighbours on one side only
+    }
+  }
+  EXPECT_EQ (detail::localSpacing ({Eigen::Vector3f::Zero ()}, 10), std::vector<float> (1, 0.0f));
+}
+
+TEST (NoiseResolutionGate, MergesNothingWhereTheSpacingExceedsTheNoise)
+{
+  // 2,000 random samples on 0.2 m x 0.2 m (spacing 4.5 mm), noise 1 mm, radius 2 mm: random
+  // pairs closer than 2 mm are many, and the ungated rule merges them; the gate merges none,
+  // and the model is then the unmerged one exactly.
+  const Cloud::Ptr a = randomSquare (2000, 0.2, 0.001, 11);
+  ASSERT_GT (buildCloudModel (*a, merging (0.001, 2.0))->mergedSamples (), 100u);
+  const CloudModel::ConstPtr gate = buildCloudModel (*a, gated (0.001, 2.0));
+  const CloudModel::ConstPtr plain = buildCloudModel (*a, merging (0.001, 0.0));
+  EXPECT_EQ (gate->mergedSamples (), 0u);
+  EXPECT_EQ (gate->size (), a->size ());
+  EXPECT_TRUE (gate->pointOfSource ().empty ());
+  EXPECT_EQ (gate->hierarchy ().means (), plain->hierarchy ().means ());
+  EXPECT_EQ (gate->hierarchy ().nodes ().size (), plain->hierarchy ().nodes ().size ());
+}
+
+TEST (NoiseResolutionGate, MergesLikeTheUngatedRuleWhereTheNoiseExceedsTheSpacing)
+{
+  // Samples 5 mm apart on a plane (local spacing 5.6 mm, 7 mm at the corners), noise 10 mm:
+  // every sample passes the gate, so the clusters are the ungated rule's. (The samples lie on
+  // the plane: drawn noise thickens the sheet and widens the 3-D neighbour distances of the
+  // samples it throws farthest, which then stay unmerged; the next test has such a cloud.)
+  const Cloud::Ptr a = sheet (0.2, 0.005, 0.0, 12);
+  const CloudModel::ConstPtr gate = buildCloudModel (*a, gated (0.01, 2.0));
+  const CloudModel::ConstPtr all = buildCloudModel (*a, merging (0.01, 2.0));
+  EXPECT_LT (gate->size (), a->size () / 4);
+  EXPECT_EQ (gate->size (), all->size ());
+  EXPECT_EQ (gate->pointOfSource (), all->pointOfSource ());
+  EXPECT_EQ (gate->hierarchy ().means (), all->hierarchy ().means ());
+}
+
+TEST (NoiseResolutionGate, MergesOnlyThePartSampledDenserThanTheNoise)
+{
+  // One cloud, two patches, noise 4 mm: a 2 mm grid (merged) and, 0.5 m away, a 20 mm grid
+  // (kept sample for sample). The ungated rule at 2 sigma = 8 mm merges neither more nor less
+  // in the sparse patch (its samples are 20 mm apart), so also check a 6 sigma radius, which
+  // the gate must keep out of the sparse patch.
+  const double sigma = 0.004;
+  Cloud::Ptr a = sheet (0.1, 0.002, 0.0, 13);
+  const std::size_t dense = a->size ();
+  *a += *sheet (0.4, 0.02, 0.0, 14, Eigen::Vector3d (0.8, 0.0, 0.0));
+  for (const double factor : {2.0, 6.0})
+  {
+    const CloudModel::ConstPtr gate = buildCloudModel (*a, gated (sigma, factor));
+    ASSERT_EQ (gate->pointOfSource ().size (), a->size ());
+    std::vector<int> members (gate->size (), 0);
+    for (const int p : gate->pointOfSource ())
+      ++members[static_cast<std::size_t> (p)];
+    std::size_t dense_points = 0;
+    for (std::size_t i = 0; i < a->size (); ++i)
+    {
+      const int p = gate->pointOfSource ()[i];
+      if (i >= dense)
+        EXPECT_EQ (members[static_cast<std::size_t> (p)], 1) << "sparse sample " << i << " merged, radius " << factor;
+      else if (members[static_cast<std::size_t> (p)] > 1)
+        ++dense_points;
+    }
+    EXPECT_GT (dense_points, dense * 9 / 10) << "radius " << factor;
+    EXPECT_LT (gate->size () - (a->size () - dense), dense / 4) << "radius " << factor;
+  }
+  // Ungated at 6 sigma, the sparse patch merges too (the gate is what keeps it).
+  const CloudModel::ConstPtr all = buildCloudModel (*a, merging (sigma, 6.0));
+  std::vector<int> members (all->size (), 0);
+  for (const int p : all->pointOfSource ())
+    ++members[static_cast<std::size_t> (p)];
+  std::size_t sparse_merged = 0;
+  for (std::size_t i = dense; i < a->size (); ++i)
+    sparse_merged += members[static_cast<std::size_t> (all->pointOfSource ()[i])] > 1 ? 1 : 0;
+  EXPECT_GT (sparse_merged, 0u);
+}
+
+TEST (NoiseResolutionGate, NoisySheetMergesMostlyOnceTheNoiseIsAboveTheSpacing)
+{
+  // A 5 mm grid with its noise drawn along z: at sigma = 2 h the noisy sheet's neighbours are
+  // spread in 3-D, yet most samples pass the gate; at sigma = h / 2 almost none does.
+  const Cloud::Ptr noisy = sheet (0.2, 0.005, 0.01, 16);
+  const CloudModel::ConstPtr high = buildCloudModel (*noisy, gated (0.01, 2.0));
+  EXPECT_LT (high->size (), noisy->size () / 3);
+  const Cloud::Ptr quiet = sheet (0.2, 0.005, 0.0025, 17);
+  EXPECT_LT (buildCloudModel (*quiet, gated (0.0025, 2.0))->mergedSamples (), quiet->size () / 100);
+}
+
+TEST (NoiseResolutionGate, DeterministicAndIndependentOfThreads)
+{
+  const Cloud::Ptr a = randomSquare (4000, 0.1, 0.003, 15);  // spacing 1.6 mm, noise 3 mm
+  CloudModelParams one = gated (0.003, 2.0);
+  one.threads = 1;
+  CloudModelParams two = one;
+  two.threads = 2;
+  const CloudModel::ConstPtr x = buildCloudModel (*a, one);
+  const CloudModel::ConstPtr y = buildCloudModel (*a, two);
+  ASSERT_GT (x->mergedSamples (), 0u);
+  EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
+  EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
 }

@@ -66,6 +66,19 @@ struct CloudModelParams
     * per-point values. In noise standard deviations, >= 0; 0 (default) merges nothing. No
     * effect without a noise model (noise None) or with covariances given by the caller. */
   double noise_resolution = 0.0;
+  /** \brief Where noise_resolution merges (issue #17 item 1). Everywhere: every sample within
+    * the radius of a seed. WhereNoiseExceedsSpacing: only samples whose local spacing is at most
+    * their noise's smallest standard deviation, the spacing sqrt(pi / k) times the distance to
+    * the k-th nearest neighbour (k as above: the square root of the surface area per sample
+    * that k neighbours cover); a sample spaced wider than its noise is never merged, so a cloud
+    * sampled coarser than its noise is modelled exactly as with noise_resolution = 0. Default
+    * Everywhere (see docs/PERFORMANCE.md, issue #17 item 1). */
+  enum class ResolutionGate
+  {
+    Everywhere,
+    WhereNoiseExceedsSpacing
+  };
+  ResolutionGate noise_resolution_gate = ResolutionGate::Everywhere;
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
   /** \brief Threads of the build (covariance estimation and hierarchy): 0 = one per hardware

@@ -59,6 +59,7 @@ class CloudModelParams:
     surface: bool
     orientation: NormalOrientation
     noise_resolution: float
+    noise_resolution_gated: bool
     threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,

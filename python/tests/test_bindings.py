@@ -58,6 +58,10 @@ def test_defaults_are_the_cpp_defaults():
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
     assert p.surface is False and p.orientation == pc.NormalOrientation.Auto
     assert p.noise_resolution == 0.0
+    assert p.noise_resolution_gated is False
+    p.noise_resolution_gated = True
+    assert p.noise_resolution_gated is True
+    p.noise_resolution_gated = False
     assert p.threads == 0
     assert [o.name for o in pc.NormalOrientation.__members__.values()] == ["Auto", "PointNormals", "Viewpoint", "Propagate"]
     assert p.noise.name == pc.SensorNoiseModel.none().name

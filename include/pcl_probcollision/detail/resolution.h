@@ -28,8 +28,22 @@ struct NoiseClusters
   * and invariant under rigid motion of the samples.
   * \param[in] positions the samples (finite)
   * \param[in] radii per sample, the merge radius when it seeds a cluster (0: it merges nothing)
+  * \param[in] eligible per sample, whether it may join another's cluster (nullptr: every one;
+  *            CloudModelParams::ResolutionGate). A sample not eligible should have radius 0.
   * \return the clusters; cluster_of is empty only for no sample */
 NoiseClusters
-noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii);
+noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii,
+               const std::vector<char>* eligible = nullptr);
+
+/** \brief Local sample spacing (CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing):
+  * per sample, sqrt(pi / k) times the distance to its k-th nearest other sample (k-d tree,
+  * pcl::KdTreeFLANN), the square root of the surface area per sample that a disc through the
+  * k nearest neighbours covers; for samples spread evenly at spacing h on a surface it is about
+  * h. With fewer than k + 1 samples, the farthest other sample's distance is used with their
+  * count (0 for a single sample).
+  * \param[in] positions the samples (finite)
+  * \param[in] k neighbours (>= 1) */
+std::vector<float>
+localSpacing (const std::vector<Eigen::Vector3f>& positions, int k);
 } // namespace detail
 } // namespace pcl_probcollision

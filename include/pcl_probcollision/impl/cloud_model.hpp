@@ -69,7 +69,11 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    if (detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution, merged, cluster_of, seeds))
+    if (detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution,
+                              params.noise_resolution_gate == CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing
+                                  ? params.k
+                                  : 0,
+                              merged, cluster_of, seeds))
     {
       CloudModelParams once = params;
       once.noise_resolution = 0.0;

@@ -25,6 +25,9 @@ namespace detail
   * \param[in] cloud, indices the samples (non-finite ones are left out)
   * \param[in] noise the sensor noise model (None merges nothing)
   * \param[in] factor merge radius in noise standard deviations (> 0)
+  * \param[in] gate_k 0: every sample may merge (ResolutionGate::Everywhere); k >= 1: only
+  *            samples whose localSpacing() with k neighbours is at most their smallest noise
+  *            standard deviation (ResolutionGate::WhereNoiseExceedsSpacing)
   * \param[out] merged one point per cluster: the seed's fields, at the members' centroid, with
   *             the members' mean normal for point types with normals; the cloud's viewpoint
   * \param[out] cluster_of per index of cloud, its merged point (-1 when not a sample)
@@ -33,7 +36,7 @@ namespace detail
 template <typename PointT>
 bool
 mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices, const SensorNoiseModel& noise,
-              double factor, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds)
+              double factor, int gate_k, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds)
 {
   if (noise.type () == SensorNoiseModel::Type::None || !(factor > 0.0))
     return false;
@@ -53,15 +56,30 @@ mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
   }
   const SensorPose sensor = SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_);
   std::vector<float> radii (positions.size (), 0.0f);
+  std::vector<float> spacing;
+  std::vector<char> eligible;
+  if (gate_k > 0)
+  {
+    spacing = localSpacing (positions, gate_k);
+    eligible.assign (positions.size (), 0);
+  }
   for (std::size_t p = 0; p < positions.size (); ++p)
   {
     const Eigen::Matrix3d sigma = noise.covariance (positions[p].cast<double> (), Eigen::Vector3d::Zero (), sensor);
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
     eig.computeDirect (sigma, Eigen::EigenvaluesOnly);
     const double smallest = eig.eigenvalues ()(0);
-    radii[p] = std::isfinite (smallest) ? static_cast<float> (factor * std::sqrt (std::max (0.0, smallest))) : 0.0f;
+    const double deviation = std::isfinite (smallest) ? std::sqrt (std::max (0.0, smallest)) : 0.0;
+    if (gate_k > 0)
+    {
+      // The gate: the noise at least the local spacing (a sample spaced wider never merges).
+      if (!(deviation > 0.0 && spacing[p] <= deviation))
+        continue;
+      eligible[p] = 1;
+    }
+    radii[p] = static_cast<float> (factor * deviation);
   }
-  const NoiseClusters clusters = noiseClusters (positions, radii);
+  const NoiseClusters clusters = noiseClusters (positions, radii, gate_k > 0 ? &eligible : nullptr);
   if (!clusters.merged ())
     return false;
 
