@@ -650,7 +650,8 @@ joinParts (std::vector<TopPart>& parts, Tree& out)
   std::vector<std::pair<std::size_t, std::int32_t>> stack {{0, 0}};  // part, its node's id
   while (!stack.empty ())
   {
-    const auto [p, slot] = stack.back ();
+    const std::size_t p = stack.back ().first;
+    const std::int32_t slot = stack.back ().second;
     stack.pop_back ();
     TopPart& part = parts[p];
     if (part.whole)
