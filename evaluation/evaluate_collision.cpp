@@ -1307,6 +1307,35 @@ writeOutputs (const Options& o, const Results& results)
   printTargets (targets);
 }
 
+/** \brief The items of a comma-separated option value. */
+std::vector<std::string>
+list (const std::string& value)
+{
+  std::vector<std::string> items;
+  std::stringstream in (value);
+  std::string item;
+  while (std::getline (in, item, ','))
+    items.push_back (item);
+  return items;
+}
+
+std::vector<double>
+numbers (const std::vector<std::string>& items)
+{
+  std::vector<double> out;
+  for (const std::string& item : items)
+    out.push_back (std::stod (item));
+  return out;
+}
+
+/** \brief The values > 0 (a 0 in --merge or --gate leaves those settings out). */
+std::vector<double>
+positive (std::vector<double> values)
+{
+  values.erase (std::remove_if (values.begin (), values.end (), [] (double v) { return !(v > 0.0); }), values.end ());
+  return values;
+}
+
 Options
 parse (int argc, char** argv)
 {
@@ -1340,43 +1369,15 @@ parse (int argc, char** argv)
     else if (a == "--dump")
       o.dump = true;
     else if (a == "--noise")
-    {
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        o.noise.push_back (std::stod (item));
-    }
+      o.noise = numbers (list (value ()));
     else if (a == "--merge")
-    {
-      o.merge.clear ();
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        if (std::stod (item) > 0.0)
-          o.merge.push_back (std::stod (item));
-    }
+      o.merge = positive (numbers (list (value ())));
     else if (a == "--gate")
-    {
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        if (std::stod (item) > 0.0)
-          o.gate.push_back (std::stod (item));
-    }
+      o.gate = positive (numbers (list (value ())));
     else if (a == "--drop")
-    {
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        o.drop.push_back (std::stod (item));
-    }
+      o.drop = numbers (list (value ()));
     else if (a == "--only")
-    {
-      std::stringstream list (value ());
-      std::string item;
-      while (std::getline (list, item, ','))
-        o.only.push_back (item);
-    }
+      o.only = list (value ());
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"

@@ -49,36 +49,24 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (surface);
   s.push_back (pooled);
   s.push_back (other);
+  // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
+  // noise is at least the local sample spacing ("gate<c>"); separators and surface layer each.
+  auto addMerged = [&] (const std::string& prefix, double c, CloudModelParams::ResolutionGate where) {
+    std::ostringstream name;
+    name << c;
+    for (const OursSetting* base : {&classifier, &surface})
+    {
+      OursSetting merged = *base;
+      merged.name = (base == &surface ? "surface-" : "") + prefix + name.str ();
+      merged.model.noise_resolution = c;
+      merged.model.noise_resolution_gate = where;
+      s.push_back (merged);
+    }
+  };
   for (const double c : merge)
-  {
-    // Issue #17 item 1: samples closer than c noise sigmas merged, separators and surface.
-    std::ostringstream name;
-    name << c;
-    OursSetting merged = classifier;
-    merged.name = "merge" + name.str ();
-    merged.model.noise_resolution = c;
-    s.push_back (merged);
-    merged = surface;
-    merged.name = "surface-merge" + name.str ();
-    merged.model.noise_resolution = c;
-    s.push_back (merged);
-  }
+    addMerged ("merge", c, CloudModelParams::ResolutionGate::Everywhere);
   for (const double c : gate)
-  {
-    // The same, only where the noise is at least the local sample spacing.
-    std::ostringstream name;
-    name << c;
-    OursSetting merged = classifier;
-    merged.name = "gate" + name.str ();
-    merged.model.noise_resolution = c;
-    merged.model.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
-    s.push_back (merged);
-    merged = surface;
-    merged.name = "surface-gate" + name.str ();
-    merged.model.noise_resolution = c;
-    merged.model.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
-    s.push_back (merged);
-  }
+    addMerged ("gate", c, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing);
   if (!full)
     return s;
   auto add = [&] (const std::string& name, auto change) {
