@@ -21,7 +21,7 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 std::vector<OursSetting>
-oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate)
+oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate, const std::vector<double>& cap)
 {
   std::vector<OursSetting> s;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
@@ -67,6 +67,14 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
     addMerged ("merge", c, CloudModelParams::ResolutionGate::Everywhere);
   for (const double c : gate)
     addMerged ("gate", c, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing);
+  // Issue #17 item 2: the separators' work capped at n leaf-pair fits a query.
+  for (const double n : cap)
+  {
+    OursSetting capped = classifier;
+    capped.request.max_leaf_fits = static_cast<std::size_t> (n);
+    capped.name = "cap" + std::to_string (capped.request.max_leaf_fits);
+    s.push_back (capped);
+  }
   if (!full)
     return s;
   auto add = [&] (const std::string& name, auto change) {

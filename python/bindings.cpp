@@ -789,13 +789,15 @@ PYBIND11_MODULE (_core, m)
       "exhaustive: visit every reachable leaf pair instead of stopping once P > collision_above;\n"
       "per_point: fill probabilities_a/_b; enable_timings: fill build_ms/query_ms; traversal, rho_min, seed,\n"
       "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier;\n"
+      "max_leaf_fits: at most this many leaf pairs fitted a query, nearest first (0 = no cap; result.budget_exhausted);\n"
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
       "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
-                          double expanded_k_sigma, bool defer_kernel_fits, bool surface, bool surface_pooled) {
+                          double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
+                          bool surface_pooled) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -807,6 +809,7 @@ PYBIND11_MODULE (_core, m)
               r.seed = seed;
               r.expanded_k_sigma = expanded_k_sigma;
               r.defer_kernel_fits = defer_kernel_fits;
+              r.max_leaf_fits = max_leaf_fits;
               r.surface = surface;
               r.surface_pooled = surface_pooled;
               return r;
@@ -816,7 +819,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("enable_timings") = dr.enable_timings, py::arg ("traversal") = dr.traversal,
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
-            py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
+            py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -828,6 +831,8 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("seed", &CollisionRequest::seed)
       .def_readwrite ("expanded_k_sigma", &CollisionRequest::expanded_k_sigma)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
+      .def_readwrite ("max_leaf_fits", &CollisionRequest::max_leaf_fits,
+                      "At most this many leaf pairs fitted a query, nearest first; 0 = no cap.")
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
@@ -841,6 +846,7 @@ PYBIND11_MODULE (_core, m)
                traversalName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
                ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
                ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
+               ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
                ", surface=" + (r.surface ? "True" : "False") +
                ", surface_pooled=" + (r.surface_pooled ? "True" : "False") + ")";
       });
@@ -866,6 +872,8 @@ PYBIND11_MODULE (_core, m)
                      "Standard deviation of signed_distance (both clouds' noise, the fitted surfaces' uncertainty,\n"
                      "the discretisation between samples); NaN with it.")
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
+      .def_readonly ("budget_exhausted", &CollisionResult::budget_exhausted,
+                     "True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound.")
       .def_readonly ("no_leaf_tested", &CollisionResult::no_leaf_tested)
       .def_readonly ("unobserved", &CollisionResult::unobserved,
                      "True when the surface layer's answer rests on surface the samples do not show\n"
@@ -899,6 +907,8 @@ PYBIND11_MODULE (_core, m)
           s += ", signed_distance_std=" + num (r.signed_distance_std);
         if (r.unobserved)  // shown only when set, like the signed distance only when computed
           s += ", unobserved=True";
+        if (r.budget_exhausted)  // shown only when set
+          s += ", budget_exhausted=True";
         s = s + ", lower_bound=" + (r.lower_bound ? "True" : "False") +
             ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
             ", witness_side=" + std::to_string (r.witness_side) +

@@ -69,9 +69,13 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
     fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
     return false;
   }
-  bool stopped = traversal.lower_bound;
+  // A capped traversal still finishes the pairs it set aside (their kernel fits; the pairs were
+  // counted against the cap when their planes were fitted).
+  bool stopped = traversal.lower_bound && !traversal.budget_exhausted;
   if (!stopped)
     stopped = leaf_test.finishDeferred (params.stop_probability, params.exhaustive, params.skip_dominated);
+  stopped = stopped || traversal.budget_exhausted;
+  result.budget_exhausted = traversal.budget_exhausted;
   result.bv_tests = traversal.node_pairs_tested;
   if (leaf_test.failures () > 0)
   {
@@ -147,6 +151,7 @@ pool (CollisionResult& into, const CollisionResult& separators, const CollisionR
 {
   into.probability = 0.5 * (into.probability + separators.probability);
   into.lower_bound = into.lower_bound || separators.lower_bound;
+  into.budget_exhausted = into.budget_exhausted || separators.budget_exhausted;
   into.no_leaf_tested = into.no_leaf_tested && separators.no_leaf_tested;
   if (into.witness_side == 0 && separators.witness_side != 0)
   {

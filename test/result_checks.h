@@ -89,6 +89,7 @@ expectSameResult (const pcl_probcollision::CollisionResult& want, const pcl_prob
   EXPECT_EQ (want.verdict, got.verdict);
   EXPECT_TRUE (sameBits (want.probability, got.probability)) << want.probability << " vs " << got.probability;
   EXPECT_EQ (want.lower_bound, got.lower_bound);
+  EXPECT_EQ (want.budget_exhausted, got.budget_exhausted);
   EXPECT_EQ (want.no_leaf_tested, got.no_leaf_tested);
   EXPECT_EQ (want.witness_side, got.witness_side);
   EXPECT_EQ (want.witness_index, got.witness_index);

@@ -376,6 +376,65 @@ TEST (BVHTraversal, EarlyStopGivesLowerBound)
   EXPECT_LE (g_skip.leaf_pairs_tested, g_full.leaf_pairs_tested);
 }
 
+// max_leaf_tests caps the leaf tests: the traversal stops before the one past the cap, flags it,
+// and its maximum is a lower bound of the uncapped one.
+TEST (BVHTraversal, LeafTestBudgetStopsWithALowerBound)
+{
+  const UncertainCloud c = shapeCloud (Shape::Box, 500, 41);
+  ProbabilisticBVH a (c), b (c);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
+  auto graded = [&] (const Node& la, const Node& lb, double) { return 0.001 * ((la.begin + lb.begin) % 500); };
+  TraversalParams tp;
+  tp.exhaustive = true;
+  const TraversalResult full = detail::traverseHierarchies (a, b, I, tp, graded);
+  ASSERT_GT (full.leaf_pairs_tested, 10u);
+  EXPECT_FALSE (full.budget_exhausted);
+  for (const std::size_t cap : {std::size_t (1), std::size_t (10), full.leaf_pairs_tested - 1})
+  {
+    SCOPED_TRACE (cap);
+    tp.max_leaf_tests = cap;
+    const TraversalResult capped = detail::traverseHierarchies (a, b, I, tp, graded);
+    EXPECT_EQ (capped.leaf_pairs_tested, cap);
+    EXPECT_TRUE (capped.budget_exhausted);
+    EXPECT_TRUE (capped.lower_bound);
+    EXPECT_LE (capped.probability, full.probability);
+  }
+  tp.max_leaf_tests = full.leaf_pairs_tested;  // exactly enough: not exhausted
+  const TraversalResult enough = detail::traverseHierarchies (a, b, I, tp, graded);
+  EXPECT_FALSE (enough.budget_exhausted);
+  EXPECT_FALSE (enough.lower_bound);
+  EXPECT_EQ (enough.probability, full.probability);
+}
+
+// Children are visited nearest first: two clouds that touch at one end meet there first.
+TEST (BVHTraversal, NearestLeafPairsComeFirst)
+{
+  UncertainCloud sa, sb;
+  for (int i = 0; i < 400; ++i)
+  {
+    // A rod along x from 0 to 4; B the same rod, shifted to start where A ends.
+    const double x = 0.01 * i;
+    sa.means.emplace_back (x, 0.0, 0.0);
+    sb.means.emplace_back (x + 3.995, 0.0, 0.0);
+  }
+  sa.covariances.assign (sa.means.size (), Eigen::Matrix3d::Identity () * 1e-6);
+  sb.covariances = sa.covariances;
+  ProbabilisticBVH a (sa), b (sb);
+  std::vector<double> first_gap;
+  auto record = [&] (const Node& la, const Node& lb, double) {
+    first_gap.push_back ((la.box.center - lb.box.center).norm ());
+    return 0.0;
+  };
+  TraversalParams tp;
+  tp.rho_min = 0.0;  // reach every pair
+  tp.exhaustive = true;
+  detail::traverseHierarchies (a, b, Eigen::Isometry3d::Identity (), tp, record);
+  ASSERT_GT (first_gap.size (), 4u);
+  // The first leaf pair is the closest of all.
+  EXPECT_EQ (first_gap.front (), *std::min_element (first_gap.begin (), first_gap.end ()));
+  EXPECT_LT (first_gap.front (), 0.5);
+}
+
 TEST (BVHTraversal, ThreadsGiveSerialAnswers)
 {
   ProbabilisticBVH a (shapeCloud (Shape::Sphere, 2000, 51, 0.005));

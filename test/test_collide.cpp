@@ -123,6 +123,48 @@ TEST (Collide, SkippingDominatedPairsKeepsProbabilityAndWitness)
   EXPECT_GT (fewer, 0u) << "no query was cheaper without per-point values";
 }
 
+// CollisionRequest::max_leaf_fits: at most that many fits, flagged when pairs were left, P a lower
+// bound of the uncapped P; a cap the query never reaches changes nothing.
+TEST (Collide, LeafFitCapBoundsTheWorkAndGivesALowerBound)
+{
+  const CloudModel a (randomSheet (600, 0.2, 0.0, 0.004, 51));
+  std::size_t capped_queries = 0;
+  for (const double gap : {0.02, 0.006, 0.0})
+  {
+    SCOPED_TRACE (gap);
+    const CloudModel b (randomSheet (600, 0.2, gap, 0.004, 52));
+    CollisionRequest plain;
+    CollisionResult rp;
+    ASSERT_TRUE (collide (a, b, Eigen::Isometry3d::Identity (), plain, rp)) << rp.message;
+    EXPECT_FALSE (rp.budget_exhausted);
+    if (rp.leaf_pairs_tested < 2)
+      continue;  // decided by its first fit (a collision met first): nothing to cap
+    for (const std::size_t cap : {std::size_t (1), rp.leaf_pairs_tested / 2, rp.leaf_pairs_tested})
+    {
+      SCOPED_TRACE (cap);
+      CollisionRequest capped = plain;
+      capped.max_leaf_fits = cap;
+      CollisionResult rc;
+      ASSERT_TRUE (collide (a, b, Eigen::Isometry3d::Identity (), capped, rc)) << rc.message;
+      expectSane (rc, true, capped);
+      EXPECT_LE (rc.leaf_pairs_tested, cap);
+      EXPECT_LE (rc.probability, rp.probability);
+      if (cap == rp.leaf_pairs_tested)
+      {
+        EXPECT_FALSE (rc.budget_exhausted);
+        EXPECT_EQ (rc.probability, rp.probability);
+      }
+      else
+      {
+        EXPECT_TRUE (rc.budget_exhausted);
+        EXPECT_TRUE (rc.lower_bound);
+        ++capped_queries;
+      }
+    }
+  }
+  EXPECT_GT (capped_queries, 0u) << "no query reached its cap: the test would prove nothing";
+}
+
 // CollisionRequest::defer_kernel_fits: the same P whenever the query does not stop early, the
 // same verdict always, fewer kernel fits; ignored with per-point values.
 TEST (Collide, DeferredKernelFitsKeepTheAnswer)

@@ -157,6 +157,7 @@ TEST (CollisionRequest, EqualityComparesEveryMember)
       {"seed", [] (CollisionRequest& r) { r.seed = 2; }},
       {"expanded_k_sigma", [] (CollisionRequest& r) { r.expanded_k_sigma = 2.0; }},
       {"defer_kernel_fits", [] (CollisionRequest& r) { r.defer_kernel_fits = true; }},
+      {"max_leaf_fits", [] (CollisionRequest& r) { r.max_leaf_fits = 7; }},
       {"classifier.C", [] (CollisionRequest& r) { r.classifier.C = 10.0; }},
       {"classifier.kernel", [] (CollisionRequest& r) { r.classifier.kernel = KernelMode::Linear; }},
       {"classifier.loss", [] (CollisionRequest& r) { r.classifier.loss = Loss::Huber; }},

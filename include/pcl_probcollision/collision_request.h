@@ -3,6 +3,7 @@
 
 #include <pcl_probcollision/classifier_params.h>
 
+#include <cstddef>
 #include <cstdint>
 
 namespace pcl_probcollision
@@ -60,6 +61,13 @@ struct CollisionRequest
     * bound either way) is lower. Faster on colliding poses; off by default because the lower
     * P of those poses costs ranking accuracy (docs/PERFORMANCE.md). */
   bool defer_kernel_fits = false;
+  /** \brief A cap on the separators' work: at most this many leaf pairs fitted per query; 0
+    * (default) = no cap. Leaf pairs are visited nearest first (detail/bvh_traversal.h), so the
+    * pairs left over are the farther ones; a query that reaches the cap stops with P the
+    * largest so far (CollisionResult::budget_exhausted, a lower bound). It bounds the worst
+    * case at high noise, where inflated boxes overlap everywhere and thousands of pairs are
+    * fitted (docs/PERFORMANCE.md, issue #17). Not used by the surface layer. */
+  std::size_t max_leaf_fits = 0;
 
   /** \brief The surface layer (METHOD.md 10a), experimental: instead of the separators, test
     * each object's points against the other's oriented surface (a local signed distance near

@@ -46,8 +46,12 @@ struct CollisionResult
     * surfaces' own uncertainty and the discretisation between samples); NaN with it. */
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
   /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
-    * InCollision and final). */
+    * InCollision and final, unless budget_exhausted). */
   bool lower_bound = false;
+  /** \brief True when the query stopped at CollisionRequest::max_leaf_fits with leaf pairs
+    * left unfitted: P (and lower_bound) is the largest over the pairs fitted, nearest first; the
+    * pairs left could only raise it. */
+  bool budget_exhausted = false;
   /** \brief True when no leaf pair was reached: the boxes never came near (P = 0). */
   bool no_leaf_tested = false;
   /** \brief True when the answer rests on surface the samples do not show (the surface layer

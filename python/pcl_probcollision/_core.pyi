@@ -78,12 +78,14 @@ class CollisionRequest:
     seed: int
     expanded_k_sigma: float
     defer_kernel_fits: bool
+    max_leaf_fits: int
     surface: bool
     surface_pooled: bool
     def __init__(self, *, free_below: float = ..., collision_above: float = ..., exhaustive: bool = ...,
                  per_point: bool = ..., enable_timings: bool = ..., traversal: TraversalMode = ...,
                  rho_min: float = ..., seed: int = ..., expanded_k_sigma: float = ...,
-                 defer_kernel_fits: bool = ..., surface: bool = False, surface_pooled: bool = False) -> None: ...
+                 defer_kernel_fits: bool = ..., max_leaf_fits: int = ..., surface: bool = False,
+                 surface_pooled: bool = False) -> None: ...
     def validate(self) -> None: ...
 
 class CollisionResult:
@@ -108,6 +110,9 @@ class CollisionResult:
         """Standard deviation of signed_distance; NaN with it."""
     @property
     def lower_bound(self) -> bool: ...
+    @property
+    def budget_exhausted(self) -> bool:
+        """True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound."""
     @property
     def no_leaf_tested(self) -> bool: ...
     @property

@@ -22,7 +22,7 @@ def same_result(r, s):
     assert r.probability == s.probability  # exact, not approx
     # The surface layer's distance: exact too, NaN (not computed) on both sides alike.
     np.testing.assert_array_equal([r.signed_distance, r.signed_distance_std], [s.signed_distance, s.signed_distance_std])
-    for f in ("lower_bound", "no_leaf_tested", "unobserved", "witness_side", "witness_index", "points_a", "points_b",
+    for f in ("lower_bound", "budget_exhausted", "no_leaf_tested", "unobserved", "witness_side", "witness_index", "points_a", "points_b",
               "points_skipped_nonfinite", "bv_tests", "leaf_pairs_tested", "kernel_leaf_pairs",
               "degenerate_leaf_pairs", "classifier_iterations"):
         assert getattr(r, f) == getattr(s, f), f

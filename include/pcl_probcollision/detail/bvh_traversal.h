@@ -34,7 +34,7 @@ struct TraversalParams
     : mode (request.traversal), rho_min (request.rho_min),
       // In decision mode a contribution above collision_above makes InCollision final (METHOD.md 7).
       stop_probability (request.collision_above), exhaustive (request.exhaustive), seed (request.seed),
-      expanded_k_sigma (request.expanded_k_sigma)
+      expanded_k_sigma (request.expanded_k_sigma), max_leaf_tests (request.max_leaf_fits)
   {}
 
   /** \brief Traversal mode (CollisionRequest::traversal). */
@@ -58,6 +58,8 @@ struct TraversalParams
     * Same probability, fewer leaf tests; off by default because a leaf test that records
     * contacts then misses some. Assumes the leaf test returns values in [0, 1]. */
   bool skip_dominated = false;
+  /** \brief Stop before the leaf test that would exceed this many (0 = no cap). */
+  std::size_t max_leaf_tests = 0;
 
   /** \brief Throws pcl::BadArgumentException naming the first parameter out of range. */
   void
@@ -96,6 +98,9 @@ struct TraversalResult
   /** \brief True when the traversal stopped early at stop_probability: probability is then a
     * lower bound of the exhaustive value. */
   bool lower_bound = false;
+  /** \brief True when the traversal stopped at max_leaf_tests with pairs left (lower_bound is
+    * then set too). */
+  bool budget_exhausted = false;
   /** \brief True when no leaf test returned a valid (non-NaN) value. */
   bool no_leaf_tested = true;
   /** \brief Leaf ids (in A and B) of the maximum contribution, -1 when none. */
@@ -120,7 +125,7 @@ struct TraversalResult
   operator== (const TraversalResult& o) const
   {
     auto same = [] (double x, double y) { return x == y || (std::isnan (x) && std::isnan (y)); };
-    return probability == o.probability && lower_bound == o.lower_bound &&
+    return probability == o.probability && lower_bound == o.lower_bound && budget_exhausted == o.budget_exhausted &&
            no_leaf_tested == o.no_leaf_tested && max_node_a == o.max_node_a &&
            max_node_b == o.max_node_b && same (max_reach_weight, o.max_reach_weight) &&
            same (max_leaf_probability, o.max_leaf_probability) &&
@@ -143,7 +148,8 @@ struct TraversalResult
   * - otherwise the node that is not a leaf is opened; if both are internal, the one with the
   *   larger half diagonal |half_extents| (ties: A). The volume is not used because flat
   *   surface patches have almost none.
-  * Children are visited depth-first in storage order (iterative stack, no recursion).
+  * Depth-first (iterative stack, no recursion); the opened node's children are visited nearest
+  * first (box centre to the other node's box centre), ties in storage order.
   *
   * \param[in] bvh_a hierarchy of cloud A (its frame is the query frame)
   * \param[in] bvh_b hierarchy of cloud B
@@ -191,11 +197,13 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
     std::int32_t a;
     std::int32_t b;
     double rho;
+    double distance;  ///< squared distance between the two box centres, for the visiting order
   };
   std::vector<Entry> stack;
   stack.reserve (256);
-  stack.push_back ({ProbabilisticBVH::rootId (), ProbabilisticBVH::rootId (), 1.0});
+  stack.push_back ({ProbabilisticBVH::rootId (), ProbabilisticBVH::rootId (), 1.0, 0.0});
   std::mt19937_64 rng (params.seed);
+  const Eigen::Isometry3d T_b_a = T_a_b.inverse (Eigen::Isometry);
   double best = -std::numeric_limits<double>::infinity ();
 
   while (!stack.empty ())
@@ -252,6 +260,12 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
     const bool leaf_b = nb.isLeaf ();
     if (leaf_a && leaf_b)
     {
+      if (params.max_leaf_tests > 0 && result.leaf_pairs_tested >= params.max_leaf_tests)
+      {
+        result.budget_exhausted = true;
+        result.lower_bound = true;
+        break;
+      }
       ++result.leaf_pairs_tested;
       const double p = leaf_test (na, nb, rho);
       if (std::isnan (p))
@@ -278,16 +292,25 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
 
     const bool open_a =
         !leaf_a && (leaf_b || na.box.halfDiagonalSquared () >= nb.box.halfDiagonalSquared ());
+    // Children nearest the other node first: in decision mode the pair that decides a
+    // collision is then met early (at high noise, thousands of overlapping pairs precede it
+    // in storage order). The maximum of a full traversal does not depend on the order.
+    const std::size_t first = stack.size ();
     if (open_a)
     {
+      const Eigen::Vector3d other = T_a_b * nb.box.center;
       for (std::int32_t c = na.first_child + na.num_children; c-- > na.first_child;)
-        stack.push_back ({c, e.b, rho});
+        stack.push_back ({c, e.b, rho, (nodes_a[static_cast<std::size_t> (c)].box.center - other).squaredNorm ()});
     }
     else
     {
+      const Eigen::Vector3d other = T_b_a * na.box.center;
       for (std::int32_t c = nb.first_child + nb.num_children; c-- > nb.first_child;)
-        stack.push_back ({e.a, c, rho});
+        stack.push_back ({e.a, c, rho, (nodes_b[static_cast<std::size_t> (c)].box.center - other).squaredNorm ()});
     }
+    // Farthest pushed first, nearest popped first; ties keep the first child on top.
+    std::stable_sort (stack.begin () + static_cast<std::ptrdiff_t> (first), stack.end (),
+                      [] (const Entry& x, const Entry& y) { return x.distance > y.distance; });
   }
 
   if (result.max_node_a >= 0)
