@@ -39,7 +39,8 @@ fmt (double v)
 // Flags that take one value, and flags that take none.
 const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
-  "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads"};
+  "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
+  "-max_leaf_fits"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-ignore_normals", "-v"};
 
@@ -398,6 +399,20 @@ parseCommandLine (const std::vector<std::string>& args)
       if (!(o.epsilon >= 0.0 && o.epsilon < 0.5))
         return usage (bad + "must be in [0, 0.5)");
     }
+    else if (a == "-noise_resolution")
+    {
+      if (!parseDouble (v, o.noise_resolution))
+        return usage (bad + "is not a number");
+      if (!(o.noise_resolution >= 0.0) || !std::isfinite (o.noise_resolution))
+        return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging)");
+    }
+    else if (a == "-max_leaf_fits")
+    {
+      std::uint64_t n = 0;
+      if (!parseUint64 (v, n))
+        return usage (bad + "is not a non-negative integer (0: no cap)");
+      o.max_leaf_fits = static_cast<std::size_t> (n);
+    }
     else if (a == "-split")
     {
       if (v != "pca" && v != "octree")
@@ -501,6 +516,10 @@ helpText ()
        "  -k K            = "
     << D::k
     << "      neighbours of the covariance estimation\n"
+       "  -noise_resolution C   = "
+    << fmt (D::noise_resolution)
+    << "   merge samples closer than C noise sigmas into one (0: none; 2 is\n"
+       "                  the evaluated choice at high noise: faster, less accurate at low noise)\n"
        "\n"
        "Query:\n"
        "  -thresholds LOW,HIGH   = "
@@ -514,6 +533,10 @@ helpText ()
     << D::seed
     << "       seed of the stochastic traversal\n"
        "  -exhaustive     visit every reachable leaf pair (no early stop; P is then exact, not a bound)\n"
+       "  -max_leaf_fits N   = "
+    << D::max_leaf_fits
+    << "   at most N leaf pairs fitted a query, nearest first (0: no cap); a capped\n"
+       "                  query prints P >= and \"budget exhausted\": P is a lower bound\n"
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
        "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"

@@ -40,6 +40,8 @@ struct Defaults
   static inline const std::uint64_t seed = request.seed;
   static inline const bool stochastic = request.traversal == pcl_probcollision::TraversalMode::Stochastic;
   static inline const bool exhaustive = request.exhaustive;
+  static inline const std::size_t max_leaf_fits = request.max_leaf_fits;
+  static inline const double noise_resolution = model.noise_resolution;
   static inline const bool surface = request.surface;
   static inline const bool surface_pooled = request.surface_pooled;
   static inline const bool measured = !model.surface_projection;
@@ -92,6 +94,10 @@ struct Options
   /** \brief -measured: surface projection off (CloudModelParams::surface_projection). */
   bool measured = Defaults::measured;
   bool exhaustive = Defaults::exhaustive;
+  /** \brief -max_leaf_fits N: CollisionRequest::max_leaf_fits (0 = no cap). */
+  std::size_t max_leaf_fits = Defaults::max_leaf_fits;
+  /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging). */
+  double noise_resolution = Defaults::noise_resolution;
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;

@@ -229,6 +229,7 @@ requestFor (const Options& o)
   r.free_below = o.free_below;
   r.collision_above = o.collision_above;
   r.exhaustive = o.exhaustive || o.output.has_value ();
+  r.max_leaf_fits = o.max_leaf_fits;
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
   r.per_point = o.output.has_value ();
@@ -245,6 +246,7 @@ modelParamsFor (const Options& o)
 {
   pcl_probcollision::CloudModelParams m;
   m.k = o.k;
+  m.noise_resolution = o.noise_resolution;
   m.surface_projection = !o.measured;
   m.surface = o.surface;
   m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
@@ -301,6 +303,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   // samples do not show (CollisionResult::unobserved).
   j.key ("unobserved").boolean (r.unobserved);
   j.key ("lower_bound").boolean (r.lower_bound);
+  j.key ("budget_exhausted").boolean (r.budget_exhausted);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
   j.key ("points_a").unsignedInteger (r.points_a);
   j.key ("points_b").unsignedInteger (r.points_b);
@@ -357,6 +360,8 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("positions").string (o.measured ? "measured" : "projected");
   j.key ("seed").unsignedInteger (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
+  j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
+  j.key ("noise_resolution").number (o.noise_resolution);
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
@@ -388,11 +393,12 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
     std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f", r.signed_distance, r.signed_distance_std);
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
+  const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";
   std::snprintf (buf, sizeof (buf),
-                 "%s%-9s P %s %.6f%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "%s%-9s P %s %.6f%s%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
                  "query %.1f ms]",
                  prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
-                 r.probability, distance, unobserved, r.points_a, r.points_b, r.points_skipped_nonfinite,
+                 r.probability, distance, unobserved, capped, r.points_a, r.points_b, r.points_skipped_nonfinite,
                  r.leaf_pairs_tested,
                  std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
   return buf;

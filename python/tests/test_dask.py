@@ -16,7 +16,7 @@ from pcl_probcollision import dask as pcd
 from conftest import DATA, patch, sheet, write_pcd
 
 PYTHON = sys.executable
-FIELDS = ("probability", "verdict", "status", "lower_bound", "no_leaf_tested", "points_a", "points_b",
+FIELDS = ("probability", "verdict", "status", "lower_bound", "budget_exhausted", "no_leaf_tested", "points_a", "points_b",
           "points_skipped_nonfinite", "leaf_pairs_tested", "bv_tests", "kernel_leaf_pairs",
           "degenerate_leaf_pairs", "classifier_iterations", "witness_side", "witness_index", "witness_point",
           "witness_normal")

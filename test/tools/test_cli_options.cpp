@@ -58,6 +58,10 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.measured);
   EXPECT_FALSE (o.exhaustive);
   EXPECT_FALSE (o.surface);
+  EXPECT_EQ (o.max_leaf_fits, 0u);        // no cap
+  EXPECT_EQ (o.noise_resolution, 0.0);    // no merging
+  EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
+  EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_FALSE (o.surface_pooled);
   EXPECT_FALSE (o.ignore_normals);
   EXPECT_FALSE (o.mesh_spacing);
@@ -155,6 +159,10 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-o", "out.ply"}, "-o");
   expectUsageError ({"-threads", "-1"}, "-threads");
   expectUsageError ({"-threads", "two"}, "-threads");
+  expectUsageError ({"-max_leaf_fits", "-1"}, "-max_leaf_fits");
+  expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
+  expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");
+  expectUsageError ({"-noise_resolution", "inf"}, "-noise_resolution");
 }
 
 TEST (CliOptions, FlagsAndPositionals)

@@ -404,6 +404,45 @@ TEST_F (PcdCollisionTool, DemoPosesVerdicts)
   EXPECT_GE (v[2]["probability"].number, v[1]["probability"].number);
 }
 
+// -max_leaf_fits N caps the fits of a query (budget_exhausted, P a lower bound: P >= in the human
+// line with its marker); -noise_resolution C merges samples (fewer model points). Both are in
+// the JSON parameters.
+TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
+{
+  const auto plain = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string ()});
+  const auto capped = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-max_leaf_fits", "1"});
+  ASSERT_EQ (plain.size (), 3u);
+  ASSERT_EQ (capped.size (), 3u);
+  std::size_t exhausted = 0;
+  for (std::size_t i = 0; i < capped.size (); ++i)
+  {
+    EXPECT_FALSE (plain[i]["budget_exhausted"].boolean) << i;
+    EXPECT_EQ (plain[i]["parameters"]["max_leaf_fits"].number, 0.0);
+    EXPECT_EQ (capped[i]["parameters"]["max_leaf_fits"].number, 1.0);
+    EXPECT_LE (capped[i]["leaf_pairs"].number, 1.0) << i;
+    EXPECT_LE (capped[i]["probability"].number, plain[i]["probability"].number) << i;
+    if (capped[i]["budget_exhausted"].boolean)
+    {
+      ++exhausted;
+      EXPECT_TRUE (capped[i]["lower_bound"].boolean) << i;
+      EXPECT_GT (plain[i]["leaf_pairs"].number, 1.0) << i;
+    }
+  }
+  EXPECT_GT (exhausted, 0u) << "no demo pose needed a second fit: the test would prove nothing";
+  const ToolRun human = run ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-max_leaf_fits", "1"});
+  ASSERT_EQ (human.status, 0) << human.err;
+  std::size_t marked = 0;
+  for (const auto& l : lines (human.out))
+    marked += l.find ("budget exhausted") != std::string::npos && l.find ("P >=") != std::string::npos;
+  EXPECT_EQ (marked, exhausted);
+
+  const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3"});
+  ASSERT_EQ (merged.size (), 1u);
+  EXPECT_EQ (merged[0]["parameters"]["noise_resolution"].number, 3.0);
+  EXPECT_LT (merged[0]["points_b"].number, static_cast<double> (kScenePoints));
+  EXPECT_GT (merged[0]["points_b"].number, 0.0);
+}
+
 TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)
 {
   // Extra poses in the batch: rotated ones and a comma/space mix, to exercise the cache with

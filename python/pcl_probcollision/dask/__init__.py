@@ -51,6 +51,10 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "stochastic": _REQUEST.traversal == core.TraversalMode.Stochastic,
     "seed": _REQUEST.seed,
     "exhaustive": _REQUEST.exhaustive,
+    # At most this many leaf pairs fitted a query, nearest first (0: no cap).
+    "max_leaf_fits": _REQUEST.max_leaf_fits,
+    # Samples closer than this many noise sigmas merged into one (0: none).
+    "noise_resolution": _MODEL.noise_resolution,
     # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
     # their faces, clouds by their viewpoint or by propagation) and signed_distance is filled.
     "surface": _REQUEST.surface,
@@ -109,6 +113,8 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
         raise ValueError(f"option mesh_density: must be > 0, got {o['mesh_density']}")
     if int(o["threads"]) < 0:
         raise ValueError(f"option threads: must be >= 0, got {o['threads']}")
+    if int(o["max_leaf_fits"]) < 0:
+        raise ValueError(f"option max_leaf_fits: must be >= 0, got {o['max_leaf_fits']}")
     model_params(o, "a", exact=False).validate()
     request_of(o).validate()
     return o
@@ -121,6 +127,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
                               n_min=min(_N_MIN, int(o["nmax"])), sigma_max=float(o["sigma_max"]),
                               epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
     p.split = o["split"]
+    p.noise_resolution = float(o["noise_resolution"])
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
     return p
@@ -132,7 +139,8 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         free_below=o["thresholds"][0], collision_above=o["thresholds"][1], exhaustive=bool(o["exhaustive"]),
         per_point=False, enable_timings=True,
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
-        seed=int(o["seed"]), surface=bool(o["surface"]), surface_pooled=bool(o["surface_pooled"]))
+        seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), surface=bool(o["surface"]),
+        surface_pooled=bool(o["surface_pooled"]))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -244,7 +252,7 @@ _builds = collections.Counter()  # models built in this process, by token (tests
 
 
 def _params_key(o: Dict[str, Any], side: str, exact: bool) -> tuple:
-    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface")
+    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface", "noise_resolution")
     noise = () if exact else (o["sensor_" + side], float(o["sigma_" + side]))
     return tuple(o[k] for k in keys) + noise
 
@@ -294,6 +302,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         "verdict": np.array([int(r.verdict) for r in results], dtype=np.int8),
         "status": np.array([int(r.status) for r in results], dtype=np.int8),
         "lower_bound": np.array([r.lower_bound for r in results], dtype=bool),
+        "budget_exhausted": np.array([r.budget_exhausted for r in results], dtype=bool),
         "no_leaf_tested": np.array([r.no_leaf_tested for r in results], dtype=bool),
         # NaN without surface (or where the surfaces never came within reach), as in CollisionResult.
         "signed_distance": np.array([r.signed_distance for r in results], dtype=np.float64),
@@ -322,7 +331,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
 
 class BatchResults:
     """Answers in pose order, one numpy array per field: probability, verdict (int8 of Verdict),
-    status, lower_bound, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
+    status, lower_bound, budget_exhausted, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
     unobserved (bool: with surface=True, the answer rests on surface the samples do not show; False otherwise),
     the counters (points_a, points_b, points_skipped_nonfinite, leaf_pairs_tested, bv_tests,
     kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
