@@ -50,11 +50,14 @@ awk -F, -v OFS=, -v v="$demo_verdict" -v s="$demo_surface" '
 echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)}, with -surface ${demo_surface:-nothing} (issue 16 target: collision)"
 
 # The summary table as markdown (docs/RESULTS.md quotes it).
-awk -F, 'NR == 1 { print "| workload | noise | method | setting | queries | easy | easy acc. | AUC | Brier (near) | flip rate | P std | median us | p90 us | max us | build ms | memory MB |";
-                   print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
-         { mem = ($16 == "nan") ? "nan" : sprintf ("%.2f", $16 / 1e6);
-           printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.0f | %.0f | %.0f | %s | %s |\n",
-                  $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, mem }' \
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
+                   print "| workload | noise | method | setting | queries | easy | easy acc. | AUC | Brier (near) | flip rate | P std | median us | p90 us | p99 us | max us | build ms | memory MB |";
+                   print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
+         { mem = ($c["memory_bytes"] == "nan") ? "nan" : sprintf ("%.2f", $c["memory_bytes"] / 1e6);
+           printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %.0f | %.0f | %.0f | %.0f | %s | %s |\n",
+                  $c["workload"], $c["noise_pct"], $c["method"], $c["setting"], $c["queries"], $c["easy_queries"],
+                  $c["easy_accuracy"], $c["auc"], $c["brier_near"], $c["renoise_flip_rate"], $c["renoise_p_std"],
+                  $c["median_us"], $c["p90_us"], $c["p99_us"], $c["max_us"], $c["build_ms"], mem }' \
   "$out/summary.csv" > "$out/summary.md"
 
 # Issue 16's measures of ours and the 2-sigma collision map (columns found by header name).
