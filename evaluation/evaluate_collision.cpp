@@ -19,7 +19,8 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--only SETTING,...]
+//                      [--drop F,...]
 //
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
@@ -79,6 +80,9 @@ struct Options
   /** \brief The same merge gated by the local spacing ("gate<c>", "surface-gate<c>"); empty
     * (default) leaves them out. */
   std::vector<double> gate;
+  /** \brief BVHParams::noise_stop of the "stop<c>" and "surface-stop<c>" settings (issue #17
+    * item 1), one pair per value; empty (default) leaves them out. */
+  std::vector<double> stop;
   /** \brief --only: the settings of ours run in the W1 cells (empty: all); the stability
     * passes and the other workloads are not filtered. */
   std::vector<std::string> only;
@@ -417,7 +421,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
-  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate);
+  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop);
   for (const double f : o.drop)
   {
     // A control for model changes that do not follow the geometry: the separators with f % of
@@ -1328,7 +1332,7 @@ numbers (const std::vector<std::string>& items)
   return out;
 }
 
-/** \brief The values > 0 (a 0 in --merge or --gate leaves those settings out). */
+/** \brief The values > 0 (a 0 in --merge, --gate or --stop leaves those settings out). */
 std::vector<double>
 positive (std::vector<double> values)
 {
@@ -1374,6 +1378,8 @@ parse (int argc, char** argv)
       o.merge = positive (numbers (list (value ())));
     else if (a == "--gate")
       o.gate = positive (numbers (list (value ())));
+    else if (a == "--stop")
+      o.stop = positive (numbers (list (value ())));
     else if (a == "--drop")
       o.drop = numbers (list (value ()));
     else if (a == "--only")
@@ -1381,7 +1387,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--only SETTING,...] [--drop F,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--only SETTING,...] [--drop F,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");
