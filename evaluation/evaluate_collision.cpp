@@ -19,8 +19,8 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cap N,N,...]
-//                      [--only SETTING,...] [--drop F,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...]
+//                      [--cap N,N,...] [--only SETTING,...] [--drop F,...]
 //
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
@@ -80,6 +80,10 @@ struct Options
   /** \brief The same merge gated by the local spacing ("gate<c>", "surface-gate<c>"); empty
     * (default) leaves them out. */
   std::vector<double> gate;
+  /** \brief BVHParams::noise_stop of the "stop<c>" and "surface-stop<c>" settings (issue #17
+    * item 1), one pair per value; empty (default) leaves them out (docs/PERFORMANCE.md: no c
+    * met the targets; each pair adds a surface-layer run to every cell). */
+  std::vector<double> stop;
   /** \brief CollisionRequest::max_leaf_fits of the "cap<n>" settings (issue #17 item 2); empty
     * (default) leaves them out. */
   std::vector<double> cap;
@@ -421,7 +425,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
-  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.cap);
+  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop, o.cap);
   for (const double f : o.drop)
   {
     // A control for model changes that do not follow the geometry: the separators with f % of
@@ -1332,7 +1336,7 @@ numbers (const std::vector<std::string>& items)
   return out;
 }
 
-/** \brief The values > 0 (a 0 in --merge or --gate leaves those settings out). */
+/** \brief The values > 0 (a 0 in --merge, --gate or --stop leaves those settings out). */
 std::vector<double>
 positive (std::vector<double> values)
 {
@@ -1378,6 +1382,8 @@ parse (int argc, char** argv)
       o.merge = positive (numbers (list (value ())));
     else if (a == "--gate")
       o.gate = positive (numbers (list (value ())));
+    else if (a == "--stop")
+      o.stop = positive (numbers (list (value ())));
     else if (a == "--cap")
       o.cap = positive (numbers (list (value ())));
     else if (a == "--drop")
@@ -1387,7 +1393,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <random>
@@ -21,7 +22,8 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 std::vector<OursSetting>
-oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate, const std::vector<double>& cap)
+oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate,
+              const std::vector<double>& stop, const std::vector<double>& cap)
 {
   std::vector<OursSetting> s;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
@@ -50,23 +52,31 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (pooled);
   s.push_back (other);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
-  // noise is at least the local sample spacing ("gate<c>"); separators and surface layer each.
-  auto addMerged = [&] (const std::string& prefix, double c, CloudModelParams::ResolutionGate where) {
+  // noise is at least the local sample spacing ("gate<c>"), or the hierarchy not split within
+  // c point sigmas ("stop<c>"); separators and surface layer each.
+  auto addVariant = [&] (const std::string& prefix, double c, const std::function<void (CloudModelParams&)>& change) {
     std::ostringstream name;
     name << c;
     for (const OursSetting* base : {&classifier, &surface})
     {
-      OursSetting merged = *base;
-      merged.name = (base == &surface ? "surface-" : "") + prefix + name.str ();
-      merged.model.noise_resolution = c;
-      merged.model.noise_resolution_gate = where;
-      s.push_back (merged);
+      OursSetting variant = *base;
+      variant.name = (base == &surface ? "surface-" : "") + prefix + name.str ();
+      change (variant.model);
+      s.push_back (variant);
     }
   };
+  auto merged = [] (double c, CloudModelParams::ResolutionGate where) {
+    return [c, where] (CloudModelParams& m) {
+      m.noise_resolution = c;
+      m.noise_resolution_gate = where;
+    };
+  };
   for (const double c : merge)
-    addMerged ("merge", c, CloudModelParams::ResolutionGate::Everywhere);
+    addVariant ("merge", c, merged (c, CloudModelParams::ResolutionGate::Everywhere));
   for (const double c : gate)
-    addMerged ("gate", c, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing);
+    addVariant ("gate", c, merged (c, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing));
+  for (const double c : stop)
+    addVariant ("stop", c, [c] (CloudModelParams& m) { m.hierarchy.noise_stop = c; });
   // Issue #17 item 2: the separators' work capped at n leaf-pair fits a query.
   for (const double n : cap)
   {

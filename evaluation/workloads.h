@@ -66,10 +66,12 @@ struct OursSetting
   * full = false keeps default, classifier, surface, pooled and max. Each c of merge adds "merge<c>"
   * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c;
   * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
-  * (ResolutionGate::WhereNoiseExceedsSpacing). Each n of cap adds "cap<n>": classifier with
-  * CollisionRequest::max_leaf_fits = n (issue #17 item 2). */
+  * (ResolutionGate::WhereNoiseExceedsSpacing); each c of stop "stop<c>" and "surface-stop<c>",
+  * the hierarchy not split within the noise (BVHParams::noise_stop = c). Each n of cap adds
+  * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2). */
 std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {},
-                                       const std::vector<double>& gate = {}, const std::vector<double>& cap = {});
+                                       const std::vector<double>& gate = {}, const std::vector<double>& stop = {},
+                                       const std::vector<double>& cap = {});
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and
   * its std (NaN when not computed, e.g. before the surface layer or with surface off) and the

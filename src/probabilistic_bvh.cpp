@@ -41,6 +41,14 @@ BVHParams::validate () const
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::BVHParams::validate] k_sigma "
                              << k_sigma << " must be finite and >= 0");
+  if (!(noise_stop >= 0.0) || !std::isfinite (noise_stop))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] noise_stop "
+                             << noise_stop << " must be finite and >= 0");
+  if (n_noise_max < 1)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::BVHParams::validate] n_noise_max " << n_noise_max
+                                                                                << " must be >= 1");
   if (leakage_bound != LeakageBound::MinSlab && leakage_bound != LeakageBound::UnionBound)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::BVHParams::validate] leakage_bound "
@@ -463,6 +471,21 @@ splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsil
   return false;
 }
 
+/** \brief BVHParams::noise_stop's test: the means' range along e3 is at most noise_stop times the
+  * median of the points' standard deviations along e3 (the median: one point with a wide
+  * covariance, e.g. at an edge, should not keep a node whole). */
+bool
+withinNoise (const NodeGeometry& g, double noise_stop, std::vector<double>& tmp)
+{
+  const std::vector<double>& p = g.q[0];
+  const auto mm = std::minmax_element (p.begin (), p.end ());
+  const double L = *mm.second - *mm.first;
+  tmp.assign (g.s[0].begin (), g.s[0].end ());
+  const std::size_t mid = tmp.size () / 2;
+  std::nth_element (tmp.begin (), tmp.begin () + mid, tmp.end ());
+  return L <= noise_stop * tmp[mid];
+}
+
 using Node = ProbabilisticBVH::Node;
 
 /** \brief What a worker reuses from node to node. */
@@ -501,6 +524,9 @@ makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& t
     node.leaf_reason = ProbabilisticBVH::LeafReason::StopRule;
   else if (m <= static_cast<std::size_t> (params.n_min))
     node.leaf_reason = ProbabilisticBVH::LeafReason::MinSize;
+  else if (params.noise_stop > 0.0 && m <= static_cast<std::size_t> (params.n_noise_max) &&
+           withinNoise (g, params.noise_stop, s.tmp))
+    node.leaf_reason = ProbabilisticBVH::LeafReason::NoiseStop;
   else
   {
     split = params.split_style == BVHParams::SplitStyle::Pca ? splitPca (pts, g, params.epsilon, s.tmp, s.children)

@@ -49,6 +49,46 @@ distinctPoints (const ProbabilisticBVH& bvh, const Node& node)
   return v;
 }
 
+/** \brief Nodes of a and b that differ (ids, ranges, reasons, boxes, leakage), and a node
+  * count mismatch counted as a difference too. */
+std::size_t
+differingNodes (const ProbabilisticBVH& a, const ProbabilisticBVH& b)
+{
+  const std::size_t n = std::min (a.nodes ().size (), b.nodes ().size ());
+  std::size_t differing = std::max (a.nodes ().size (), b.nodes ().size ()) - n;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Node& x = a.nodes ()[i];
+    const Node& y = b.nodes ()[i];
+    const bool same = x.first_child == y.first_child && x.num_children == y.num_children && x.begin == y.begin &&
+                      x.end == y.end && x.num_points == y.num_points && x.depth == y.depth &&
+                      x.leaf_reason == y.leaf_reason && x.leakage == y.leakage && x.variation == y.variation &&
+                      x.max_sigma == y.max_sigma && x.box.axes == y.box.axes && x.box.center == y.box.center &&
+                      x.box.half_extents == y.box.half_extents;
+    differing += same ? 0 : 1;
+  }
+  return differing;
+}
+
+/** \brief BVHParams::noise_stop's condition recomputed from the node's own points: the means'
+  * range along the box's first axis (e3) over the median point standard deviation along it. */
+double
+extentOverMedianSigma (const ProbabilisticBVH& bvh, const Node& node)
+{
+  const Eigen::Vector3d a = node.box.axes.col (0);
+  double lo = std::numeric_limits<double>::infinity (), hi = -lo;
+  std::vector<double> sd;
+  for (int j : distinctPoints (bvh, node))
+  {
+    const double p = a.dot (bvh.means ()[j]);
+    lo = std::min (lo, p);
+    hi = std::max (hi, p);
+    sd.push_back (std::sqrt (bvh.covariances ()[j].quadratic (a)));
+  }
+  std::sort (sd.begin (), sd.end ());
+  return (hi - lo) / sd[sd.size () / 2];
+}
+
 double
 cloudScale (const UncertainCloud& c)
 {
@@ -72,7 +112,15 @@ TEST (BVHParams, DefaultsMatchMethod)
   EXPECT_DOUBLE_EQ (p.sigma_max, 0.05);
   EXPECT_DOUBLE_EQ (p.epsilon, 0.02);
   EXPECT_DOUBLE_EQ (p.k_sigma, 1.0);
+  EXPECT_DOUBLE_EQ (p.noise_stop, 0.0);
+  EXPECT_EQ (p.n_noise_max, 160);
   EXPECT_NO_THROW (p.validate ());
+  BVHParams q;
+  q.noise_stop = 2.0;
+  EXPECT_FALSE (p == q);
+  q = BVHParams ();
+  q.n_noise_max = 80;
+  EXPECT_TRUE (p != q);
 }
 
 TEST (BVHParams, ValidateRejectsEachParameterByName)
@@ -112,6 +160,18 @@ TEST (BVHParams, ValidateRejectsEachParameterByName)
   p = BVHParams ();
   p.k_sigma = std::numeric_limits<double>::infinity ();
   EXPECT_THROW (p.validate (), pcl::BadArgumentException);
+  p = BVHParams ();
+  p.noise_stop = -1.0;
+  EXPECT_NE (message (p).find ("noise_stop -1"), std::string::npos) << message (p);
+  p = BVHParams ();
+  p.noise_stop = std::numeric_limits<double>::quiet_NaN ();
+  EXPECT_NE (message (p).find ("noise_stop"), std::string::npos) << message (p);
+  p = BVHParams ();
+  p.noise_stop = std::numeric_limits<double>::infinity ();
+  EXPECT_NE (message (p).find ("noise_stop"), std::string::npos) << message (p);
+  p = BVHParams ();
+  p.n_noise_max = 0;
+  EXPECT_NE (message (p).find ("n_noise_max 0"), std::string::npos) << message (p);
 }
 
 TEST (ProbabilisticBVH, BadInputThrowsAndKeepsPreviousHierarchy)
@@ -249,6 +309,7 @@ TEST_P (BVHInvariants, Hold)
           EXPECT_LE (m, static_cast<std::size_t> (params.n_min));
           break;
         case ProbabilisticBVH::LeafReason::NoProgress: break;
+        case ProbabilisticBVH::LeafReason::NoiseStop: ADD_FAILURE () << "noise_stop is off"; break;
         case ProbabilisticBVH::LeafReason::NotLeaf: ADD_FAILURE () << "leaf flagged NotLeaf"; break;
       }
       // Random clouds have no coincident projections: every wanted split succeeds.
@@ -677,21 +738,126 @@ TEST (ProbabilisticBVH, AnyThreadCountBuildsTheOneThreadHierarchy)
       EXPECT_EQ (many.pointIndices (), one.pointIndices ()) << threads;
       EXPECT_EQ (many.leafCount (), one.leafCount ());
       EXPECT_EQ (many.depth (), one.depth ());
-      std::size_t differing = 0;
-      for (std::size_t i = 0; i < one.nodes ().size (); ++i)
-      {
-        const Node& a = one.nodes ()[i];
-        const Node& b = many.nodes ()[i];
-        const bool same = a.first_child == b.first_child && a.num_children == b.num_children &&
-                          a.begin == b.begin && a.end == b.end && a.num_points == b.num_points &&
-                          a.depth == b.depth && a.leaf_reason == b.leaf_reason && a.leakage == b.leakage &&
-                          a.variation == b.variation && a.max_sigma == b.max_sigma && a.box.axes == b.box.axes &&
-                          a.box.center == b.box.center && a.box.half_extents == b.box.half_extents;
-        differing += same ? 0 : 1;
-      }
-      EXPECT_EQ (differing, 0u) << "threads " << threads;
+      EXPECT_EQ (differingNodes (one, many), 0u) << "threads " << threads;
     }
   }
   ProbabilisticBVH bvh;
   EXPECT_THROW (bvh.build (cloud, BVHParams (), -1), pcl::BadArgumentException);
+}
+
+// ---------------------------------------------------------------------------------------------
+// BVHParams::noise_stop (issue #17 item 1): no split within the noise
+
+namespace
+{
+std::size_t
+countReason (const ProbabilisticBVH& bvh, ProbabilisticBVH::LeafReason reason)
+{
+  return static_cast<std::size_t> (std::count_if (bvh.nodes ().begin (), bvh.nodes ().end (),
+                                                  [&] (const Node& nd) { return nd.leaf_reason == reason; }));
+}
+} // namespace
+
+// Covariances small against the node sizes: the rule never fires and the hierarchy is the one
+// built without it, node for node.
+TEST (ProbabilisticBVH, NoiseStopLeavesALowNoiseHierarchyUnchanged)
+{
+  for (const auto style : {BVHParams::SplitStyle::Pca, BVHParams::SplitStyle::Octree})
+  {
+    const UncertainCloud cloud = shapeCloud (Shape::Sphere, 10000, 31, 0.002);
+    BVHParams params;
+    params.split_style = style;
+    const ProbabilisticBVH off (cloud, params);
+    params.noise_stop = 4.0;
+    const ProbabilisticBVH on (cloud, params);
+    ASSERT_GT (off.nodes ().size (), 500u);
+    EXPECT_EQ (countReason (on, ProbabilisticBVH::LeafReason::NoiseStop), 0u);
+    EXPECT_EQ (differingNodes (off, on), 0u);
+    EXPECT_EQ (on.pointIndices (), off.pointIndices ());
+  }
+}
+
+// The same means with covariances as wide as a 160-point node: the rule keeps such nodes whole,
+// exactly where its condition holds, and leaves fewer, never larger than n_noise_max.
+TEST (ProbabilisticBVH, NoiseStopKeepsNodesWithinTheNoiseWhole)
+{
+  for (const auto style : {BVHParams::SplitStyle::Pca, BVHParams::SplitStyle::Octree})
+  {
+    SCOPED_TRACE (style == BVHParams::SplitStyle::Pca ? "Pca" : "Octree");
+    const UncertainCloud cloud = shapeCloud (Shape::Sphere, 10000, 31, 0.2);
+    BVHParams params;
+    params.split_style = style;
+    const ProbabilisticBVH off (cloud, params);
+    params.noise_stop = 4.0;
+    const ProbabilisticBVH on (cloud, params);
+    EXPECT_GT (countReason (on, ProbabilisticBVH::LeafReason::NoiseStop), 0u);
+    EXPECT_LT (on.leafCount (), off.leafCount () / 2);
+    EXPECT_LT (on.nodes ().size (), off.nodes ().size () / 2);
+    std::vector<int> covered (cloud.size (), 0);
+    for (const Node& nd : on.nodes ())
+    {
+      if (nd.isLeaf ())
+      {
+        EXPECT_LE (nd.num_points, params.n_noise_max);
+        for (int j : on.indices (nd))
+          covered[static_cast<std::size_t> (j)] = 1;
+      }
+      if (nd.leaf_reason == ProbabilisticBVH::LeafReason::NoiseStop)
+      {
+        EXPECT_GT (nd.num_points, params.n_min);
+        EXPECT_LE (extentOverMedianSigma (on, nd), params.noise_stop * (1.0 + 1e-9));
+      }
+      // An internal node the rule could have kept whole was beyond the noise.
+      if (!nd.isLeaf () && nd.num_points <= params.n_noise_max)
+      {
+        EXPECT_GT (extentOverMedianSigma (on, nd), params.noise_stop * (1.0 - 1e-9));
+      }
+    }
+    EXPECT_EQ (std::count (covered.begin (), covered.end (), 1), static_cast<std::ptrdiff_t> (cloud.size ()));
+
+    // A lower cap: more leaves, none above it.
+    params.n_noise_max = 40;
+    const ProbabilisticBVH capped (cloud, params);
+    EXPECT_GT (countReason (capped, ProbabilisticBVH::LeafReason::NoiseStop), 0u);
+    EXPECT_GT (capped.leafCount (), on.leafCount ());
+    for (const Node& nd : capped.nodes ())
+    {
+      if (nd.isLeaf ())
+      {
+        EXPECT_LE (nd.num_points, 40);
+      }
+    }
+  }
+}
+
+// The rule is decided where every split is (makeNode), so the threaded build agrees with the
+// serial one when it fires.
+TEST (ProbabilisticBVH, NoiseStopBuildsTheSameHierarchyOnAnyThreadCount)
+{
+  const UncertainCloud cloud = shapeCloud (Shape::Sphere, 40000, 93, 0.1);
+  // Small leaves, kept whole inside the subtrees built whole; then leaves of several thousand
+  // points, kept whole among the top levels made in parallel (above 4,096 or 5,000 points).
+  BVHParams small, large;
+  small.noise_stop = 4.0;
+  large.noise_stop = 12.0;
+  large.n_noise_max = 40000;
+  for (const BVHParams& params : {small, large})
+  {
+    const ProbabilisticBVH one (cloud, params, 1);
+    ASSERT_GT (countReason (one, ProbabilisticBVH::LeafReason::NoiseStop), 4u);
+    std::int32_t largest = 0;
+    for (const Node& nd : one.nodes ())
+      if (nd.leaf_reason == ProbabilisticBVH::LeafReason::NoiseStop)
+        largest = std::max (largest, nd.num_points);
+    if (params.n_noise_max == 40000)
+    {
+      EXPECT_GT (largest, 5000);
+    }
+    for (const int threads : {2, 3, 0})
+    {
+      const ProbabilisticBVH many (cloud, params, threads);
+      EXPECT_EQ (many.pointIndices (), one.pointIndices ()) << threads;
+      EXPECT_EQ (differingNodes (one, many), 0u) << "threads " << threads << ", noise_stop " << params.noise_stop;
+    }
+  }
 }

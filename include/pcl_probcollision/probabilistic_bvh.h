@@ -46,6 +46,17 @@ struct BVHParams
   double k_sigma = 1.0;
   /** \brief MinSlab (default, METHOD.md 8.4) or the UnionBound variant. */
   LeakageBound leakage_bound = LeakageBound::MinSlab;
+  /** \brief Resolution tied to the noise (issue #17 item 1): a node of at most n_noise_max
+    * points whose extent along its longest principal axis e3 (the means' range) is at most
+    * noise_stop times the median standard deviation of its points along e3 is not split: its
+    * halves would lie within about noise_stop / 2 point sigmas of each other, closer than the
+    * noise can tell apart. In point standard deviations, finite and >= 0; 0 (default) is off.
+    * Checked after the n_max / sigma_max and n_min rules, so it only turns would-be splits into
+    * leaves (LeafReason::NoiseStop). */
+  double noise_stop = 0.0;
+  /** \brief Largest node that noise_stop may keep whole (>= 1): bounds the points of a leaf,
+    * hence the cost of one leaf test. Default 160 (8 times the default n_max). */
+  int n_noise_max = 160;
 
   /** \brief Throws pcl::BadArgumentException naming the first parameter out of range and its
     * value. */
@@ -56,7 +67,7 @@ struct BVHParams
   {
     return split_style == o.split_style && n_max == o.n_max && n_min == o.n_min &&
            sigma_max == o.sigma_max && epsilon == o.epsilon && k_sigma == o.k_sigma &&
-           leakage_bound == o.leakage_bound;
+           leakage_bound == o.leakage_bound && noise_stop == o.noise_stop && n_noise_max == o.n_noise_max;
   }
   /** \brief Member-wise inequality. */
   bool operator!= (const BVHParams& o) const { return !(*this == o); }
@@ -93,7 +104,8 @@ public:
     NotLeaf,    ///< internal node
     StopRule,   ///< m <= n_max and variation <= sigma_max
     MinSize,    ///< the stop rule failed but m <= n_min
-    NoProgress  ///< a split was wanted but could not separate the points (METHOD.md 8.2 guard)
+    NoProgress, ///< a split was wanted but could not separate the points (METHOD.md 8.2 guard)
+    NoiseStop   ///< a split was wanted but the node is within the noise (BVHParams::noise_stop)
   };
 
   /** \brief One node. Children of a node are stored contiguously. */
