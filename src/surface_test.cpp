@@ -741,6 +741,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   params.expanded_k_sigma = kReachSigmas;
   params.exhaustive = true;
   params.skip_dominated = false;
+  params.nearest_first = false;  // every pair is enumerated: the order is of no use here
   params.box_margin = std::max (a.surface ().medianSpacing (), b.surface ().medianSpacing ());
   auto& pairs = scratch.pairs;
   pairs.clear ();

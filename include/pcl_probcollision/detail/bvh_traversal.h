@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace pcl_probcollision
@@ -60,6 +61,10 @@ struct TraversalParams
   bool skip_dominated = false;
   /** \brief Stop before the leaf test that would exceed this many (0 = no cap). */
   std::size_t max_leaf_tests = 0;
+  /** \brief Visit an opened node's children nearest the other node first (default), else in
+    * storage order. Only the order of the leaf tests changes; a traversal that visits every
+    * pair (the surface layer's enumeration) gains nothing from it. */
+  bool nearest_first = true;
 
   /** \brief Throws pcl::BadArgumentException naming the first parameter out of range. */
   void
@@ -300,17 +305,23 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
     {
       const Eigen::Vector3d other = T_a_b * nb.box.center;
       for (std::int32_t c = na.first_child + na.num_children; c-- > na.first_child;)
-        stack.push_back ({c, e.b, rho, (nodes_a[static_cast<std::size_t> (c)].box.center - other).squaredNorm ()});
+        stack.push_back ({c, e.b, rho,
+                          params.nearest_first ? (nodes_a[static_cast<std::size_t> (c)].box.center - other).squaredNorm () : 0.0});
     }
     else
     {
       const Eigen::Vector3d other = T_b_a * na.box.center;
       for (std::int32_t c = nb.first_child + nb.num_children; c-- > nb.first_child;)
-        stack.push_back ({e.a, c, rho, (nodes_b[static_cast<std::size_t> (c)].box.center - other).squaredNorm ()});
+        stack.push_back ({e.a, c, rho,
+                          params.nearest_first ? (nodes_b[static_cast<std::size_t> (c)].box.center - other).squaredNorm () : 0.0});
     }
-    // Farthest pushed first, nearest popped first; ties keep the first child on top.
-    std::stable_sort (stack.begin () + static_cast<std::ptrdiff_t> (first), stack.end (),
-                      [] (const Entry& x, const Entry& y) { return x.distance > y.distance; });
+    // Farthest pushed first, nearest popped first; ties keep the first child on top. An
+    // insertion sort (stable, at most eight entries, no allocation: std::stable_sort asks for
+    // a buffer on every call).
+    if (params.nearest_first)
+      for (std::size_t i = first + 1; i < stack.size (); ++i)
+        for (std::size_t j = i; j > first && stack[j - 1].distance < stack[j].distance; --j)
+          std::swap (stack[j - 1], stack[j]);
   }
 
   if (result.max_node_a >= 0)
