@@ -1336,7 +1336,7 @@ numbers (const std::vector<std::string>& items)
   return out;
 }
 
-/** \brief The values > 0 (a 0 in --merge, --gate or --stop leaves those settings out). */
+/** \brief The values > 0 (a 0 in --merge, --gate, --stop or --cap leaves those settings out). */
 std::vector<double>
 positive (std::vector<double> values)
 {

@@ -24,8 +24,9 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
   -measured -deterministic -stochastic -seed -exhaustive -max_leaf_fits -noise_resolution -surface
-  -surface_pooled -ignore_normals -nmax -sigma_max -epsilon -split -mesh_density -json (accepted; the output is always JSON lines) -v. A value is the next argument
-  or follows '='. -surface (experimental) adds the signed distance between the surfaces.
+  -surface_pooled -ignore_normals -nmax -sigma_max -epsilon -split -mesh_density -json (accepted;
+  the output is always JSON lines) -v. A value is the next argument or follows '='. -surface
+  (experimental) adds the signed distance between the surfaces.
 """
 
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
