@@ -762,6 +762,10 @@ PYBIND11_MODULE (_core, m)
                      [] (CloudModelParams& p, double v) { p.hierarchy.epsilon = v; })
       .def_property ("k_sigma", [] (const CloudModelParams& p) { return p.hierarchy.k_sigma; },
                      [] (CloudModelParams& p, double v) { p.hierarchy.k_sigma = v; })
+      .def_property ("noise_stop", [] (const CloudModelParams& p) { return p.hierarchy.noise_stop; },
+                     [] (CloudModelParams& p, double v) { p.hierarchy.noise_stop = v; },
+                     "Do not split a hierarchy node of at most n_noise_max (160) points whose extent is within\n"
+                     "noise_stop noise standard deviations (BVHParams::noise_stop); default 0: off.")
       .def_property ("split",
                      [] (const CloudModelParams& p) {
                        return std::string (p.hierarchy.split_style == BVHParams::SplitStyle::Octree ? "octree" : "pca");

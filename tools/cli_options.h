@@ -42,6 +42,8 @@ struct Defaults
   static inline const bool exhaustive = request.exhaustive;
   static inline const std::size_t max_leaf_fits = request.max_leaf_fits;
   static inline const double noise_resolution = model.noise_resolution;
+  static inline const double noise_stop = model.hierarchy.noise_stop;
+  static inline const int n_noise_max = model.hierarchy.n_noise_max;
   static inline const bool surface = request.surface;
   static inline const bool surface_pooled = request.surface_pooled;
   static inline const bool measured = !model.surface_projection;
@@ -98,6 +100,8 @@ struct Options
   std::size_t max_leaf_fits = Defaults::max_leaf_fits;
   /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging). */
   double noise_resolution = Defaults::noise_resolution;
+  /** \brief -noise_stop C: BVHParams::noise_stop (0 = off). */
+  double noise_stop = Defaults::noise_stop;
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;

@@ -252,6 +252,7 @@ modelParamsFor (const Options& o)
   m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
                                                 : pcl_probcollision::BVHParams::SplitStyle::Pca;
   m.hierarchy.n_max = o.n_max;
+  m.hierarchy.noise_stop = o.noise_stop;
   m.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
   m.hierarchy.sigma_max = o.sigma_max;
   m.hierarchy.epsilon = o.epsilon;
@@ -362,6 +363,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("exhaustive").boolean (rq.exhaustive);
   j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
   j.key ("noise_resolution").number (o.noise_resolution);
+  j.key ("noise_stop").number (o.noise_stop);
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;

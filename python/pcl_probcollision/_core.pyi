@@ -60,6 +60,7 @@ class CloudModelParams:
     orientation: NormalOrientation
     noise_resolution: float
     noise_resolution_gated: bool
+    noise_stop: float
     threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,

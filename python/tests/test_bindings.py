@@ -58,6 +58,7 @@ def test_defaults_are_the_cpp_defaults():
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
     assert p.surface is False and p.orientation == pc.NormalOrientation.Auto
     assert p.noise_resolution == 0.0
+    assert p.noise_stop == 0.0
     assert p.noise_resolution_gated is False
     p.noise_resolution_gated = True
     assert p.noise_resolution_gated is True
@@ -569,3 +570,19 @@ def test_cmake_install_gives_an_importable_package(tmp_path):
                          env=env, check=True, capture_output=True, text=True, cwd=tmp_path).stdout.split("\n")
     assert out[0].startswith(str(site))
     assert out[1] in ("Verdict.InContact", "Verdict.InCollision")
+
+
+def test_noise_stop_keeps_nodes_within_the_noise_whole(table_points, gripper_patch):
+    # BVHParams::noise_stop through CloudModelParams: the table's 5 mm noise on 3-4 mm spacing
+    # leaves nodes within 20 sigmas unsplit, so the hierarchy is smaller and a query tests fewer boxes.
+    params = pc.CloudModelParams(noise=NOISE.noise)
+    stopped_params = pc.CloudModelParams(noise=NOISE.noise)
+    stopped_params.noise_stop = 20.0
+    assert stopped_params.noise_stop == 20.0
+    plain, stopped = pc.build_model(table_points, params=params), pc.build_model(table_points, params=stopped_params)
+    assert stopped.size == plain.size and stopped.bytes < plain.bytes
+    T = translation(0.1, 0.1, 0.004)
+    assert pc.collide(stopped, gripper_patch, T).bv_tests < pc.collide(plain, gripper_patch, T).bv_tests
+    stopped_params.noise_stop = -1.0
+    with pytest.raises(ValueError, match="noise_stop"):
+        pc.build_model(table_points, params=stopped_params)

@@ -62,6 +62,8 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (o.noise_resolution, 0.0);    // no merging
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
+  EXPECT_EQ (o.noise_stop, 0.0);  // every node split as the hierarchy's rules say
+  EXPECT_EQ (parse ({"-noise_stop", "2"}).options.noise_stop, 2.0);
   EXPECT_FALSE (o.surface_pooled);
   EXPECT_FALSE (o.ignore_normals);
   EXPECT_FALSE (o.mesh_spacing);
@@ -163,6 +165,8 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
   expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");
   expectUsageError ({"-noise_resolution", "inf"}, "-noise_resolution");
+  expectUsageError ({"-noise_stop", "-0.5"}, "-noise_stop");
+  expectUsageError ({"-noise_stop", "nan"}, "-noise_stop");
 }
 
 TEST (CliOptions, FlagsAndPositionals)

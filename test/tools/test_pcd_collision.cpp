@@ -405,8 +405,9 @@ TEST_F (PcdCollisionTool, DemoPosesVerdicts)
 }
 
 // -max_leaf_fits N caps the fits of a query (budget_exhausted, P a lower bound: P >= in the human
-// line with its marker); -noise_resolution C merges samples (fewer model points). Both are in
-// the JSON parameters.
+// line with its marker); -noise_resolution C merges samples (fewer model points); -noise_stop C
+// keeps nodes within C noise sigmas whole (fewer, larger leaves: fewer box tests). All are in the
+// JSON parameters.
 TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
 {
   const auto plain = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string ()});
@@ -441,6 +442,19 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_EQ (merged[0]["parameters"]["noise_resolution"].number, 3.0);
   EXPECT_LT (merged[0]["points_b"].number, static_cast<double> (kScenePoints));
   EXPECT_GT (merged[0]["points_b"].number, 0.0);
+
+  // The demo's table is 5 mm noise on 3-4 mm spacing: at C = 20 most of it stays in whole nodes.
+  const auto stopped = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-noise_stop", "20"});
+  ASSERT_EQ (stopped.size (), plain.size ());
+  std::size_t fewer = 0;
+  for (std::size_t i = 0; i < stopped.size (); ++i)
+  {
+    EXPECT_EQ (plain[i]["parameters"]["noise_stop"].number, 0.0);
+    EXPECT_EQ (stopped[i]["parameters"]["noise_stop"].number, 20.0);
+    EXPECT_LE (stopped[i]["bv_tests"].number, plain[i]["bv_tests"].number) << i;
+    fewer += stopped[i]["bv_tests"].number < plain[i]["bv_tests"].number;
+  }
+  EXPECT_GT (fewer, 0u) << "-noise_stop 20 changed no hierarchy the demo's poses reach";
 }
 
 TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)

@@ -55,6 +55,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "max_leaf_fits": _REQUEST.max_leaf_fits,
     # Samples closer than this many noise sigmas merged into one (0: none).
     "noise_resolution": _MODEL.noise_resolution,
+    # A hierarchy node of at most 160 points within this many noise sigmas is not split (0: off).
+    "noise_stop": _MODEL.noise_stop,
     # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
     # their faces, clouds by their viewpoint or by propagation) and signed_distance is filled.
     "surface": _REQUEST.surface,
@@ -128,6 +130,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
                               epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
     p.split = o["split"]
     p.noise_resolution = float(o["noise_resolution"])
+    p.noise_stop = float(o["noise_stop"])
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
     return p
@@ -252,7 +255,7 @@ _builds = collections.Counter()  # models built in this process, by token (tests
 
 
 def _params_key(o: Dict[str, Any], side: str, exact: bool) -> tuple:
-    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface", "noise_resolution")
+    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface", "noise_resolution", "noise_stop")
     noise = () if exact else (o["sensor_" + side], float(o["sigma_" + side]))
     return tuple(o[k] for k in keys) + noise
 
