@@ -41,7 +41,7 @@ const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
   "-noise_stop", "-max_leaf_fits"};
-const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-json",
+const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-ignore_normals", "-v"};
 
 ParseResult
@@ -284,6 +284,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.measured = true;
       else if (a == "-exhaustive")
         o.exhaustive = true;
+      else if (a == "-defer_kernel_fits")
+        o.defer_kernel_fits = true;
       else if (a == "-surface")
         o.surface = true;
       else if (a == "-surface_pooled")
@@ -546,6 +548,9 @@ helpText ()
     << D::seed
     << "       seed of the stochastic traversal\n"
        "  -exhaustive     visit every reachable leaf pair (no early stop; P is then exact, not a bound)\n"
+       "  -defer_kernel_fits  fit every reached leaf pair's plane before any kernel rung: the same\n"
+       "                  verdicts, queries about twice as fast; a collision's P (a lower bound)\n"
+       "                  may be lower\n"
        "  -max_leaf_fits N   = "
     << D::max_leaf_fits
     << "   at most N leaf pairs fitted a query, nearest first (0: no cap); a capped\n"

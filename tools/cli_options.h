@@ -40,6 +40,7 @@ struct Defaults
   static inline const std::uint64_t seed = request.seed;
   static inline const bool stochastic = request.traversal == pcl_probcollision::TraversalMode::Stochastic;
   static inline const bool exhaustive = request.exhaustive;
+  static inline const bool defer_kernel_fits = request.defer_kernel_fits;
   static inline const std::size_t max_leaf_fits = request.max_leaf_fits;
   static inline const double noise_resolution = model.noise_resolution;
   static inline const double noise_stop = model.hierarchy.noise_stop;
@@ -96,6 +97,8 @@ struct Options
   /** \brief -measured: surface projection off (CloudModelParams::surface_projection). */
   bool measured = Defaults::measured;
   bool exhaustive = Defaults::exhaustive;
+  /** \brief -defer_kernel_fits: CollisionRequest::defer_kernel_fits. */
+  bool defer_kernel_fits = Defaults::defer_kernel_fits;
   /** \brief -max_leaf_fits N: CollisionRequest::max_leaf_fits (0 = no cap). */
   std::size_t max_leaf_fits = Defaults::max_leaf_fits;
   /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging). */

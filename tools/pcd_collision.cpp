@@ -230,6 +230,7 @@ requestFor (const Options& o)
   r.collision_above = o.collision_above;
   r.exhaustive = o.exhaustive || o.output.has_value ();
   r.max_leaf_fits = o.max_leaf_fits;
+  r.defer_kernel_fits = o.defer_kernel_fits;
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
   r.per_point = o.output.has_value ();
@@ -361,6 +362,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("positions").string (o.measured ? "measured" : "projected");
   j.key ("seed").unsignedInteger (o.seed);
   j.key ("exhaustive").boolean (rq.exhaustive);
+  j.key ("defer_kernel_fits").boolean (rq.defer_kernel_fits);
   j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
   j.key ("noise_resolution").number (o.noise_resolution);
   j.key ("noise_stop").number (o.noise_stop);

@@ -63,6 +63,8 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_EQ (o.noise_stop, 0.0);  // every node split as the hierarchy's rules say
+  EXPECT_FALSE (o.defer_kernel_fits);
+  EXPECT_TRUE (parse ({"-defer_kernel_fits"}).options.defer_kernel_fits);
   EXPECT_EQ (parse ({"-noise_stop", "2"}).options.noise_stop, 2.0);
   EXPECT_FALSE (o.surface_pooled);
   EXPECT_FALSE (o.ignore_normals);

@@ -455,6 +455,21 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
     fewer += stopped[i]["bv_tests"].number < plain[i]["bv_tests"].number;
   }
   EXPECT_GT (fewer, 0u) << "-noise_stop 20 changed no hierarchy the demo's poses reach";
+
+  // -defer_kernel_fits: the same verdicts, and the same P where the query did not stop early.
+  const auto deferred = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-defer_kernel_fits"});
+  ASSERT_EQ (deferred.size (), plain.size ());
+  double kernel_pairs = 0.0;
+  for (std::size_t i = 0; i < deferred.size (); ++i)
+  {
+    EXPECT_FALSE (plain[i]["parameters"]["defer_kernel_fits"].boolean);
+    EXPECT_TRUE (deferred[i]["parameters"]["defer_kernel_fits"].boolean);
+    EXPECT_EQ (deferred[i]["verdict"].text, plain[i]["verdict"].text) << i;
+    if (!plain[i]["lower_bound"].boolean && !deferred[i]["lower_bound"].boolean)
+      EXPECT_EQ (deferred[i]["probability"].number, plain[i]["probability"].number) << i;
+    kernel_pairs += deferred[i]["kernel_leaf_pairs"].number;
+  }
+  EXPECT_GT (kernel_pairs, 0.0) << "no demo pose needed a kernel rung: nothing was deferred";
 }
 
 TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)

@@ -51,6 +51,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "stochastic": _REQUEST.traversal == core.TraversalMode.Stochastic,
     "seed": _REQUEST.seed,
     "exhaustive": _REQUEST.exhaustive,
+    # Every reached leaf pair's plane before any kernel rung (the same verdicts, faster).
+    "defer_kernel_fits": _REQUEST.defer_kernel_fits,
     # At most this many leaf pairs fitted a query, nearest first (0: no cap).
     "max_leaf_fits": _REQUEST.max_leaf_fits,
     # Samples closer than this many noise sigmas merged into one (0: none).
@@ -142,7 +144,8 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         free_below=o["thresholds"][0], collision_above=o["thresholds"][1], exhaustive=bool(o["exhaustive"]),
         per_point=False, enable_timings=True,
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
-        seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), surface=bool(o["surface"]),
+        seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), defer_kernel_fits=bool(o["defer_kernel_fits"]),
+        surface=bool(o["surface"]),
         surface_pooled=bool(o["surface_pooled"]))
 
 
@@ -414,7 +417,7 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     client: a distributed.Client; None = the default client if there is one, else this process.
     chunk_size: poses per task (default: about 8 tasks per worker thread, 32 to 2000 poses).
     options: pcd_collision's flags without the dash (sensor, sensor_a, sensor_b, sigma, sigma_a,
-        sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, surface, nmax,
+        sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, defer_kernel_fits, surface, nmax,
         sigma_max, epsilon, split, mesh_density, ignore_normals) and threads (collide_batch threads per task).
         surface=True is pcd_collision's -surface: both models get the oriented surface (meshes
         by their faces' normals, a cloud file with normal_x normal_y normal_z by them unless
