@@ -24,7 +24,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <condition_variable>
+#include <deque>
+#include <exception>
 #include <fstream>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -635,22 +639,24 @@ run (int argc, char** argv)
   // pose order as soon as it is done: answers stream, and a chunk's slowest pose idles the
   // other threads only briefly. Which thread answers a pose changes nothing in its answer.
   const unsigned workers = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
-  const std::size_t chunk = std::size_t{16} * workers;
-  std::vector<Eigen::Isometry3d> chunk_poses;
-  std::vector<pcl_probcollision::CollisionResult> chunk_results;
-  for (std::size_t i = 0; i < poses.size (); ++i)
+  const std::size_t chunk = std::size_t{64} * workers;
+  using Results = std::vector<pcl_probcollision::CollisionResult>;
+  struct Chunk
   {
-    const std::size_t k = i % chunk;
-    if (k == 0)
-    {
-      const std::size_t end = std::min (poses.size (), i + chunk);
-      chunk_poses.clear ();
-      for (std::size_t j = i; j < end; ++j)
-        chunk_poses.push_back (toIsometry (poses[j]));
-      pc.computeBatch (chunk_poses, chunk_results, static_cast<int> (workers));
-    }
-    const Eigen::Isometry3d& T = chunk_poses[k];
-    pcl_probcollision::CollisionResult& result = chunk_results[k];
+    std::size_t start = 0;
+    std::vector<Eigen::Isometry3d> T;
+    Results results;
+  };
+  auto answer = [&] (std::size_t start) {
+    Chunk c;
+    c.start = start;
+    for (std::size_t j = start; j < std::min (poses.size (), start + chunk); ++j)
+      c.T.push_back (toIsometry (poses[j]));
+    pc.computeBatch (c.T, c.results, static_cast<int> (workers));
+    return c;
+  };
+  // Prints pose i (k-th of its chunk) and its answer; throws Failure for a failed query.
+  auto emit = [&] (std::size_t i, std::size_t k, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
     if (!result.ok () || shares_terminal)
       progress.clear ();
     if (!result.ok ())
@@ -715,6 +721,84 @@ run (int argc, char** argv)
       std::fprintf (log, "Writing %s [done, %.1f ms : %zu points, a then b, fields x y z intensity rgb label]\n",
                     o.output->c_str (), *write_ms, written);
     progress.show (i + 1);
+  };
+  if (!batch || workers < 2)
+  {
+    for (std::size_t start = 0; start < poses.size (); start += chunk)
+    {
+      Chunk c = answer (start);
+      for (std::size_t k = 0; k < c.T.size (); ++k)
+        emit (start + k, k, c.T[k], c.results[k]);
+    }
+  }
+  else
+  {
+    // With several threads, printing (formatting the answers: a few percent of a batch of the
+    // separators) runs on a thread of its own while the next chunk is answered; the calling
+    // thread keeps answering, as with one chunk at a time. Lines come out in the same order.
+    std::mutex mutex;
+    std::condition_variable ready;
+    std::deque<Chunk> queue;
+    bool finished = false, failed = false;
+    std::exception_ptr error;
+    std::thread printer ([&] {
+      try
+      {
+        for (;;)
+        {
+          Chunk c;
+          {
+            std::unique_lock<std::mutex> lock (mutex);
+            ready.wait (lock, [&] { return !queue.empty () || finished; });
+            if (queue.empty ())
+              return;
+            c = std::move (queue.front ());
+            queue.pop_front ();
+          }
+          for (std::size_t k = 0; k < c.T.size (); ++k)
+            emit (c.start + k, k, c.T[k], c.results[k]);
+        }
+      }
+      catch (...)
+      {
+        const std::lock_guard<std::mutex> lock (mutex);
+        error = std::current_exception ();
+        failed = true;
+      }
+    });
+    auto finish = [&] {
+      {
+        const std::lock_guard<std::mutex> lock (mutex);
+        finished = true;
+      }
+      ready.notify_one ();
+      printer.join ();
+    };
+    try
+    {
+      for (std::size_t start = 0; start < poses.size (); start += chunk)
+      {
+        {
+          const std::lock_guard<std::mutex> lock (mutex);
+          if (failed)
+            break;  // the printer stopped at a failed query: answer no more
+        }
+        Chunk c = answer (start);
+        {
+          const std::lock_guard<std::mutex> lock (mutex);
+          queue.push_back (std::move (c));
+        }
+        ready.notify_one ();
+      }
+    }
+    catch (...)
+    {
+      finish ();
+      throw;
+    }
+    finish ();
+    if (error)
+      std::rethrow_exception (error);
   }
   progress.clear ();
   return 0;

@@ -466,7 +466,9 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
     EXPECT_TRUE (deferred[i]["parameters"]["defer_kernel_fits"].boolean);
     EXPECT_EQ (deferred[i]["verdict"].text, plain[i]["verdict"].text) << i;
     if (!plain[i]["lower_bound"].boolean && !deferred[i]["lower_bound"].boolean)
+    {
       EXPECT_EQ (deferred[i]["probability"].number, plain[i]["probability"].number) << i;
+    }
     kernel_pairs += deferred[i]["kernel_leaf_pairs"].number;
   }
   EXPECT_GT (kernel_pairs, 0.0) << "no demo pose needed a kernel rung: nothing was deferred";
@@ -504,12 +506,13 @@ TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)
     EXPECT_EQ (batch[i]["build_ms"].number, 0.0) << i;
 }
 
-// -threads: every line the same as one thread's, in pose order, timings aside; 2 threads answer
-// in chunks of 32 poses, so 45 poses cross a chunk boundary.
+// -threads: every line the same as one thread's, in pose order, timings aside; n threads answer
+// in chunks of 64 n poses (printed on a thread of their own while the next chunk is answered),
+// so 300 poses cross chunk boundaries for 1 to 3 threads.
 TEST_F (PcdCollisionTool, ThreadsGiveOneThreadsOutputInPoseOrder)
 {
   std::ostringstream poses;
-  for (int i = 0; i < 45; ++i)
+  for (int i = 0; i < 300; ++i)
     poses << -0.15 + 0.01 * (i % 7) << " 0.05 " << 0.25 - 0.006 * i << " " << 0.02 * (i % 5) << " 0 " << 0.1 * i << "\n";
   writeFile (dir_ / "poses.txt", poses.str ());
   // The timing members and the human line's timings are the only parts allowed to differ.
@@ -529,7 +532,7 @@ TEST_F (PcdCollisionTool, ThreadsGiveOneThreadsOutputInPoseOrder)
   for (const bool json : {true, false})
   {
     const std::vector<std::string> one = answers ("1", json);
-    ASSERT_EQ (one.size (), 45u);
+    ASSERT_EQ (one.size (), 300u);
     for (const char* threads : {"2", "3", "0"})
       EXPECT_EQ (answers (threads, json), one) << "-threads " << threads << (json ? " -json" : "");
     if (!json)
@@ -542,6 +545,24 @@ TEST_F (PcdCollisionTool, ThreadsGiveOneThreadsOutputInPoseOrder)
       EXPECT_EQ (v.object.count ("query_ms"), 0u);
       EXPECT_EQ (v.object.count ("timings_ms"), 0u);
     }
+  }
+}
+
+// A query that fails mid-batch stops the run at its line with any thread count: the lines before
+// it printed, none after, exit status 1, the pose named by its index in the file.
+TEST_F (PcdCollisionTool, AFailedQueryStopsTheBatchAtItsLine)
+{
+  std::ostringstream poses;
+  for (int i = 0; i < 200; ++i)
+    poses << (i == 150 ? "1e300 0 0 0 0 0" : "0.1 0 0.25 0 0 " + std::to_string (0.01 * i)) << "\n";
+  writeFile (dir_ / "poses.txt", poses.str ());
+  for (const char* threads : {"1", "2"})
+  {
+    const ToolRun r = run ({kGripper.string (), kScene.string (), "-poses", (dir_ / "poses.txt").string (), "-json",
+                            "-threads", threads});
+    EXPECT_EQ (r.status, 1) << "-threads " << threads;
+    EXPECT_EQ (lines (r.out).size (), 150u) << "-threads " << threads;
+    EXPECT_NE (r.err.find ("pose 150: query failed"), std::string::npos) << r.err;
   }
 }
 
