@@ -21,12 +21,12 @@
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <condition_variable>
 #include <deque>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -739,8 +739,8 @@ run (int argc, char** argv)
     std::mutex mutex;
     std::condition_variable ready;
     std::deque<Chunk> queue;
-    bool finished = false, failed = false;
-    std::exception_ptr error;
+    bool finished = false;
+    std::exception_ptr error;  // set by the printer when it stops at a failed query
     std::thread printer ([&] {
       try
       {
@@ -763,7 +763,6 @@ run (int argc, char** argv)
       {
         const std::lock_guard<std::mutex> lock (mutex);
         error = std::current_exception ();
-        failed = true;
       }
     });
     auto finish = [&] {
@@ -780,7 +779,7 @@ run (int argc, char** argv)
       {
         {
           const std::lock_guard<std::mutex> lock (mutex);
-          if (failed)
+          if (error)
             break;  // the printer stopped at a failed query: answer no more
         }
         Chunk c = answer (start);
