@@ -123,7 +123,7 @@ CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
   const std::size_t stride = std::max<std::size_t> (1, covs.size () / 1000);
   std::vector<double> sigmas;
   for (std::size_t i = 0; i < covs.size (); i += stride)
-    sigmas.push_back (std::sqrt (std::max (0.0, (covs[i].xx + covs[i].yy + covs[i].zz) / 3.0)));
+    sigmas.push_back (std::sqrt (std::max (0.0, (double (covs[i].xx) + covs[i].yy + covs[i].zz) / 3.0)));
   std::nth_element (sigmas.begin (), sigmas.begin () + sigmas.size () / 2, sigmas.end ());
   const double sigma = sigmas.empty () ? 0.0 : sigmas[sigmas.size () / 2];
   const float top = static_cast<float> (max_abs_coordinate);

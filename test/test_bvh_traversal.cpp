@@ -509,7 +509,9 @@ TEST (BVHTraversal, PoseEqualsPretransformedRebuild)
     GaussianPairLeafTest l1 (a, b, T, 0.01), l2 (a, b_moved, I, 0.01);
     const TraversalResult r1 = detail::traverseHierarchies (a, b, T, tp, l1);
     const TraversalResult r2 = detail::traverseHierarchies (a, b_moved, I, tp, l2);
-    EXPECT_NEAR (r1.probability, r2.probability, 1e-9) << "trial " << trial;
+    // The moved cloud's covariances are rotated and then stored as float (relative error
+    // 2^-24), so the two agree to about 1e-7, not to rounding.
+    EXPECT_NEAR (r1.probability, r2.probability, 1e-6) << "trial " << trial;
     EXPECT_EQ (r1.probability > 0.5, r2.probability > 0.5);
     EXPECT_EQ (r1.leaf_pairs_tested, r2.leaf_pairs_tested);
     EXPECT_EQ (r1.disjoint_pairs, r2.disjoint_pairs);
@@ -525,7 +527,7 @@ TEST (BVHTraversal, PoseEqualsPretransformedRebuild)
     std::sort (leak.begin (), leak.end ());
     std::sort (leak_moved.begin (), leak_moved.end ());
     for (std::size_t i = 0; i < leak.size (); ++i)
-      EXPECT_NEAR (leak[i], leak_moved[i], 1e-9);
+      EXPECT_NEAR (leak[i], leak_moved[i], 1e-6);
     collisions += r1.probability > 0.5;
   }
   EXPECT_GT (collisions, 0);

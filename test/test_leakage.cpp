@@ -82,14 +82,16 @@ TEST (Leakage, SinglePointNodeOracle)
 {
   // One point, isotropic sigma, box inflated by k_sigma = 1: the point sits at the centre of a
   // cube of half extent sigma, so leakage = 1 - (Phi(1) - Phi(-1)) = 2 Phi(-1) = 0.317311.
+  // sigma = 2^-7, so that the variance is exact in the float the hierarchy keeps.
+  constexpr double sigma = 0x1p-7;
   UncertainCloud c;
   c.means.push_back (Eigen::Vector3d (1, 2, 3));
-  c.covariances.push_back (Eigen::Matrix3d::Identity () * 1e-4);
+  c.covariances.push_back (Eigen::Matrix3d::Identity () * sigma * sigma);
   ProbabilisticBVH bvh (c);
   ASSERT_EQ (bvh.nodes ().size (), 1u);
   EXPECT_NEAR (bvh.node (0).leakage, 2.0 * Phi (-1.0), 1e-12);
-  EXPECT_NEAR (bvh.node (0).box.half_extents.maxCoeff (), 0.01, 1e-12);
-  EXPECT_NEAR (bvh.node (0).box.half_extents.minCoeff (), 0.01, 1e-12);
+  EXPECT_NEAR (bvh.node (0).box.half_extents.maxCoeff (), sigma, 1e-12);
+  EXPECT_NEAR (bvh.node (0).box.half_extents.minCoeff (), sigma, 1e-12);
   // k_sigma = 3: 2 Phi(-3).
   BVHParams p;
   p.k_sigma = 3.0;
@@ -102,7 +104,7 @@ TEST (Leakage, AreaWeightsWeightTheMean)
   // Two points in one leaf: one exact (P_x = 0), one noisy; weights move the node's leakage.
   UncertainCloud c;
   c.means = {Eigen::Vector3d (0, 0, 0), Eigen::Vector3d (1, 0, 0)};
-  c.covariances = {Eigen::Matrix3d::Zero (), Eigen::Matrix3d::Identity () * 1e-4};
+  c.covariances = {Eigen::Matrix3d::Zero (), Eigen::Matrix3d::Identity () * 0x1p-14};  // exact in float
   ProbabilisticBVH equal (c);
   const double p_noisy = detail::pointOutsideProbability (equal.node (0).box, c.means[1], c.covariances[1]);
   EXPECT_GT (p_noisy, 0.1);

@@ -226,7 +226,11 @@ TEST_P (BVHInvariants, Hold)
   const std::size_t n = std::get<1> (GetParam ());
   BVHParams params;
   params.split_style = std::get<2> (GetParam ());
-  const UncertainCloud cloud = shapeCloud (shape, n, 1000 + n);
+  // Covariances exact in float, as the hierarchy keeps them (PackedCovariance), so that the
+  // oracles below read what the build read.
+  UncertainCloud cloud = shapeCloud (shape, n, 1000 + n);
+  for (Eigen::Matrix3d& c : cloud.covariances)
+    c = c.cast<float> ().cast<double> ();
   ProbabilisticBVH bvh;
   ASSERT_TRUE (bvh.build (cloud, params));
   ASSERT_FALSE (bvh.empty ());
@@ -518,7 +522,8 @@ TEST (ProbabilisticBVH, GatherAppliesTheTransform)
     for (std::size_t i = 0; i < v.size; ++i)
     {
       EXPECT_LE ((v.means[i] - T * c.means[idx[i]]).norm (), 1e-12);
-      EXPECT_LE ((v.covariances[i] - T.linear () * c.covariances[idx[i]] * T.linear ().transpose ()).norm (), 1e-15);
+      const Eigen::Matrix3d kept = c.covariances[idx[i]].cast<float> ().cast<double> ();  // stored as float
+      EXPECT_LE ((v.covariances[i] - T.linear () * kept * T.linear ().transpose ()).norm (), 1e-15);
       EXPECT_EQ (v.covariances[i], v.covariances[i].transpose ());
     }
     const PointSetView own = bvh.gatherPoints (nd, m, cv);

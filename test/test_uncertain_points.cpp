@@ -66,12 +66,16 @@ TEST (PackedCovariance, RoundTripsASymmetricMatrixExactly)
   EXPECT_EQ (p.zz, 16.0);
   EXPECT_EQ (p.matrix (), s);  // exact: each entry is copied, and (a + a) / 2 = a in binary
 
+  // Any other matrix is kept to single precision: each entry is the nearest float.
   std::mt19937_64 rng (3);
   for (int i = 0; i < 100; ++i)
   {
     const Eigen::Matrix3d c = randomSpd (rng);
     const Eigen::Matrix3d symmetric = 0.5 * (c + c.transpose ());  // bitwise symmetric
-    EXPECT_EQ (PackedCovariance (symmetric).matrix (), symmetric) << i;
+    const Eigen::Matrix3d rounded = symmetric.cast<float> ().cast<double> ();
+    EXPECT_EQ (PackedCovariance (symmetric).matrix (), rounded) << i;
+    EXPECT_LE ((rounded - symmetric).cwiseAbs ().maxCoeff (), 0x1p-24 * symmetric.cwiseAbs ().maxCoeff ()) << i;
+    EXPECT_EQ (PackedCovariance (rounded).matrix (), rounded) << i;  // float entries round-trip exactly
   }
 }
 
@@ -101,13 +105,14 @@ TEST (PackedCovariance, QuadraticIsTheVarianceAlongADirection)
   d (0, 1) = d (1, 0) = 0.5;
   EXPECT_EQ (PackedCovariance (d).quadratic (Eigen::Vector3d (1.0, 1.0, 0.0)), 6.0);
 
-  // Against the full product on random matrices and directions; both sides sum at most nine
-  // terms of size |a|^2 |Sigma|, so a few ulps of the largest is the tolerance.
+  // Against the full product of the stored (float-rounded) matrix on random matrices and
+  // directions; both sides sum at most nine terms of size |a|^2 |Sigma|, so a few ulps of the
+  // largest is the tolerance.
   std::mt19937_64 rng (5);
   std::normal_distribution<double> n (0.0, 1.0);
   for (int i = 0; i < 200; ++i)
   {
-    const Eigen::Matrix3d c = randomSpd (rng);
+    const Eigen::Matrix3d c = randomSpd (rng).cast<float> ().cast<double> ();
     const double x = n (rng);
     const double y = n (rng);
     const double z = n (rng);

@@ -171,7 +171,8 @@ public:
   /** \brief Builds the hierarchy over a copy of cloud, replacing any previous one.
     * \param[in] cloud points with covariances in one frame (metres, square metres); its
     *            area_weights (empty = equal weights) weight the leakage; it is copied
-    *            (means, packed covariances and source indices are kept, see means())
+    *            (means, covariances packed in single precision and source indices are
+    *            kept, see means() and covariances())
     * \param[in] params construction parameters
     * \param[in] threads threads of the build: 0 = one per hardware thread; default 1. The
     *            hierarchy is the same for any count, node ids included.
@@ -233,8 +234,9 @@ public:
   /** \brief The stored point means, in the cloud's own frame (index = point index of the
     * hierarchy). */
   const std::vector<Eigen::Vector3d>& means () const { return means_; }
-  /** \brief The stored covariances, symmetrised and packed (area weights are not kept: they
-    * only weight the leakage at build time). */
+  /** \brief The stored covariances, symmetrised and packed in single precision (each entry the
+    * nearest float to the input's; exact for covariances estimated by the library, which are
+    * float already). Area weights are not kept: they only weight the leakage at build time. */
   const std::vector<PackedCovariance>& covariances () const { return covariances_; }
   /** \brief The source index of every point (the built cloud's source_indices), or empty when
     * the built cloud had none. */
@@ -271,7 +273,7 @@ public:
 private:
   bool buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers);
 
-  // The points, in the cloud's own frame: 76 bytes a point.
+  // The points, in the cloud's own frame: 52 bytes a point.
   std::vector<Eigen::Vector3d> means_;
   std::vector<PackedCovariance> covariances_;
   std::vector<int> source_indices_;

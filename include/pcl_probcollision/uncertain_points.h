@@ -29,31 +29,36 @@ struct UncertainCloud
   bool empty () const { return means.empty (); }
 };
 
-/** \brief A symmetric 3 x 3 covariance stored by its six distinct entries: 48 bytes instead of
-  * the 72 of an Eigen::Matrix3d, for the copies a hierarchy keeps of every point. */
+/** \brief A symmetric 3 x 3 covariance stored by its six distinct entries in single precision:
+  * 24 bytes instead of the 72 of an Eigen::Matrix3d, for the copy a hierarchy keeps of every
+  * point. Single precision loses nothing for covariances the library estimates, which PCL's
+  * Covariance point type already holds as float; a caller's double covariance is rounded to
+  * the nearest float (relative error at most 2^-24), far below any covariance's own
+  * uncertainty. Arithmetic on the entries is in double. */
 struct PackedCovariance
 {
-  double xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+  float xx = 0.0f, xy = 0.0f, xz = 0.0f, yy = 0.0f, yz = 0.0f, zz = 0.0f;
 
   PackedCovariance () = default;
-  /** \brief The symmetric part (S + S^T) / 2 of s. */
+  /** \brief The symmetric part (S + S^T) / 2 of s, rounded to float. */
   explicit PackedCovariance (const Eigen::Matrix3d& s)
-    : xx (s (0, 0)), xy (0.5 * (s (0, 1) + s (1, 0))), xz (0.5 * (s (0, 2) + s (2, 0))), yy (s (1, 1)),
-      yz (0.5 * (s (1, 2) + s (2, 1))), zz (s (2, 2)) {}
+    : xx (static_cast<float> (s (0, 0))), xy (static_cast<float> (0.5 * (s (0, 1) + s (1, 0)))),
+      xz (static_cast<float> (0.5 * (s (0, 2) + s (2, 0)))), yy (static_cast<float> (s (1, 1))),
+      yz (static_cast<float> (0.5 * (s (1, 2) + s (2, 1)))), zz (static_cast<float> (s (2, 2))) {}
   /** \brief The full matrix. */
   Eigen::Matrix3d
   matrix () const
   {
     Eigen::Matrix3d m;
-    m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    m << double (xx), double (xy), double (xz), double (xy), double (yy), double (yz), double (xz), double (yz), double (zz);
     return m;
   }
   /** \brief a^T Sigma a: the variance along a (for a unit a). */
   double
   quadratic (const Eigen::Vector3d& a) const
   {
-    return a.x () * a.x () * xx + a.y () * a.y () * yy + a.z () * a.z () * zz +
-           2.0 * (a.x () * a.y () * xy + a.x () * a.z () * xz + a.y () * a.z () * yz);
+    return a.x () * a.x () * double (xx) + a.y () * a.y () * double (yy) + a.z () * a.z () * double (zz) +
+           2.0 * (a.x () * a.y () * double (xy) + a.x () * a.z () * double (xz) + a.y () * a.z () * double (yz));
   }
 };
 
