@@ -768,11 +768,13 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
   UncertainCloud copy = std::move (cloud);
   copy.means.shrink_to_fit ();
   copy.source_indices.shrink_to_fit ();
-  // Packed once: the build reads the covariances the hierarchy keeps.
-  std::vector<PackedCovariance> covariances;
-  covariances.reserve (copy.size ());
-  for (const Eigen::Matrix3d& c : copy.covariances)
-    covariances.emplace_back (c);
+  // Packed once, in chunks on the workers: the build reads the covariances the hierarchy keeps.
+  std::vector<PackedCovariance> covariances (copy.size ());
+  constexpr std::size_t kPackChunk = 65536;
+  detail::parallelFor ((copy.size () + kPackChunk - 1) / kPackChunk, workers, [&] (std::size_t c, std::size_t) {
+    for (std::size_t i = c * kPackChunk; i < std::min (copy.size (), (c + 1) * kPackChunk); ++i)
+      covariances[i] = PackedCovariance (copy.covariances[i]);
+  });
   copy.covariances = std::vector<Eigen::Matrix3d> ();
   const BuildPoints points {copy.means, covariances, copy.area_weights};
   Tree tree;

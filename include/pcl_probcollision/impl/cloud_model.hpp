@@ -4,6 +4,7 @@
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/detail/input_checks.h>
+#include <pcl_probcollision/detail/parallel.h>
 #include <pcl_probcollision/impl/resolution.hpp>
 
 #include <pcl/common/point_tests.h>
@@ -118,34 +119,54 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     neighbours = estimation.getNeighbours ();
   }
 
+  // The model's points: the finite ones with a finite covariance, in cloud order. Chunks count
+  // theirs, then fill their own slots on the build's threads (5,000,000 points: 0.4 s serial).
+  const auto covarianceOf = [&] (std::size_t j) -> const Covariance& {
+    static const Covariance kNaN = Covariance::nan ();
+    return covariances ? (*covariances)[at (j)] : (estimated.size () == n ? estimated[j] : kNaN);
+  };
+  const auto kept = [&] (std::size_t j) { return pcl::isXYZFinite (cloud[at (j)]) && covarianceOf (j).isFinite (); };
+  constexpr std::size_t kChunk = 65536;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  const std::size_t workers = detail::threadCount (params.threads);
+  std::vector<std::size_t> first (chunks + 1, 0);  // model slot of each chunk's first kept point
+  detail::parallelFor (chunks, workers, [&] (std::size_t c, std::size_t) {
+    std::size_t count = 0;
+    for (std::size_t j = c * kChunk; j < std::min (n, (c + 1) * kChunk); ++j)
+      count += kept (j) ? 1 : 0;
+    first[c + 1] = count;
+  });
+  for (std::size_t c = 0; c < chunks; ++c)
+    first[c + 1] += first[c];
+  const std::size_t model_points = first[chunks];
+  const std::size_t skipped = n - model_points;
   UncertainCloud points;
-  std::size_t skipped = 0;
-  points.means.reserve (n);
-  points.covariances.reserve (n);
-  points.source_indices.reserve (n);
-  if (!radii.empty () && !covariances)
-    points.area_weights.reserve (n);
-  std::vector<std::size_t> kept_slots;  // estimation slot of each model point (surface model)
-  for (std::size_t j = 0; j < n; ++j)
-  {
-    const int i = at (j);
-    const PointT& p = cloud[i];
-    const Covariance& c = covariances ? (*covariances)[i] : (estimated.size () == n ? estimated[j] : Covariance::nan ());
-    if (!pcl::isXYZFinite (p) || !c.isFinite ())
+  points.means.resize (model_points);
+  points.covariances.resize (model_points);
+  points.source_indices.resize (model_points);
+  const bool weights = !radii.empty () && !covariances;
+  if (weights)
+    points.area_weights.resize (model_points);
+  std::vector<std::size_t> kept_slots (params.surface ? model_points : 0);  // estimation slot of each model point (surface model)
+  detail::parallelFor (chunks, workers, [&] (std::size_t c, std::size_t) {
+    std::size_t slot = first[c];
+    for (std::size_t j = c * kChunk; j < std::min (n, (c + 1) * kChunk); ++j)
     {
-      ++skipped;
-      continue;
+      if (!kept (j))
+        continue;
+      const int i = at (j);
+      points.means[slot] = cloud[i].getVector3fMap ().template cast<double> ();
+      if (!displacements.empty ())
+        points.means[slot] += displacements[j];
+      points.covariances[slot] = covarianceOf (j).matrix ();
+      points.source_indices[slot] = i;
+      if (weights)
+        points.area_weights[slot] = static_cast<double> (radii[j]) * radii[j];
+      if (params.surface)
+        kept_slots[slot] = j;
+      ++slot;
     }
-    points.means.emplace_back (p.getVector3fMap ().template cast<double> ());
-    if (!displacements.empty ())
-      points.means.back () += displacements[j];
-    points.covariances.push_back (c.matrix ());
-    points.source_indices.push_back (i);
-    if (!radii.empty () && !covariances)
-      points.area_weights.push_back (static_cast<double> (radii[j]) * radii[j]);
-    if (params.surface)
-      kept_slots.push_back (j);
-  }
+  });
   if (points.empty ())
   {
     err << name << " cloud has no finite point (" << n << " given, " << skipped << " non-finite)";
