@@ -28,6 +28,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -581,6 +582,29 @@ run (int argc, char** argv)
   loadInput (b, with_normals, log);
   warnIfScalesDiffer (a, b);
 
+  // A cloud's model does not depend on the other input. When the other is a mesh, whose
+  // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at
+  // 5,000,000 points), the model is built meanwhile on the other threads; with -threads 1
+  // everything stays on one. The model is the one compute() would build (same parameters and
+  // name); if its build fails, compute() builds it again and reports the failure as before.
+  const unsigned threads = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
+  auto earlyBuild = [&] (const Input& cloud, const Input& other, const std::string& sensor,
+                         double sigma, const char* which) {
+    std::future<pcl_probcollision::CloudModel::ConstPtr> model;
+    if (threads > 1 && cloud.kind == InputKind::Cloud && !cloud.oriented && other.kind == InputKind::Mesh &&
+        !o.mesh_spacing)
+    {
+      pcl_probcollision::CloudModelParams params = modelParamsFor (o);
+      params.noise = pcl_probcollision::SensorNoiseModel::fromName (sensor, sigma);
+      model = std::async (std::launch::async, [&cloud, params, which] {
+        return pcl_probcollision::buildCloudModel (*cloud.cloud, params, nullptr, nullptr, which);
+      });
+    }
+    return model;
+  };
+  auto early_a = earlyBuild (a, b, o.sensor_a, o.sigma_a, "input");
+  auto early_b = earlyBuild (b, a, o.sensor_b, o.sigma_b, "target");
+
   // MeshSampled mode: spacing from -mesh_density, the other cloud, or the meshes' size.
   for (Input* m : {&a, &b})
   {
@@ -626,6 +650,22 @@ run (int argc, char** argv)
     pc.setTargetNoise (SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
   // The build time of the clouds built here, which compute() would otherwise have counted.
   double cloud_build_ms = 0.0;
+  auto takeEarly = [&] (std::future<pcl_probcollision::CloudModel::ConstPtr>& model, bool input) {
+    if (!model.valid ())
+      return;
+    try
+    {
+      const pcl_probcollision::CloudModel::ConstPtr built = model.get ();
+      input ? pc.setInputModel (built) : pc.setTargetModel (built);
+      cloud_build_ms += built->buildMilliseconds ();
+    }
+    catch (const pcl::PCLException&)
+    {
+      // compute() builds it again and reports the error, as without the early build.
+    }
+  };
+  takeEarly (early_a, true);
+  takeEarly (early_b, false);
   if (a.kind == InputKind::Cloud && a.oriented)
     cloud_build_ms += pc.getInputModel ()->buildMilliseconds ();
   if (b.kind == InputKind::Cloud && b.oriented)
