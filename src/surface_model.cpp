@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <queue>
 #include <tuple>
 
@@ -228,7 +229,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     }
     spacing_[i] = static_cast<float> (s);
   });
-  {
+  // The spacing's statistics (a sort of every point's) need nothing of what follows until the
+  // end: on a thread of their own when the build has several.
+  auto spacingStatistics = [this, n] {
     std::vector<float> sorted (spacing_);
     std::sort (sorted.begin (), sorted.end ());
     median_spacing_ = n ? sorted[n / 2] : 0.0;
@@ -247,7 +250,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
         break;
       }
     }
-  }
+  };
+  std::future<void> statistics;
+  if (workers > 1)
+    statistics = std::async (std::launch::async, spacingStatistics);
+  else
+    spacingStatistics ();
 
   // Resolve Auto: the caller's normals, else a viewpoint outside the cloud (a scan), else
   // propagation.
@@ -308,16 +316,25 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // Whatever no seed reached (every point in Propagate mode): one part at a time, from its
   // point farthest from the centroid, pointing away from it; then the part's enclosed volume
   // decides (a closed surface oriented outward encloses a positive one).
-  std::vector<double> distance (n);
-  std::vector<std::size_t> order (n);
-  for (std::size_t i = 0; i < n; ++i)
+  // (The farthest-first order is sorted only when some point is left: a scan oriented from its
+  // viewpoint or by its own normals usually leaves none.)
+  std::vector<std::size_t> order;
+  bool unreached = false;
+  for (std::size_t i = 0; i < n && !unreached; ++i)
+    unreached = component[i] < 0 && !normals_[i].isZero ();
+  if (unreached)
   {
-    distance[i] = (points[i] - centroid).squaredNorm ();
-    order[i] = i;
+    std::vector<double> distance (n);
+    order.resize (n);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      distance[i] = (points[i] - centroid).squaredNorm ();
+      order[i] = i;
+    }
+    std::sort (order.begin (), order.end (), [&] (std::size_t x, std::size_t y) {
+      return distance[x] > distance[y] || (distance[x] == distance[y] && x < y);
+    });
   }
-  std::sort (order.begin (), order.end (), [&] (std::size_t x, std::size_t y) {
-    return distance[x] > distance[y] || (distance[x] == distance[y] && x < y);
-  });
   int next_component = 1;
   for (const std::size_t s : order)
   {
@@ -363,6 +380,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     propagated_ += mode != NormalOrientation::Propagate && component[i] != 0 && !normals_[i].isZero () ? 1 : 0;
   }
 
+  if (statistics.valid ())
+    statistics.get ();
+
   // Dipoles: each point counts in the first leaf holding it (leaves overlap by epsilon).
   const auto& nodes = bvh.nodes ();
   owner_.assign (n, -1);
@@ -374,24 +394,19 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   dipoles_.assign (nodes.size (), Dipole ());
   if (nodes.empty ())
     return;
-  // Children before parents: the reverse of a depth-first pre-order.
-  std::vector<std::int32_t> preorder, stack{ProbabilisticBVH::rootId ()};
-  while (!stack.empty ())
-  {
-    const std::int32_t id = stack.back ();
-    stack.pop_back ();
-    preorder.push_back (id);
-    const auto& node = nodes[static_cast<std::size_t> (id)];
-    for (int c = 0; c < node.num_children; ++c)
-      stack.push_back (node.first_child + c);
-  }
-  for (auto it = preorder.rbegin (); it != preorder.rend (); ++it)
-  {
-    const std::int32_t id = *it;
-    const auto& node = nodes[static_cast<std::size_t> (id)];
-    Dipole& d = dipoles_[static_cast<std::size_t> (id)];
-    if (node.isLeaf ())
+  // A leaf's dipole reads only its own points: the leaves on the workers, then the internal
+  // nodes from their children, children first (a child's id is larger than its parent's).
+  std::vector<std::int32_t> leaves;
+  for (std::size_t id = 0; id < nodes.size (); ++id)
+    if (nodes[id].isLeaf ())
+      leaves.push_back (static_cast<std::int32_t> (id));
+  constexpr std::size_t kLeafChunk = 1024;
+  detail::parallelFor ((leaves.size () + kLeafChunk - 1) / kLeafChunk, workers, [&] (std::size_t c, std::size_t) {
+    for (std::size_t l = c * kLeafChunk; l < std::min (leaves.size (), (c + 1) * kLeafChunk); ++l)
     {
+      const std::int32_t id = leaves[l];
+      const auto& node = nodes[static_cast<std::size_t> (id)];
+      Dipole& d = dipoles_[static_cast<std::size_t> (id)];
       for (const int i : bvh.indices (node))
         if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
         {
@@ -405,8 +420,14 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       for (const int i : bvh.indices (node))
         if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
           d.radius = std::max (d.radius, (points[static_cast<std::size_t> (i)] - d.center).norm ());
-      continue;
     }
+  });
+  for (std::size_t id = nodes.size (); id-- > 0;)
+  {
+    const auto& node = nodes[id];
+    if (node.isLeaf ())
+      continue;
+    Dipole& d = dipoles_[id];
     for (int c = 0; c < node.num_children; ++c)
     {
       const Dipole& child = dipoles_[static_cast<std::size_t> (node.first_child + c)];

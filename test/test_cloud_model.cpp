@@ -215,6 +215,7 @@ TEST (CloudModel, AnyBuildThreadCountGivesTheSameAnswers)
   request.exhaustive = true;
   request.per_point = true;
   request.surface = true;
+  std::vector<CloudModel::ConstPtr> models;  // b's, one per answer
   auto answer = [&] (int threads) {
     CloudModelParams params;
     params.noise = SensorNoiseModel::isotropic (0.001);
@@ -222,9 +223,24 @@ TEST (CloudModel, AnyBuildThreadCountGivesTheSameAnswers)
     params.threads = threads;
     const CloudModel::ConstPtr ma = buildCloudModel (*a, params, nullptr, nullptr, "a");
     const CloudModel::ConstPtr mb = buildCloudModel (*b, params, nullptr, nullptr, "b");
+    models.push_back (mb);
     CollisionResult r;
     EXPECT_TRUE (collide (*ma, *mb, Eigen::Isometry3d::Identity (), request, r)) << r.message;
     return r;
+  };
+  // The surface model itself, whose statistics and leaf dipoles are made on the build's threads.
+  const auto sameSurface = [] (const SurfaceModel& x, const SurfaceModel& y) {
+    if (x.medianSpacing () != y.medianSpacing () || x.surfaceSpacing () != y.surfaceSpacing () ||
+        x.normals () != y.normals () || x.spacing () != y.spacing () || x.dipoles ().size () != y.dipoles ().size ())
+      return false;
+    for (std::size_t i = 0; i < x.dipoles ().size (); ++i)
+    {
+      const SurfaceModel::Dipole& u = x.dipoles ()[i];
+      const SurfaceModel::Dipole& v = y.dipoles ()[i];
+      if (u.area != v.area || u.center != v.center || u.moment != v.moment || u.radius != v.radius)
+        return false;
+    }
+    return true;
   };
   const CollisionResult one = answer (1);
   EXPECT_GT (one.leaf_pairs_tested, 100u);
@@ -241,7 +257,9 @@ TEST (CloudModel, AnyBuildThreadCountGivesTheSameAnswers)
     EXPECT_TRUE (same (many.probabilities_a, one.probabilities_a)) << threads;
     EXPECT_TRUE (same (many.probabilities_b, one.probabilities_b)) << threads;
     EXPECT_EQ (many.signed_distance, one.signed_distance) << threads;
+    EXPECT_TRUE (sameSurface (models.back ()->surface (), models.front ()->surface ())) << threads;
   }
+  EXPECT_GT (models.front ()->surface ().medianSpacing (), 0.0);
 }
 
 TEST (CloudModel, BuiltFromPointsKeepsSourceIndicesForPerPointResults)
