@@ -534,6 +534,39 @@ TEST (CovarianceEstimation, DefaultSearchAnswersSingleQueriesLikePclKdTree)
   }
 }
 
+// setComputeNormals (false): the neighbours, radii and covariances of the default, without the
+// normal fits (a cloud that brings its own normals, as a CloudModel's surface takes them).
+TEST (CovarianceEstimation, NeighboursWithoutNormalFits)
+{
+  const Cloud::Ptr cloud = scrambledPlaneWithNaN ();
+  auto run = [&] (bool normals, CovarianceEstimation<pcl::PointXYZ>& est) {
+    est.setInputCloud (cloud);
+    est.setSensorNoise (SensorNoiseModel::isotropic (0.002));
+    est.setComputeSurface (true);
+    est.setComputeNormals (normals);
+    EXPECT_EQ (est.getComputeNormals (), normals);
+    pcl::PointCloud<Covariance> out;
+    est.compute (out);
+    return out;
+  };
+  CovarianceEstimation<pcl::PointXYZ> with, without;
+  const auto a = run (true, with);
+  const auto b = run (false, without);
+  ASSERT_EQ (a.size (), b.size ());
+  EXPECT_EQ (with.getNormals ().size (), cloud->size ());
+  EXPECT_TRUE (without.getNormals ().empty ());
+  EXPECT_EQ (without.getNeighbours (), with.getNeighbours ());
+  EXPECT_EQ (without.getNeighbours ().size (), cloud->size () * 10u);
+  for (std::size_t i = 0; i < a.size (); ++i)
+  {
+    ASSERT_EQ (a[i].isFinite (), b[i].isFinite ()) << i;
+    if (!a[i].isFinite ())
+      continue;
+    EXPECT_TRUE (a[i].matrix () == b[i].matrix ()) << i;
+    EXPECT_EQ (with.getNeighbourRadii ()[i], without.getNeighbourRadii ()[i]) << i;
+  }
+}
+
 // Blocks of points go to several threads; every output must be what one thread gives, bit for
 // bit, including the NaN rows and is_dense.
 TEST (CovarianceEstimation, AnyThreadCountGivesTheOneThreadOutput)

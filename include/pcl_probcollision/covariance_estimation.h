@@ -106,7 +106,13 @@ public:
     * and its neighbours (default off: costs one eigen solve a point and k indices a point). */
   void setComputeSurface (bool compute) { compute_surface_ = compute; }
   bool getComputeSurface () const { return compute_surface_; }
-  /** \brief After compute() with setComputeSurface(true): the unit normal of the plane fitted
+  /** \brief With setComputeSurface(true), whether to fit each point's normal (default on). Off
+    * when the caller has a normal for every point: the neighbours are still recorded, without
+    * the eigen solve a point, and getNormals() stays empty. */
+  void setComputeNormals (bool compute) { compute_normals_ = compute; }
+  bool getComputeNormals () const { return compute_normals_; }
+  /** \brief After compute() with setComputeSurface(true) (and setComputeNormals, the default):
+    * the unit normal of the plane fitted
     * to each output point's neighbours (the weakest direction of its discretisation spread),
     * unoriented; zero where it is undetermined (fewer than two neighbours, all coincident),
     * NaN for non-finite points. Empty otherwise. */
@@ -143,6 +149,7 @@ private:
   bool project_ = true;  // CloudModelParams::surface_projection; test_cloud_model checks they agree
   std::vector<Eigen::Vector3d> displacements_;
   bool compute_surface_ = false;
+  bool compute_normals_ = true;
   std::vector<Eigen::Vector3f> normals_;
   std::vector<int> neighbours_;
   int threads_ = 1;

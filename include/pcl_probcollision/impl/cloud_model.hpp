@@ -112,6 +112,18 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     else
       estimation.setSurfaceProjection (false);
     estimation.setComputeSurface (params.surface);
+    // A cloud with a usable normal at every finite point takes its own (below): no normal fits.
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+    {
+      bool all_given = params.surface;
+      for (std::size_t j = 0; j < n && all_given; ++j)
+      {
+        const PointT& p = cloud[at (j)];
+        const Eigen::Vector3f given (p.normal_x, p.normal_y, p.normal_z);
+        all_given = !pcl::isXYZFinite (p) || (given.allFinite () && given.squaredNorm () > 0.0f);
+      }
+      estimation.setComputeNormals (!all_given);
+    }
     estimation.compute (estimated);
     radii = estimation.getNeighbourRadii ();
     displacements = estimation.getSurfaceDisplacements ();
@@ -199,7 +211,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     for (std::size_t p = 0; p < m; ++p)
     {
       const std::size_t j = kept_slots[p];
-      in.normals[p] = normals[j];
+      in.normals[p] = normals.empty () ? Eigen::Vector3f::Zero () : normals[j];
       in.radii[p] = radii[j];
       for (std::size_t q = 0; q < k; ++q)
       {

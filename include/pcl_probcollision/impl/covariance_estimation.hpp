@@ -444,9 +444,11 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   radii_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
   normals_.clear ();
   neighbours_.clear ();
+  const bool fit_normals = compute_surface_ && compute_normals_;
   if (compute_surface_)
   {
-    normals_.assign (indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
+    if (fit_normals)
+      normals_.assign (indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
     neighbours_.assign (indices.size () * static_cast<std::size_t> (this->k_), -1);
   }
   if (project_)
@@ -542,7 +544,7 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
         }
       }
 
-      if (compute_surface_)
+      if (fit_normals)
       {
         Eigen::Vector3d n = Eigen::Vector3d::Zero ();
         double lambda0 = 0.0;
