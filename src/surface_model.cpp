@@ -157,12 +157,16 @@ smoothNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals, std::s
         next[i] = n;
         return;
       }
+      // Without a branch (whether a neighbour is on the same face is a coin toss near edges):
+      // a neighbour off the face adds -0, which leaves every sum as it is.
       Eigen::Vector3f sum = n;
       for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
       {
         const Eigen::Vector3f& m = normals[static_cast<std::size_t> (graph.targets[static_cast<std::size_t> (e)])];
-        if (m.dot (n) > kSmoothCosine)
-          sum += m;
+        const bool same_face = (m.x () * n.x () + m.y () * n.y ()) + m.z () * n.z () > kSmoothCosine;
+        sum.x () += same_face ? m.x () : -0.0f;
+        sum.y () += same_face ? m.y () : -0.0f;
+        sum.z () += same_face ? m.z () : -0.0f;
       }
       next[i] = sum.normalized ();
     });
