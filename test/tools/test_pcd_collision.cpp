@@ -896,9 +896,15 @@ TEST_F (PcdCollisionTool, NormalRunsPrintOnlyStageLinesOnStderr)
     SCOPED_TRACE (a.string ());
     const ToolRun r = run ({a.string (), kScene.string (), "-pose", "0,0,0.3,0,0,0"});
     ASSERT_EQ (r.status, 0) << r.err;
+    // One line per model built, in the order a, b.
+    const std::size_t built_a = r.err.find ("Building " + a.string () + " [done, ");
+    const std::size_t built_b = r.err.find ("Building " + kScene.string () + " [done, ");
+    EXPECT_NE (built_a, std::string::npos) << r.err;
+    EXPECT_NE (built_b, std::string::npos) << r.err;
+    EXPECT_LT (built_a, built_b) << r.err;
     for (std::string l : lines (r.err))
     {
-      EXPECT_TRUE (l.rfind ("Loading ", 0) == 0 || l.rfind ("Sampling ", 0) == 0) << l;
+      EXPECT_TRUE (l.rfind ("Loading ", 0) == 0 || l.rfind ("Sampling ", 0) == 0 || l.rfind ("Building ", 0) == 0) << l;
       for (const std::string& path : {a.string (), kScene.string ()})
         for (std::size_t at = l.find (path); at != std::string::npos; at = l.find (path))
           l.erase (at, path.size ());
