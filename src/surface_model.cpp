@@ -11,6 +11,7 @@
 #include <future>
 #include <queue>
 #include <tuple>
+#include <utility>
 
 namespace pcl_probcollision
 {
@@ -81,7 +82,8 @@ class Propagation
 {
 public:
   Propagation (const Graph& graph, std::vector<Eigen::Vector3f>& normals, std::vector<int>& component)
-    : graph_ (graph), normals_ (normals), component_ (component) {}
+    : graph_ (graph), normals_ (normals), component_ (component),
+      best_ (normals.size (), std::pair<float, int> (-1.0f, -1)) {}
 
   void
   seed (int i)
@@ -117,13 +119,21 @@ private:
       const int t = graph_.targets[static_cast<std::size_t> (e)];
       if (component_[static_cast<std::size_t> (t)] >= 0 || normals_[static_cast<std::size_t> (t)].isZero ())
         continue;
-      queue_.emplace (std::abs (n.dot (normals_[static_cast<std::size_t> (t)])), i, t);
+      // An edge into t below one already queued for t would be popped after it, when t is
+      // oriented already: it is not queued at all (the same orientation, a smaller queue).
+      const std::pair<float, int> key (std::abs (n.dot (normals_[static_cast<std::size_t> (t)])), i);
+      std::pair<float, int>& best = best_[static_cast<std::size_t> (t)];
+      if (!(key > best))
+        continue;
+      best = key;
+      queue_.emplace (key.first, i, t);
     }
   }
 
   const Graph& graph_;
   std::vector<Eigen::Vector3f>& normals_;
   std::vector<int>& component_;
+  std::vector<std::pair<float, int>> best_;  ///< per point, the best (weight, from) queued into it
   std::priority_queue<std::tuple<float, int, int>> queue_;
 };
 /** \brief fn(i) for every point i < n, in chunks on `workers` threads; fn writes only slot i. */
