@@ -770,9 +770,8 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
   copy.source_indices.shrink_to_fit ();
   // Packed once, in chunks on the workers: the build reads the covariances the hierarchy keeps.
   std::vector<PackedCovariance> covariances (copy.size ());
-  constexpr std::size_t kPackChunk = 65536;
-  detail::parallelFor ((copy.size () + kPackChunk - 1) / kPackChunk, workers, [&] (std::size_t c, std::size_t) {
-    for (std::size_t i = c * kPackChunk; i < std::min (copy.size (), (c + 1) * kPackChunk); ++i)
+  detail::parallelChunks (copy.size (), 65536, workers, [&] (std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
       covariances[i] = PackedCovariance (copy.covariances[i]);
   });
   copy.covariances = std::vector<Eigen::Matrix3d> ();

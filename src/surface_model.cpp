@@ -141,9 +141,8 @@ template <typename Fn>
 void
 forEachPoint (std::size_t n, std::size_t workers, Fn&& fn)
 {
-  constexpr std::size_t kChunk = 4096;
-  detail::parallelFor ((n + kChunk - 1) / kChunk, workers, [&] (std::size_t c, std::size_t) {
-    for (std::size_t i = c * kChunk; i < std::min (n, (c + 1) * kChunk); ++i)
+  detail::parallelChunks (n, 4096, workers, [&] (std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
       fn (i);
   });
 }
@@ -414,9 +413,8 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   for (std::size_t id = 0; id < nodes.size (); ++id)
     if (nodes[id].isLeaf ())
       leaves.push_back (static_cast<std::int32_t> (id));
-  constexpr std::size_t kLeafChunk = 1024;
-  detail::parallelFor ((leaves.size () + kLeafChunk - 1) / kLeafChunk, workers, [&] (std::size_t c, std::size_t) {
-    for (std::size_t l = c * kLeafChunk; l < std::min (leaves.size (), (c + 1) * kLeafChunk); ++l)
+  detail::parallelChunks (leaves.size (), 1024, workers, [&] (std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t l = begin; l < end; ++l)
     {
       const std::int32_t id = leaves[l];
       const auto& node = nodes[static_cast<std::size_t> (id)];

@@ -587,23 +587,24 @@ run (int argc, char** argv)
   // 5,000,000 points), the model is built meanwhile on the other threads; with -threads 1
   // everything stays on one. The model is the one compute() would build (same parameters and
   // name); if its build fails, compute() builds it again and reports the failure as before.
-  const unsigned threads = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
-  auto earlyBuild = [&] (const Input& cloud, const Input& other, const std::string& sensor,
-                         double sigma, const char* which) {
+  const unsigned workers = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
+  using pcl_probcollision::SensorNoiseModel;
+  // A cloud's model as compute() builds it: the tool's parameters with that input's noise, and
+  // the name compute() gives it.
+  auto buildCloud = [&o] (const Input& in, const std::string& sensor, double sigma, bool input) {
+    pcl_probcollision::CloudModelParams params = modelParamsFor (o);
+    params.noise = SensorNoiseModel::fromName (sensor, sigma);
+    return pcl_probcollision::buildCloudModel (*in.cloud, params, nullptr, nullptr, input ? "input" : "target");
+  };
+  auto earlyBuild = [&] (const Input& cloud, const Input& other, const std::string& sensor, double sigma, bool input) {
     std::future<pcl_probcollision::CloudModel::ConstPtr> model;
-    if (threads > 1 && cloud.kind == InputKind::Cloud && !cloud.oriented && other.kind == InputKind::Mesh &&
+    if (workers > 1 && cloud.kind == InputKind::Cloud && !cloud.oriented && other.kind == InputKind::Mesh &&
         !o.mesh_spacing)
-    {
-      pcl_probcollision::CloudModelParams params = modelParamsFor (o);
-      params.noise = pcl_probcollision::SensorNoiseModel::fromName (sensor, sigma);
-      model = std::async (std::launch::async, [&cloud, params, which] {
-        return pcl_probcollision::buildCloudModel (*cloud.cloud, params, nullptr, nullptr, which);
-      });
-    }
+      model = std::async (std::launch::async, buildCloud, std::cref (cloud), sensor, sigma, input);
     return model;
   };
-  auto early_a = earlyBuild (a, b, o.sensor_a, o.sigma_a, "input");
-  auto early_b = earlyBuild (b, a, o.sensor_b, o.sigma_b, "target");
+  auto early_a = earlyBuild (a, b, o.sensor_a, o.sigma_a, true);
+  auto early_b = earlyBuild (b, a, o.sensor_b, o.sigma_b, false);
 
   // MeshSampled mode: spacing from -mesh_density, the other cloud, or the meshes' size.
   for (Input* m : {&a, &b})
@@ -629,7 +630,6 @@ run (int argc, char** argv)
   // the samples with their normals. A cloud whose file has normals (with -surface) is built here
   // too, as compute() would build it (its noise, the same name), from the points with their
   // normals, which the surface model takes as outward.
-  using pcl_probcollision::SensorNoiseModel;
   auto orientedModel = [&] (const Input& in, const SensorNoiseModel& noise, const char* which) {
     if (in.kind == InputKind::Mesh)
     {
@@ -650,33 +650,16 @@ run (int argc, char** argv)
     pc.setTargetNoise (SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
   // The build time of the clouds built here, which compute() would otherwise have counted.
   double cloud_build_ms = 0.0;
-  auto takeEarly = [&] (std::future<pcl_probcollision::CloudModel::ConstPtr>& model, bool input) {
-    if (!model.valid ())
-      return;
-    try
-    {
-      const pcl_probcollision::CloudModel::ConstPtr built = model.get ();
-      input ? pc.setInputModel (built) : pc.setTargetModel (built);
-      cloud_build_ms += built->buildMilliseconds ();
-    }
-    catch (const pcl::PCLException&)
-    {
-      // compute() builds it again and reports the error, as without the early build.
-    }
-  };
-  takeEarly (early_a, true);
-  takeEarly (early_b, false);
-  // The other clouds' models are built here too, as compute() would build them, so that every
+  // The other clouds' models are built here too (or taken from their early build), so that every
   // model gets its stage line (a 5,000,000-point cloud takes seconds); a build that fails is
-  // left to compute(), which reports it as before.
-  auto buildHere = [&] (const Input& in, const std::string& sensor, double sigma, bool input) {
-    if (in.oriented || (input ? pc.getInputModel () : pc.getTargetModel ()))
+  // left to compute(), which builds it again and reports the error as before.
+  auto cloudModel = [&] (const Input& in, std::future<pcl_probcollision::CloudModel::ConstPtr>& early,
+                         const std::string& sensor, double sigma, bool input) {
+    if (in.oriented)
       return;
-    pcl_probcollision::CloudModelParams params = modelParamsFor (o);
-    params.noise = SensorNoiseModel::fromName (sensor, sigma);
     try
     {
-      const auto built = pcl_probcollision::buildCloudModel (*in.cloud, params, nullptr, nullptr, input ? "input" : "target");
+      const auto built = early.valid () ? early.get () : buildCloud (in, sensor, sigma, input);
       input ? pc.setInputModel (built) : pc.setTargetModel (built);
       cloud_build_ms += built->buildMilliseconds ();
     }
@@ -684,8 +667,8 @@ run (int argc, char** argv)
     {
     }
   };
-  buildHere (a, o.sensor_a, o.sigma_a, true);
-  buildHere (b, o.sensor_b, o.sigma_b, false);
+  cloudModel (a, early_a, o.sensor_a, o.sigma_a, true);
+  cloudModel (b, early_b, o.sensor_b, o.sigma_b, false);
   if (a.kind == InputKind::Cloud && a.oriented)
     cloud_build_ms += pc.getInputModel ()->buildMilliseconds ();
   if (b.kind == InputKind::Cloud && b.oriented)
@@ -703,7 +686,6 @@ run (int argc, char** argv)
   // The poses are answered by computeBatch in chunks of a few per thread, each chunk printed in
   // pose order as soon as it is done: answers stream, and a chunk's slowest pose idles the
   // other threads only briefly. Which thread answers a pose changes nothing in its answer.
-  const unsigned workers = o.threads > 0 ? static_cast<unsigned> (o.threads) : std::max (1u, std::thread::hardware_concurrency ());
   const std::size_t chunk = std::size_t{64} * workers;
   using Results = std::vector<pcl_probcollision::CollisionResult>;
   struct Chunk

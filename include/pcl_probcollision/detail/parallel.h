@@ -84,5 +84,17 @@ parallelFor (std::size_t count, std::size_t workers, Task&& task)
   if (first != kNone)
     std::rethrow_exception (errors[first]);
 }
+
+/** \brief task(c, begin, end) for the consecutive ranges [begin, end) of `chunk` items (the last
+  * one shorter) that cover [0, count), c the range's number, on parallelFor's workers: for loops
+  * over many cheap items, where one item is not worth handing out alone. */
+template <typename Task>
+void
+parallelChunks (std::size_t count, std::size_t chunk, std::size_t workers, Task&& task)
+{
+  parallelFor ((count + chunk - 1) / chunk, workers, [&] (std::size_t c, std::size_t) {
+    task (c, c * chunk, std::min (count, (c + 1) * chunk));
+  });
+}
 } // namespace detail
 } // namespace pcl_probcollision

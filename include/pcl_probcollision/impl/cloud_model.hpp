@@ -44,6 +44,12 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       }
   const std::size_t n = indices ? indices->size () : cloud.size ();
   auto at = [&] (std::size_t j) { return indices ? (*indices)[j] : static_cast<int> (j); };
+  // A point's own normal, as the surface model takes it: finite and not zero (point types with
+  // normals only).
+  const auto usableNormal = [] (const auto& p) {
+    const Eigen::Vector3f given (p.normal_x, p.normal_y, p.normal_z);
+    return given.allFinite () && given.squaredNorm () > 0.0f;
+  };
 
   // Finite but absurd coordinates overflow the float arithmetic of the k-d tree (FLANN's middle
   // split computes (min + max) / 2 = inf; found by fuzz/fuzz_collide): refuse them by name.
@@ -117,11 +123,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     {
       bool all_given = params.surface;
       for (std::size_t j = 0; j < n && all_given; ++j)
-      {
-        const PointT& p = cloud[at (j)];
-        const Eigen::Vector3f given (p.normal_x, p.normal_y, p.normal_z);
-        all_given = !pcl::isXYZFinite (p) || (given.allFinite () && given.squaredNorm () > 0.0f);
-      }
+        all_given = !pcl::isXYZFinite (cloud[at (j)]) || usableNormal (cloud[at (j)]);
       estimation.setComputeNormals (!all_given);
     }
     estimation.compute (estimated);
@@ -142,9 +144,9 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   const std::size_t workers = detail::threadCount (params.threads);
   std::vector<std::size_t> first (chunks + 1, 0);  // model slot of each chunk's first kept point
-  detail::parallelFor (chunks, workers, [&] (std::size_t c, std::size_t) {
+  detail::parallelChunks (n, kChunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
     std::size_t count = 0;
-    for (std::size_t j = c * kChunk; j < std::min (n, (c + 1) * kChunk); ++j)
+    for (std::size_t j = begin; j < end; ++j)
       count += kept (j) ? 1 : 0;
     first[c + 1] = count;
   });
@@ -160,9 +162,9 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   if (weights)
     points.area_weights.resize (model_points);
   std::vector<std::size_t> kept_slots (params.surface ? model_points : 0);  // estimation slot of each model point (surface model)
-  detail::parallelFor (chunks, workers, [&] (std::size_t c, std::size_t) {
+  detail::parallelChunks (n, kChunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
     std::size_t slot = first[c];
-    for (std::size_t j = c * kChunk; j < std::min (n, (c + 1) * kChunk); ++j)
+    for (std::size_t j = begin; j < end; ++j)
     {
       if (!kept (j))
         continue;
@@ -225,10 +227,9 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       for (std::size_t p = 0; p < m; ++p)
       {
         const PointT& pt = cloud[at (kept_slots[p])];
-        const Eigen::Vector3f given (pt.normal_x, pt.normal_y, pt.normal_z);
-        if (given.allFinite () && given.squaredNorm () > 0.0f)
+        if (usableNormal (pt))
         {
-          in.normals[p] = given;
+          in.normals[p] = Eigen::Vector3f (pt.normal_x, pt.normal_y, pt.normal_z);
           in.given[p] = 1;
         }
       }
