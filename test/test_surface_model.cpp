@@ -3,6 +3,7 @@
 // surface, METHOD.md 10a): orientation, winding number, signed distance, containment, and the
 // degenerate inputs that must still get an answer.
 #include "scenes.h"
+#include "seeded_draws.h"
 
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
@@ -16,6 +17,7 @@
 #include <random>
 
 using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;
 using pcl_probcollision_test::fibonacci;
 
 namespace
@@ -374,6 +376,73 @@ TEST (SurfaceLayer, ThinSheetsCrossingWithoutDeepSamples)
   // The depth is a bound: the wall's thickness and the smaller clearance.
   EXPECT_LT (crossing.signed_distance, -0.03) << crossing.signed_distance;
   EXPECT_EQ (clear.verdict, Verdict::Free) << clear.probability << " d " << clear.signed_distance;
+}
+
+/** \brief A closed wedge (given normals): its tip along y at x = 0, z = 0, its two faces opening
+  * toward -x at half-angle alpha (outward normals (sin a, 0, +-cos a): 180 - 2 alpha degrees
+  * apart, where a slab's are 180), closed by a back face at x = -length; sampled every h. */
+pcl::PointCloud<pcl::PointNormal>
+wedge (double alpha, double length, double width, double h)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  const float sa = static_cast<float> (std::sin (alpha)), ca = static_cast<float> (std::cos (alpha));
+  const int nx = static_cast<int> (std::round (length / h)), ny = static_cast<int> (std::round (width / h));
+  for (int j = 0; j <= ny; ++j)
+  {
+    const double y = -0.5 * width + j * h;
+    for (int i = 0; i <= nx; ++i)
+    {
+      const double x = -i * h, z = -x * std::tan (alpha);
+      cloud.push_back (pointNormal (x, y, z, Eigen::Vector3f (sa, 0.0f, ca)));
+      if (i > 0)
+        cloud.push_back (pointNormal (x, y, -z, Eigen::Vector3f (sa, 0.0f, -ca)));
+    }
+    const double half = length * std::tan (alpha);
+    for (double z = -half + h; z < half; z += h)
+      cloud.push_back (pointNormal (-length, y, z, Eigen::Vector3f (-1.0f, 0.0f, 0.0f)));
+  }
+  return cloud;
+}
+
+/** \brief A thin plate x in [x0 - 0.01, x0 + 0.01] (given normals +-x), sampled every 0.07 in
+  * y over [-0.21, 0.21] and at the heights zs. */
+pcl::PointCloud<pcl::PointNormal>
+upright (double x0, const std::vector<double>& zs)
+{
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  for (const double dx : {-0.01, 0.01})
+    for (int j = 0; j <= 6; ++j)
+      for (const double z : zs)
+        cloud.push_back (pointNormal (x0 + dx, -0.21 + 0.07 * j, z, Eigen::Vector3f (dx > 0.0 ? 1.0f : -1.0f, 0.0f, 0.0f)));
+  return cloud;
+}
+
+// A sparse plate passing 0.8 sigma beyond a noisy wedge's tip (faces 137 degrees apart, like a
+// box's corner seen edge on or a tapered part): its points above and below the tip lie in front
+// of the wedge's two faces, and each behind the other face's plane, as for a sheet crossed; but
+// the planes meet at the tip, so the plate may pass beyond it and the answer must not be a
+// certain collision. Pushed 10 cm over the tip, where the wedge is 8 cm thick, it collides.
+// (On this wedge the edge term already keeps the first answer uncertain: the samples do not
+// surround the tip. The evaluation's case where they did, a piano's corner, is in
+// docs/SURFACE.md, step 4.)
+TEST (SurfaceLayer, CrossingsOfAWedge)
+{
+  const double sigma = 0.01;
+  // The wedge's samples carry the noise (its normals are exact): the tip blurs.
+  auto jittered = wedge (21.5 * M_PI / 180.0, 0.4, 0.4, 0.01);
+  std::mt19937 rng (3);
+  std::normal_distribution<double> noise (0.0, sigma);
+  for (auto& p : jittered)
+    p.getVector3fMap () += draw3 (noise, rng).cast<float> ();
+  const auto tip = buildCloudModel (jittered, noisy (sigma));
+  const std::vector<double> zs {-0.125, -0.075, -0.025, 0.025, 0.075, 0.125, 0.175, 0.225};
+  const auto clear = buildCloudModel (upright (0.018, zs), noisy (sigma));
+  const auto through = buildCloudModel (upright (-0.1, zs), noisy (sigma));
+  CollisionResult beside, crossing;
+  ASSERT_TRUE (collide (*clear, *tip, Eigen::Isometry3d::Identity (), surfaceRequest (), beside));
+  ASSERT_TRUE (collide (*through, *tip, Eigen::Isometry3d::Identity (), surfaceRequest (), crossing));
+  EXPECT_NE (beside.verdict, Verdict::InCollision) << beside.probability << " d " << beside.signed_distance;
+  EXPECT_EQ (crossing.verdict, Verdict::InCollision) << crossing.probability << " d " << crossing.signed_distance;
 }
 
 // A closed slab (given normals) whose top face has a hole 4 spacings wide (an occlusion
