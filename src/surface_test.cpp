@@ -438,7 +438,27 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
       double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
                     normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
       auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
-      if (!per_point && zOf (free) >= best_z)
+      // A wedge rather than a slab: the region behind both face planes ends at the line where
+      // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
+      // from the two planes vary linearly; where they are equal it lies deepest behind both,
+      // by `depth` (negative: beyond the tip). That depth, against the deviation the pair's
+      // points give it there, says how likely the segment passes through rather than beside
+      // the tip. Before this term a piano's corner 3 mm clear of the room (faces 137 degrees
+      // apart; the room's points 68 and 40 mm in front of each face, the tip blurred by the
+      // noise so that samples surrounded it) read P = 1; its segment lies 9 mm inside.
+      // Computed before the edge term's search, so that a pair it rules out costs no search.
+      const bool wedge = a.normal.dot (b.normal) > -kSlabFacesCosine;
+      double through_tip = 1.0;
+      if (wedge)
+      {
+        const double a_offset = b.distance + b.normal.dot (a.x - b.x);  // from b's face plane
+        const double slope = (g - a.distance) - (b.distance - a_offset);
+        const double s = std::clamp (slope != 0.0 ? (a_offset - a.distance) / slope : 0.5, 0.0, 1.0);
+        const double depth = std::min (-(a.distance + s * (g - a.distance)), -(a_offset + s * (b.distance - a_offset)));
+        through_tip = normalCdf (depth / std::hypot ((1.0 - s) * a.sigma, s * b.sigma));
+      }
+      // The edge term below only raises P_free: a pair already no better than the best is done.
+      if (!per_point && zOf (wedge ? 1.0 - (1.0 - free) * through_tip : free) >= best_z)
         continue;
       // Does the sheet reach where the pair meets a's face plane, or does the pair pass beside
       // or past its edge? Surrounded by samples of that face, it does. Otherwise the point may
@@ -457,22 +477,8 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
         const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));
         free = 1.0 - (1.0 - free) * normalCdf (-(at.tangential - 0.5 * h) / spread);
       }
-      // A wedge rather than a slab: the region behind both face planes ends at the line where
-      // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
-      // from the two planes vary linearly; where they are equal it lies deepest behind both,
-      // by `depth` (negative: beyond the tip). That depth, against the deviation the pair's
-      // points give it there, says how likely the segment passes through rather than beside
-      // the tip. Before this term a piano's corner 3 mm clear of the room (faces 137 degrees
-      // apart; the room's points 68 and 40 mm in front of each face, the tip blurred by the
-      // noise so that samples surrounded it) read P = 1; its segment lies 9 mm inside.
-      if (a.normal.dot (b.normal) > -kSlabFacesCosine)
-      {
-        const double h = b.distance + b.normal.dot (a.x - b.x);  // a's offset from b's face plane
-        const double slope = (g - a.distance) - (b.distance - h);
-        const double s = std::clamp (slope != 0.0 ? (h - a.distance) / slope : 0.5, 0.0, 1.0);
-        const double depth = std::min (-(a.distance + s * (g - a.distance)), -(h + s * (b.distance - h)));
-        free = 1.0 - (1.0 - free) * normalCdf (depth / std::hypot ((1.0 - s) * a.sigma, s * b.sigma));
-      }
+      if (wedge)
+        free = 1.0 - (1.0 - free) * through_tip;
       const double z = zOf (free);
       if (per_point)
       {
