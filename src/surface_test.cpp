@@ -69,6 +69,9 @@ constexpr double kCrossingTangentCosine = 0.7071;
   * corner seen edge on, a tapered part), whose planes meet near the pair: the pair may pass
   * beyond the wedge's tip. */
 constexpr double kSlabFacesCosine = 0.94;
+/** \brief ... and by more than this many of their normals' combined spreads
+  * (Evaluation::normal_spread): less is within the noise of a slab. */
+constexpr double kWedgeNormalSpreads = 2.0;
 /** \brief A winding number above this is inside (about 1 inside a closed surface, 0 outside). */
 constexpr double kInsideWinding = 0.5;
 
@@ -105,8 +108,19 @@ struct Scratch
     int index;
     Eigen::Vector3d x, normal, own_normal;  ///< the other's face normal; the point's own normal
     double distance, sigma, spacing;
+    double normal_spread;  ///< Evaluation::normal_spread of the other's face
   };
   std::vector<Outside> outside;
+  /** \brief The points found outside in the side's earlier leaves, and per leaf their range in
+    * it, bounding sphere and largest spacing: partners for crossings across leaves. */
+  std::vector<Outside> earlier;
+  struct OutsideLeaf
+  {
+    Eigen::Vector3d center = Eigen::Vector3d::Zero ();
+    double radius = 0.0, spacing = 0.0;
+    std::size_t begin = 0, end = 0;
+  };
+  std::vector<OutsideLeaf> earlier_leaves;
 
   void
   prepare (std::size_t n)
@@ -143,6 +157,10 @@ struct Evaluation
   bool bridged = false;
   int first = -1;          ///< the nearest sample (index into the samples)
   double tangential = 0.0; ///< x's distance from it across its normal
+  /** \brief How far the chosen face's sample normals scatter (radians, about their RMS angle
+    * from its normal): its normal is no surer than that. */
+  double normal_spread = 0.0;
+  bool past_edge = false;
 };
 
 /** \brief The quarter of the plane (spanned by unit u and w) that v points into, as a bit:
@@ -276,6 +294,9 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     out.distance = std::sqrt (beyond * beyond + along * along);
     out.normal = offset / std::max (offset.norm (), 1e-300);
     out.sigma = std::sqrt (variance_of (out.normal) + first.variance) + kDiscretisationPerDistance * h;
+    // The direction from a sample as uncertain as sigma: within sigma / distance of its own.
+    out.normal_spread = std::atan2 (out.sigma, out.distance);
+    out.past_edge = true;
     return true;
   }
   // The samples split into faces by their normals (up to kMaxFaces: the faces of a box's edge
@@ -314,7 +335,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   const double scale = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
   struct Fit
   {
-    double f = 0.0, fit_var = 0.0, weight = 0.0;
+    double f = 0.0, fit_var = 0.0, weight = 0.0, spread = 0.0;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero (), center = Eigen::Vector3d::Zero ();
   };
   auto fit = [&] (int c) {
@@ -354,6 +375,8 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     out.fit_var /= out.weight * out.weight;
     out.center /= out.weight;
     const double norm = out.normal.norm ();
+    // Mean resultant length R of the weighted unit normals: RMS angle about sqrt(2 (1 - R)).
+    out.spread = std::sqrt (2.0 * std::max (0.0, 1.0 - norm / std::max (out.weight, 1e-300)));
     out.normal = norm > 0.0 ? Eigen::Vector3d (out.normal / norm) : first.normal;
     return out;
   };
@@ -397,115 +420,176 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   const double disc = inside_face ? 0.0 : kDiscretisationPerDistance * std::min (tangential, g);
   out.distance = chosen.f;
   out.normal = chosen.normal;
+  out.normal_spread = chosen.spread;
   out.sigma = std::sqrt (variance_of (out.normal) + chosen.fit_var + disc * disc);
   return true;
 }
 
-/** \brief Crossings within one query leaf: two of its points outside the other surface, joined
-  * by their own surface (kCrossingSpacings, kCrossingTangentCosine), in front of the two opposite
-  * faces of one sheet of it (face normals more than 135 degrees apart, the second point behind
-  * the first's face plane): a wall about as thin as the noise, crossed, where no sample need lie
-  * deep inside anything. The pair misses the sheet only if both lie in front of the first face,
-  * or both beyond the second:
+/** \brief A crossing: two points of the query outside the other surface, joined by their own
+  * surface (kCrossingSpacings, kCrossingTangentCosine), in front of the two opposite faces of one
+  * sheet of it (face normals more than 135 degrees apart, the second point behind the first's
+  * face plane): a wall about as thin as the noise, crossed, where no sample need lie deep inside
+  * anything. The pair misses the sheet only if both lie in front of the first face, or both
+  * beyond the second:
   * P_free = Phi(d_a / s_a) Phi(g_b / s_b) + Phi(-(d_a + t) / s_a) Phi(d_b / s_b), g_b the second's
   * offset from the first's face plane (negative), t = max(0, -g_b - d_b) the sheet's thickness.
-  * Unless samples of that face surround the point where the pair meets its plane, the pair may
-  * pass beside or past the sheet's edge: P is scaled by the chance that the sheet reaches there. The distance is z sigma (z the
-  * crossing's Phi^-1, sigma the larger of the pair's deviations), at most the depth a crossing
-  * implies: the sheet's thickness and the smaller of the two clearances. */
+  * The pair may pass beside the sheet: past its edge (unless samples of that face surround the
+  * point where the pair meets its plane), beyond a wedge's tip, or in front of a third face. P
+  * is scaled by the chance of each. The distance is z sigma (z the crossing's Phi^-1, sigma the
+  * larger of the pair's deviations), at most the depth a crossing implies: the sheet's thickness
+  * and the smaller of the two clearances. */
+void
+crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& b, const Eigen::Vector3d& center,
+           int side, std::vector<float>* per_point, SurfaceAnswer& answer, double& best_z)
+{
+  const Eigen::Vector3d v = b.x - a.x;
+  const double length = v.norm ();
+  if (&a == &b || length <= 0.0 || length > kCrossingSpacings * std::max (a.spacing, b.spacing) ||
+      a.normal.dot (b.normal) > -kSameFaceCosine)
+    return;
+  const double g = a.distance + a.normal.dot (v);  // b's offset from a's face plane
+  if (g >= 0.0)
+    return;
+  // One sheet of the query: the same face (normals within 45 degrees), the segment along it.
+  if (a.own_normal.dot (b.own_normal) < kSameFaceCosine ||
+      std::abs (a.own_normal.dot (v)) > kCrossingTangentCosine * length ||
+      std::abs (b.own_normal.dot (v)) > kCrossingTangentCosine * length)
+    return;
+  const double t = std::max (0.0, -g - b.distance);
+  double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
+                normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
+  auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
+  // A wedge rather than a slab: the region behind both face planes ends at the line where
+  // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
+  // from the two planes vary linearly; where they are equal it lies deepest behind both,
+  // by `depth` (negative: beyond the tip). That depth, against the deviation the pair's
+  // points give it there, says how likely the segment passes through rather than beside
+  // the tip. Before this term a piano's corner 3 mm clear of the room (faces 137 degrees
+  // apart; the room's points 68 and 40 mm in front of each face, the tip blurred by the
+  // noise so that samples surrounded it) read P = 1; its segment lies 9 mm inside.
+  // Computed before the edge term's search, so that a pair it rules out costs no search.
+  // Noisy normals make a slab's faces look like a wedge's: only a lead over two of their
+  // combined spreads is a wedge. (At 4 % noise slabs' faces read 20-40 degrees apart with
+  // spreads of 10-35 each, and the term read collisions 3-7 sigma deep as contact.)
+  const double apart = std::acos (std::clamp (-a.normal.dot (b.normal), -1.0, 1.0));
+  const bool wedge = apart > std::max (std::acos (kSlabFacesCosine),
+                                       kWedgeNormalSpreads * std::hypot (a.normal_spread, b.normal_spread));
+  double through_tip = 1.0;
+  if (wedge)
+  {
+    const double a_offset = b.distance + b.normal.dot (a.x - b.x);  // from b's face plane
+    const double slope = (g - a.distance) - (b.distance - a_offset);
+    const double s = std::clamp (slope != 0.0 ? (a_offset - a.distance) / slope : 0.5, 0.0, 1.0);
+    const double depth = std::min (-(a.distance + s * (g - a.distance)), -(a_offset + s * (b.distance - a_offset)));
+    through_tip = normalCdf (depth / std::hypot ((1.0 - s) * a.sigma, s * b.sigma));
+  }
+  // The edge term below only raises P_free: a pair already no better than the best is done.
+  if (!per_point && zOf (wedge ? 1.0 - (1.0 - free) * through_tip : free) >= best_z)
+    return;
+  // Does the sheet reach where the pair meets a's face plane, or does the pair pass beside
+  // or past its edge? Surrounded by samples of that face, it does. Otherwise the point may
+  // lie past an edge: the edge lies anywhere within a spacing past the last sample (half a
+  // spacing on average, 0.29 spacing deviation: kDiscretisationPerDistance's model), and
+  // the point itself is as uncertain as the pair.
+  const Eigen::Vector3d x = a.x + (a.distance / (a.distance - g)) * v;
+  Evaluation at;
+  if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
+                 [] (const Eigen::Vector3d&) { return 0.0; }, at))
+    return;
+  const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
+  if (!surrounded (x, first, kCrossingSpacings, scratch.pool, scratch.cache))
+  {
+    const double h = std::max (first.spacing, 1e-12);
+    const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));
+    free = 1.0 - (1.0 - free) * normalCdf (-(at.tangential - 0.5 * h) / spread);
+  }
+  if (wedge)
+    free = 1.0 - (1.0 - free) * through_tip;
+  // Beside the sheet: where the pair meets a's face plane, another face of the other surface
+  // (neither pair's) has x in front of it, as past a box's edge. Samples of that face,
+  // within the sheet's band of the plane near the edge, make x look surrounded. The sheet
+  // reaches x only if x lies behind that face. (Before this term a room's wall 11 mm from a
+  // piano's underside read P = 1: its points 369 mm apart straddled the piano's sides.)
+  if (!at.past_edge && at.distance > 0.0 && at.normal.dot (a.normal) < kSameFaceCosine &&
+      at.normal.dot (b.normal) < kSameFaceCosine)
+    free = 1.0 - (1.0 - free) * normalCdf (-at.distance / std::hypot (at.sigma, std::max (a.sigma, b.sigma)));
+  const double z = zOf (free);
+  if (per_point)
+  {
+    const float p = static_cast<float> (1.0 - free);
+    for (const int i : {a.index, b.index})
+    {
+      float& slot = (*per_point)[static_cast<std::size_t> (i)];
+      if (std::isnan (slot) || p > slot)
+        slot = p;
+    }
+  }
+  if (z < best_z)
+  {
+    best_z = z;
+    answer.reached = true;
+    // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
+    // the depth a crossing implies (the sheet's thickness and the smaller clearance).
+    const double sigma = std::max (a.sigma, b.sigma);
+    answer.signed_distance = std::max (z * sigma, -(t + std::min (a.distance, b.distance)));
+    answer.signed_distance_std = sigma;
+    answer.unobserved = false;
+    answer.witness_side = side;
+    answer.witness_index = a.index;
+    answer.witness_point = x;
+    answer.witness_normal = side > 0 ? a.normal : Eigen::Vector3d (-a.normal);
+  }
+}
+
+/** \brief The crossings of one query leaf's points found outside (scratch.outside): among
+  * themselves, and with the points of the side's earlier leaves within reach (a pair straddling
+  * a wall as thick as a leaf is wide lies in two leaves). Then adds them to those. A pair across
+  * leaves is judged against this leaf's pool of samples. */
 void
 crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vector<float>* per_point,
            SurfaceAnswer& answer, double& best_z)
 {
   const auto& outside = scratch.outside;
+  if (outside.empty ())
+    return;
   for (const Scratch::Outside& a : outside)
     for (const Scratch::Outside& b : outside)
+      if (&a != &b)
+        crossPair (scratch, a, b, center, side, per_point, answer, best_z);
+  // This leaf's bounding sphere and widest reach.
+  Scratch::OutsideLeaf leaf;
+  leaf.begin = scratch.earlier.size ();
+  for (const Scratch::Outside& a : outside)
+  {
+    leaf.center += a.x;
+    leaf.spacing = std::max (leaf.spacing, a.spacing);
+  }
+  leaf.center /= static_cast<double> (outside.size ());
+  for (const Scratch::Outside& a : outside)
+    leaf.radius = std::max (leaf.radius, (a.x - leaf.center).norm ());
+  for (const Scratch::OutsideLeaf& other : scratch.earlier_leaves)
+  {
+    const double reach = kCrossingSpacings * std::max (leaf.spacing, other.spacing);
+    if ((other.center - leaf.center).norm () > leaf.radius + other.radius + reach)
+      continue;
+    for (const Scratch::Outside& a : outside)
     {
-      const Eigen::Vector3d v = b.x - a.x;
-      const double length = v.norm ();
-      if (&a == &b || length <= 0.0 || length > kCrossingSpacings * std::max (a.spacing, b.spacing) ||
-          a.normal.dot (b.normal) > -kSameFaceCosine)
+      if ((a.x - other.center).norm () > other.radius + reach)
         continue;
-      const double g = a.distance + a.normal.dot (v);  // b's offset from a's face plane
-      if (g >= 0.0)
-        continue;
-      // One sheet of the query: the same face (normals within 45 degrees), the segment along it.
-      if (a.own_normal.dot (b.own_normal) < kSameFaceCosine ||
-          std::abs (a.own_normal.dot (v)) > kCrossingTangentCosine * length ||
-          std::abs (b.own_normal.dot (v)) > kCrossingTangentCosine * length)
-        continue;
-      const double t = std::max (0.0, -g - b.distance);
-      double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
-                    normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
-      auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
-      // A wedge rather than a slab: the region behind both face planes ends at the line where
-      // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
-      // from the two planes vary linearly; where they are equal it lies deepest behind both,
-      // by `depth` (negative: beyond the tip). That depth, against the deviation the pair's
-      // points give it there, says how likely the segment passes through rather than beside
-      // the tip. Before this term a piano's corner 3 mm clear of the room (faces 137 degrees
-      // apart; the room's points 68 and 40 mm in front of each face, the tip blurred by the
-      // noise so that samples surrounded it) read P = 1; its segment lies 9 mm inside.
-      // Computed before the edge term's search, so that a pair it rules out costs no search.
-      const bool wedge = a.normal.dot (b.normal) > -kSlabFacesCosine;
-      double through_tip = 1.0;
-      if (wedge)
+      for (std::size_t k = other.begin; k < other.end; ++k)
       {
-        const double a_offset = b.distance + b.normal.dot (a.x - b.x);  // from b's face plane
-        const double slope = (g - a.distance) - (b.distance - a_offset);
-        const double s = std::clamp (slope != 0.0 ? (a_offset - a.distance) / slope : 0.5, 0.0, 1.0);
-        const double depth = std::min (-(a.distance + s * (g - a.distance)), -(a_offset + s * (b.distance - a_offset)));
-        through_tip = normalCdf (depth / std::hypot ((1.0 - s) * a.sigma, s * b.sigma));
-      }
-      // The edge term below only raises P_free: a pair already no better than the best is done.
-      if (!per_point && zOf (wedge ? 1.0 - (1.0 - free) * through_tip : free) >= best_z)
-        continue;
-      // Does the sheet reach where the pair meets a's face plane, or does the pair pass beside
-      // or past its edge? Surrounded by samples of that face, it does. Otherwise the point may
-      // lie past an edge: the edge lies anywhere within a spacing past the last sample (half a
-      // spacing on average, 0.29 spacing deviation: kDiscretisationPerDistance's model), and
-      // the point itself is as uncertain as the pair.
-      const Eigen::Vector3d x = a.x + (a.distance / (a.distance - g)) * v;
-      Evaluation at;
-      if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
-                     [] (const Eigen::Vector3d&) { return 0.0; }, at))
-        continue;
-      const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
-      if (!surrounded (x, first, kCrossingSpacings, scratch.pool, scratch.cache))
-      {
-        const double h = std::max (first.spacing, 1e-12);
-        const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));
-        free = 1.0 - (1.0 - free) * normalCdf (-(at.tangential - 0.5 * h) / spread);
-      }
-      if (wedge)
-        free = 1.0 - (1.0 - free) * through_tip;
-      const double z = zOf (free);
-      if (per_point)
-      {
-        const float p = static_cast<float> (1.0 - free);
-        for (const int i : {a.index, b.index})
-        {
-          float& slot = (*per_point)[static_cast<std::size_t> (i)];
-          if (std::isnan (slot) || p > slot)
-            slot = p;
-        }
-      }
-      if (z < best_z)
-      {
-        best_z = z;
-        answer.reached = true;
-        // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
-        // the depth a crossing implies (the sheet's thickness and the smaller clearance).
-        const double sigma = std::max (a.sigma, b.sigma);
-        answer.signed_distance = std::max (z * sigma, -(t + std::min (a.distance, b.distance)));
-        answer.signed_distance_std = sigma;
-        answer.unobserved = false;
-        answer.witness_side = side;
-        answer.witness_index = a.index;
-        answer.witness_point = x;
-        answer.witness_normal = side > 0 ? a.normal : Eigen::Vector3d (-a.normal);
+        const Scratch::Outside& b = scratch.earlier[k];
+        const double pair_reach = kCrossingSpacings * std::max (a.spacing, b.spacing);
+        if ((b.x - a.x).squaredNorm () > pair_reach * pair_reach || a.normal.dot (b.normal) > -kSameFaceCosine)
+          continue;
+        crossPair (scratch, a, b, center, side, per_point, answer, best_z);
+        crossPair (scratch, b, a, center, side, per_point, answer, best_z);
       }
     }
+  }
+  scratch.earlier.insert (scratch.earlier.end (), outside.begin (), outside.end ());
+  leaf.end = scratch.earlier.size ();
+  scratch.earlier_leaves.push_back (leaf);
 }
 
 /** \brief True when the surface's area-weighted normals cancel to within kClosedFlux of its
@@ -540,6 +624,8 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const Eigen::Matrix3d R_s = T_s.linear ();
   const Eigen::Isometry3d T_s_inverse = T_s.inverse ();
   scratch.prepare (s_bvh.size ());
+  scratch.earlier.clear ();
+  scratch.earlier_leaves.clear ();
   const std::uint32_t cache_stamp = scratch.next ();
   for (std::size_t g = 0; g < groups.size ();)
   {
@@ -615,7 +701,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const double z = e.distance / sigma;
       if (e.distance > 0.0 && !e.normal.isZero ())
         scratch.outside.push_back ({i, x, e.normal, R_q * q_model.normals ()[qi].cast<double> (), e.distance, sigma,
-                                    static_cast<double> (q_model.spacing ()[qi])});
+                                    static_cast<double> (q_model.spacing ()[qi]), e.normal_spread});
       if (per_point)
       {
         float& slot = (*per_point)[qi];

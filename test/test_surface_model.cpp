@@ -378,6 +378,23 @@ TEST (SurfaceLayer, ThinSheetsCrossingWithoutDeepSamples)
   EXPECT_EQ (clear.verdict, Verdict::Free) << clear.probability << " d " << clear.signed_distance;
 }
 
+// The same crossing with both hierarchies split down to leaves of at most 2 points: the pairs
+// that straddle the wall lie in different leaves, and are found across them (within leaves
+// alone P = 0.46).
+TEST (SurfaceLayer, CrossingsAcrossLeaves)
+{
+  const double sigma = 0.01;
+  const std::vector<double> zs {-0.14, -0.10, -0.06, -0.02, 0.05, 0.09, 0.13, 0.17};
+  CloudModelParams small_leaves = noisy (sigma);
+  small_leaves.hierarchy.n_max = 2;
+  small_leaves.hierarchy.n_min = 1;
+  const auto wall = buildCloudModel (slab (1.0, 0.03, 0.05), small_leaves);
+  const auto through = buildCloudModel (plate (-0.2, zs), small_leaves);
+  CollisionResult crossing;
+  ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), crossing));
+  EXPECT_EQ (crossing.verdict, Verdict::InCollision) << crossing.probability << " d " << crossing.signed_distance;
+}
+
 /** \brief A closed wedge (given normals): its tip along y at x = 0, z = 0, its two faces opening
   * toward -x at half-angle alpha (outward normals (sin a, 0, +-cos a): 180 - 2 alpha degrees
   * apart, where a slab's are 180), closed by a back face at x = -length; sampled every h. */
