@@ -529,10 +529,16 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     best_z = z;
     answer.reached = true;
     // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
-    // the depth a crossing implies (the sheet's thickness and the smaller clearance).
+    // the depth a crossing implies (the sheet's thickness and the smaller clearance). At that
+    // bound the depth is not known: a part through a thin wall may stick out anywhere from 0
+    // to it, and the deviation says so (half the bound: the +-2 deviation interval reaches 0;
+    // P keeps the crossing's z). With the pair's deviation, collisions 2-28 mm deep read 30-84
+    // mm +- 10-15 (docs/SURFACE.md, step 4).
     const double sigma = std::max (a.sigma, b.sigma);
-    answer.signed_distance = std::max (z * sigma, -(t + std::min (a.distance, b.distance)));
-    answer.signed_distance_std = sigma;
+    const double bound = t + std::min (a.distance, b.distance);
+    const bool at_bound = z * sigma < -bound;
+    answer.signed_distance = at_bound ? -bound : z * sigma;
+    answer.signed_distance_std = at_bound ? std::max (sigma, 0.5 * bound) : sigma;
     answer.unobserved = false;
     answer.witness_side = side;
     answer.witness_index = a.index;
