@@ -437,7 +437,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   * point where the pair meets its plane), beyond a wedge's tip, or in front of a third face. P
   * is scaled by the chance of each. The distance is z sigma (z the crossing's Phi^-1, sigma the
   * larger of the pair's deviations), at most the depth a crossing implies: the sheet's thickness
-  * and the smaller of the two clearances. */
+  * and the smaller of the two clearances; there the deviation is at least half that bound. */
 void
 crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& b, const Eigen::Vector3d& center,
            int side, std::vector<float>* per_point, SurfaceAnswer& answer, double& best_z)
