@@ -160,7 +160,7 @@ struct Evaluation
   /** \brief How far the chosen face's sample normals scatter (radians, about their RMS angle
     * from its normal): its normal is no surer than that. */
   double normal_spread = 0.0;
-  bool past_edge = false;
+  bool past_edge = false;  ///< past the surface's edge: normal is the direction from the last sample
 };
 
 /** \brief The quarter of the plane (spanned by unit u and w) that v points into, as a bit:
