@@ -560,8 +560,7 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
     return;
   for (const Scratch::Outside& a : outside)
     for (const Scratch::Outside& b : outside)
-      if (&a != &b)
-        crossPair (scratch, a, b, center, side, per_point, answer, best_z);
+      crossPair (scratch, a, b, center, side, per_point, answer, best_z);
   // This leaf's bounding sphere and widest reach.
   Scratch::OutsideLeaf leaf;
   leaf.begin = scratch.earlier.size ();
@@ -584,12 +583,8 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
         continue;
       for (std::size_t k = other.begin; k < other.end; ++k)
       {
-        const Scratch::Outside& b = scratch.earlier[k];
-        const double pair_reach = kCrossingSpacings * std::max (a.spacing, b.spacing);
-        if ((b.x - a.x).squaredNorm () > pair_reach * pair_reach || a.normal.dot (b.normal) > -kSameFaceCosine)
-          continue;
-        crossPair (scratch, a, b, center, side, per_point, answer, best_z);
-        crossPair (scratch, b, a, center, side, per_point, answer, best_z);
+        crossPair (scratch, a, scratch.earlier[k], center, side, per_point, answer, best_z);
+        crossPair (scratch, scratch.earlier[k], a, center, side, per_point, answer, best_z);
       }
     }
   }
