@@ -256,6 +256,53 @@ TEST (SurfaceLayer, SparseSurfaceIsContinuousBetweenSamples)
   EXPECT_LT (over.probability, 0.1) << over.signed_distance << " +- " << over.signed_distance_std;
 }
 
+// Beside a sampled edge the surface may end anywhere within a gap past the last samples: a point
+// in the table's plane, 0.9 spacings past its edge, is not read as on the extended table
+// (P about 0.5 before the edge's mixture), while one between four samples inside the table is.
+TEST (SurfaceLayer, BesideAnEdgeTheSurfaceMayEnd)
+{
+  const double sigma = 0.001;
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (sigma));
+  // The table's samples on its rim are open toward the outside, inner ones are not.
+  std::size_t open = 0;
+  for (const Eigen::Vector4f& o : table->surface ().openings ())
+    open += o.head<3> ().isZero () ? 0u : 1u;
+  EXPECT_GE (open, 4u * 40u - 4u);
+  EXPECT_LE (open, 4u * 40u + 4u);
+  pcl::PointCloud<pcl::PointXYZ> probe;
+  probe.push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
+  const auto point = buildCloudModel (probe, withSurface ());
+  CollisionResult beside, inside;
+  ASSERT_TRUE (collide (*point, *table, shift (-0.209, -0.005, 0.0), surfaceRequest (), beside));
+  ASSERT_TRUE (collide (*point, *table, shift (-0.005, -0.005, 0.0), surfaceRequest (), inside));
+  EXPECT_LT (beside.probability, 0.35) << beside.signed_distance << " +- " << beside.signed_distance_std;
+  EXPECT_GT (beside.signed_distance, 0.0);
+  EXPECT_GT (inside.probability, 0.35) << inside.signed_distance << " +- " << inside.signed_distance_std;
+  EXPECT_LT (inside.probability, 0.65);
+}
+
+// A row of mesh vertices inside a flat face (a triangle edge): each sees its neighbours along
+// the row, 180 degrees open on either side, which says nothing about where the face goes on.
+TEST (SurfaceModel, ARowOfVerticesIsNoEdge)
+{
+  auto cloud = sheet (0.4, 0.02, 0.0, Eigen::Vector3f (0, 0, 1));
+  for (int i = -50; i <= 50; ++i)
+    cloud.push_back (pcl::PointXYZ (0.002f * static_cast<float> (i), 0.001f, 0.0f));
+  const auto model = buildCloudModel (cloud, noisy (0.001));
+  const auto& means = model->hierarchy ().means ();
+  std::size_t row = 0, open = 0;
+  for (std::size_t i = 0; i < means.size (); ++i)
+  {
+    const Eigen::Vector3d p = means[i] + model->origin ();
+    if (std::abs (p.y () - 0.001) > 1e-4 || std::abs (p.x ()) > 0.08)
+      continue;
+    ++row;
+    open += model->surface ().openings ()[i].head<3> ().isZero () ? 0u : 1u;
+  }
+  EXPECT_GE (row, 70u);
+  EXPECT_EQ (open, 0u);
+}
+
 // A small ball entirely inside a big closed surface with given outward normals: no point is
 // within reach, and the winding number reports the containment.
 TEST (SurfaceLayer, ContainmentFromTheWindingNumber)

@@ -72,6 +72,13 @@ public:
   const std::vector<Eigen::Vector3f>& normals () const { return normals_; }
   /** \brief Local sample spacing s_i of each point (data units). */
   const std::vector<float>& spacing () const { return spacing_; }
+  /** \brief Per point, where its neighbours leave the surface open (the point lies on its
+    * edge): xyz the bisector, in the tangent plane, of the widest angle between its neighbours
+    * seen from it, of length the distance to its k-th neighbour (how far they show the surface
+    * open); w the cosine of half that angle. Zero where that angle is at most 150 degrees (an
+    * inner point) or the neighbours lie along a line (a row of mesh vertices). A direction d in
+    * the plane points off the surface, within that length, when xyz . d > w |xyz| |d|. */
+  const std::vector<Eigen::Vector4f>& openings () const { return open_; }
   /** \brief Median of spacing(): the cloud's typical sample spacing. */
   double medianSpacing () const { return median_spacing_; }
   /** \brief The spacing at a typical place of the surface (not of a typical sample): the median
@@ -102,6 +109,7 @@ public:
 private:
   std::vector<Eigen::Vector3f> normals_;
   std::vector<float> spacing_;
+  std::vector<Eigen::Vector4f> open_;
   /** \brief Each point's owner leaf (the first leaf holding it): a point counts once. */
   std::vector<std::int32_t> owner_;
   std::vector<Dipole> dipoles_;
