@@ -98,7 +98,7 @@ struct Scratch
   std::vector<std::uint32_t> pooled, cached;  ///< stamps per point of the surface's model
   std::vector<Sample> cache;                  ///< the surface's samples mapped into A's frame
   std::vector<int> pool;
-  std::vector<int> wide;              ///< samples within the bridging reach (farRimAnywhere)
+  std::vector<int> wide;              ///< one leaf's samples within the bridging reach (farRimAnywhere)
   std::vector<std::int32_t> stack;    ///< its hierarchy walk
   /** \brief Per pool entry, its sample's distance from the query leaf's centre; pool and keys
     * sorted by it, so that a nearest-sample search can stop early (triangle inequality). */
@@ -686,12 +686,13 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
                          R_s * open.head<3> ().cast<double> (), static_cast<double> (open.w ())};
   };
   // evaluate's far-rim test sees the pool alone: before a point is read as beside an edge
-  // (Evaluation::beside_edge), the whole surface within the bridging reach is searched.
+  // (Evaluation::beside_edge), the whole surface within the bridging reach is searched, leaf by
+  // leaf, stopping at the first far-rim sample.
   auto farRimAnywhere = [&] (const Eigen::Vector3d& x, const Evaluation& e) {
     const Sample& first = scratch.cache[static_cast<std::size_t> (e.first)];
     const double reach = kBridgeSpacings * first.gap;
+    const double along = first.normal.dot (x - first.position);
     const Eigen::Vector3d x_s = T_s_inverse * x;
-    scratch.wide.clear ();
     scratch.stack.assign (1, ProbabilisticBVH::rootId ());
     while (!scratch.stack.empty ())
     {
@@ -706,6 +707,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
           scratch.stack.push_back (node.first_child + c);
         continue;
       }
+      scratch.wide.clear ();
       for (const int j : s_bvh.indices (node))
       {
         const std::size_t sj = static_cast<std::size_t> (j);
@@ -714,9 +716,10 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         cacheSample (sj);
         scratch.wide.push_back (j);
       }
+      if (farRim (x, first, along, e.tangential, kBridgeSpacings, scratch.wide, scratch.cache))
+        return true;
     }
-    const double along = first.normal.dot (x - first.position);
-    return farRim (x, first, along, e.tangential, kBridgeSpacings, scratch.wide, scratch.cache);
+    return false;
   };
   for (std::size_t g = 0; g < groups.size ();)
   {
