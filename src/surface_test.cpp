@@ -64,6 +64,17 @@ constexpr double kCrossingSpacings = 3.0;
   * within 45 degrees of the tangent plane at both ends (|n . u| below this): the two faces of a
   * slab, a fork's facing prongs or the two sides of a corner are not one sheet. */
 constexpr double kCrossingTangentCosine = 0.7071;
+/** \brief A crossing's end is extended along the query's surface (farthestJoined) to a joined
+  * point in front of the same face: its own distance within this many of its deviations of its
+  * offset from the end's face plane (not another face with the same normal). */
+constexpr double kCrossingPlaneSigmas = 2.0;
+/** \brief ... only where the sheet's samples resolve its edges: their noise deviation, times
+  * this, under their spacing. Otherwise the test that the sheet reaches the crossing (surrounded)
+  * is blurred by the noise, and a crossing made certain by far points of a large query surface
+  * reads P = 1 for a free pose (at 1 % noise, the room's surface beside a thin part of the piano
+  * 12 mm clear of it: the part looked as reaching through, the room's points 100 mm either side
+  * made the pair sure). */
+constexpr double kCrossingResolvedSigmas = 3.0;
 /** \brief A crossing's two faces are a slab's (parallel, their planes meeting far away) when
   * their normals are within 20 degrees of opposite; further apart they are a wedge (a box's
   * corner seen edge on, a tapered part), whose planes meet near the pair: the pair may pass
@@ -470,6 +481,49 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   return true;
 }
 
+/** \brief Of the points found outside (this leaf's and the side's earlier leaves' within
+  * reach), the one farthest in front of p's face plane in its own deviations ((offset + t) /
+  * sigma, t the sheet's thickness), among p and the points joined to p by the query's own surface
+  * (kCrossingSpacings, kCrossingTangentCosine, normals within kSameFaceCosine) that lie in front
+  * of that same face: their own distance within kCrossingPlaneSigmas of their offset from p's
+  * face plane (not another face with the same normal). Returns that point and its offset. */
+std::pair<const Scratch::Outside*, double>
+farthestJoined (const Scratch& scratch, const Scratch::Outside& p, double t)
+{
+  const Scratch::Outside* best = &p;
+  double best_offset = p.distance;
+  double best_score = (p.distance + t) / p.sigma;
+  auto consider = [&] (const Scratch::Outside& q) {
+    if (&q == &p)
+      return;
+    const Eigen::Vector3d v = q.x - p.x;
+    const double offset = p.distance + p.normal.dot (v);
+    const double score = (offset + t) / q.sigma;
+    if (score <= best_score)
+      return;
+    const double length = v.norm ();
+    if (length <= 0.0 || length > kCrossingSpacings * std::max (p.spacing, q.spacing) ||
+        q.normal.dot (p.normal) < kSameFaceCosine || q.own_normal.dot (p.own_normal) < kSameFaceCosine ||
+        std::abs (q.distance - offset) > kCrossingPlaneSigmas * q.sigma ||
+        std::abs (p.own_normal.dot (v)) > kCrossingTangentCosine * length ||
+        std::abs (q.own_normal.dot (v)) > kCrossingTangentCosine * length)
+      return;
+    best_score = score;
+    best_offset = offset;
+    best = &q;
+  };
+  for (const Scratch::Outside& q : scratch.outside)
+    consider (q);
+  for (const Scratch::OutsideLeaf& leaf : scratch.earlier_leaves)
+  {
+    if ((leaf.center - p.x).norm () > leaf.radius + kCrossingSpacings * std::max (leaf.spacing, p.spacing))
+      continue;
+    for (std::size_t k = leaf.begin; k < leaf.end; ++k)
+      consider (scratch.earlier[k]);
+  }
+  return {best, best_offset};
+}
+
 /** \brief A crossing: two points of the query outside the other surface, joined by their own
   * surface (kCrossingSpacings, kCrossingTangentCosine), in front of the two opposite faces of one
   * sheet of it (face normals more than 135 degrees apart, the second point behind the first's
@@ -501,8 +555,17 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
       std::abs (b.own_normal.dot (v)) > kCrossingTangentCosine * length)
     return;
   const double t = std::max (0.0, -g - b.distance);
-  double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
-                normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
+  // The pair's ends extended along the query's surface: a point joined to a that lies farther
+  // in front of a's face (or to b, beyond the sheet) makes a crossing surer and deeper than
+  // the pair alone shows (a part pushed 50 mm through a 10 mm wall reads as a crossing by the
+  // pairs nearest the wall, each alone a few deviations from either face).
+  auto [a_end, a_reach] = farthestJoined (scratch, a, t);
+  auto [b_end, b_reach] = farthestJoined (scratch, b, t);
+  const double in_front = std::min (normalCdf (g / b.sigma), normalCdf (-(b_reach + t) / b_end->sigma));
+  const double beyond = std::min (normalCdf (-(a.distance + t) / a.sigma), normalCdf (-(a_reach + t) / a_end->sigma));
+  double free = normalCdf (a.distance / a.sigma) * in_front + beyond * normalCdf (b.distance / b.sigma);
+  const double pair_free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
+                           normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
   auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
   // A wedge rather than a slab: the region behind both face planes ends at the line where
   // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
@@ -542,6 +605,15 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
                  [] (const Eigen::Vector3d&) { return 0.0; }, at))
     return;
   const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
+  // Where the noise blurs the sheet's edges, the pair's own ends (kCrossingResolvedSigmas).
+  if (kCrossingResolvedSigmas * std::sqrt (std::max (first.variance, 0.0)) >= first.spacing)
+  {
+    free = pair_free;
+    a_end = &a;
+    a_reach = a.distance;
+    b_end = &b;
+    b_reach = b.distance;
+  }
   if (!surrounded (x, first, kCrossingSpacings, scratch.pool, scratch.cache))
   {
     const double h = std::max (first.spacing, 1e-12);
@@ -579,8 +651,8 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     // to it, and the deviation says so (half the bound: the +-2 deviation interval reaches 0;
     // P keeps the crossing's z). With the pair's deviation, collisions 2-28 mm deep read 30-84
     // mm +- 10-15 (docs/SURFACE.md, step 4).
-    const double sigma = std::max (a.sigma, b.sigma);
-    const double bound = t + std::min (a.distance, b.distance);
+    const double sigma = std::max (a_end->sigma, b_end->sigma);
+    const double bound = t + std::min (a_reach, b_reach);
     const bool at_bound = z * sigma < -bound;
     answer.signed_distance = at_bound ? -bound : z * sigma;
     answer.signed_distance_std = at_bound ? std::max (sigma, 0.5 * bound) : sigma;

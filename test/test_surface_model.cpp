@@ -442,6 +442,23 @@ TEST (SurfaceLayer, CrossingsAcrossLeaves)
   EXPECT_EQ (crossing.verdict, Verdict::InCollision) << crossing.probability << " d " << crossing.signed_distance;
 }
 
+// A plate pushed 10 cm through the wall (heights every 4 cm, 10 cm on either side): the pairs
+// nearest the wall alone bound the depth by the wall and their own 2 cm clearance (d = -5 cm).
+// The pair's ends extended along the plate's own surface reach its ends: the depth (the smaller
+// of the two ways out, 13 cm) reads within one of the plate's sample spacings.
+TEST (SurfaceLayer, ACrossingReachesAlongTheCrossingSurface)
+{
+  const double sigma = 0.01;
+  const auto wall = buildCloudModel (slab (1.0, 0.03, 0.05), noisy (sigma));
+  const std::vector<double> zs {-0.10, -0.06, -0.02, 0.05, 0.09, 0.13};
+  const auto through = buildCloudModel (plate (-0.2, zs), noisy (sigma));
+  CollisionResult r;
+  ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), r));
+  EXPECT_EQ (r.verdict, Verdict::InCollision) << r.probability;
+  const double depth = 0.10 + 0.03;
+  EXPECT_NEAR (r.signed_distance, -depth, 0.04) << r.signed_distance << " +- " << r.signed_distance_std;
+}
+
 /** \brief A closed wedge (given normals): its tip along y at x = 0, z = 0, its two faces opening
   * toward -x at half-angle alpha (outward normals (sin a, 0, +-cos a): 180 - 2 alpha degrees
   * apart, where a slab's are 180), closed by a back face at x = -length; sampled every h. */
