@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 #include <utility>
 
 namespace pcl_probcollision
@@ -481,12 +482,24 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   return true;
 }
 
+/** \brief Whether p and q (v = q - p, length = |v|) are joined by their object's own surface,
+  * as the crossing test takes it: within kCrossingSpacings of their spacings, their own normals
+  * within kSameFaceCosine, and the segment along the surface at both ends (kCrossingTangentCosine). */
+bool
+joinedBySurface (const Scratch::Outside& p, const Scratch::Outside& q, const Eigen::Vector3d& v, double length)
+{
+  return length > 0.0 && length <= kCrossingSpacings * std::max (p.spacing, q.spacing) &&
+         p.own_normal.dot (q.own_normal) >= kSameFaceCosine &&
+         std::abs (p.own_normal.dot (v)) <= kCrossingTangentCosine * length &&
+         std::abs (q.own_normal.dot (v)) <= kCrossingTangentCosine * length;
+}
+
 /** \brief Of the points found outside (this leaf's and the side's earlier leaves' within
   * reach), the one farthest in front of p's face plane in its own deviations ((offset + t) /
-  * sigma, t the sheet's thickness), among p and the points joined to p by the query's own surface
-  * (kCrossingSpacings, kCrossingTangentCosine, normals within kSameFaceCosine) that lie in front
-  * of that same face: their own distance within kCrossingPlaneSigmas of their offset from p's
-  * face plane (not another face with the same normal). Returns that point and its offset. */
+  * sigma, t the sheet's thickness), among p and the points joined to p (joinedBySurface) that
+  * face the same way (normals within kSameFaceCosine) and lie in front of that same face: their
+  * own distance within kCrossingPlaneSigmas of their offset from p's face plane (not another
+  * face with the same normal). Returns that point and its offset. */
 std::pair<const Scratch::Outside*, double>
 farthestJoined (const Scratch& scratch, const Scratch::Outside& p, double t)
 {
@@ -499,14 +512,8 @@ farthestJoined (const Scratch& scratch, const Scratch::Outside& p, double t)
     const Eigen::Vector3d v = q.x - p.x;
     const double offset = p.distance + p.normal.dot (v);
     const double score = (offset + t) / q.sigma;
-    if (score <= best_score)
-      return;
-    const double length = v.norm ();
-    if (length <= 0.0 || length > kCrossingSpacings * std::max (p.spacing, q.spacing) ||
-        q.normal.dot (p.normal) < kSameFaceCosine || q.own_normal.dot (p.own_normal) < kSameFaceCosine ||
-        std::abs (q.distance - offset) > kCrossingPlaneSigmas * q.sigma ||
-        std::abs (p.own_normal.dot (v)) > kCrossingTangentCosine * length ||
-        std::abs (q.own_normal.dot (v)) > kCrossingTangentCosine * length)
+    if (score <= best_score || q.normal.dot (p.normal) < kSameFaceCosine ||
+        std::abs (q.distance - offset) > kCrossingPlaneSigmas * q.sigma || !joinedBySurface (p, q, v, v.norm ()))
       return;
     best_score = score;
     best_offset = offset;
@@ -543,29 +550,35 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
 {
   const Eigen::Vector3d v = b.x - a.x;
   const double length = v.norm ();
-  if (&a == &b || length <= 0.0 || length > kCrossingSpacings * std::max (a.spacing, b.spacing) ||
-      a.normal.dot (b.normal) > -kSameFaceCosine)
+  if (&a == &b || a.normal.dot (b.normal) > -kSameFaceCosine)
     return;
   const double g = a.distance + a.normal.dot (v);  // b's offset from a's face plane
-  if (g >= 0.0)
-    return;
-  // One sheet of the query: the same face (normals within 45 degrees), the segment along it.
-  if (a.own_normal.dot (b.own_normal) < kSameFaceCosine ||
-      std::abs (a.own_normal.dot (v)) > kCrossingTangentCosine * length ||
-      std::abs (b.own_normal.dot (v)) > kCrossingTangentCosine * length)
+  // One sheet of the query, b behind a's face plane.
+  if (g >= 0.0 || !joinedBySurface (a, b, v, length))
     return;
   const double t = std::max (0.0, -g - b.distance);
-  // The pair's ends extended along the query's surface: a point joined to a that lies farther
-  // in front of a's face (or to b, beyond the sheet) makes a crossing surer and deeper than
-  // the pair alone shows (a part pushed 50 mm through a 10 mm wall reads as a crossing by the
-  // pairs nearest the wall, each alone a few deviations from either face).
-  auto [a_end, a_reach] = farthestJoined (scratch, a, t);
-  auto [b_end, b_reach] = farthestJoined (scratch, b, t);
-  const double in_front = std::min (normalCdf (g / b.sigma), normalCdf (-(b_reach + t) / b_end->sigma));
-  const double beyond = std::min (normalCdf (-(a.distance + t) / a.sigma), normalCdf (-(a_reach + t) / a_end->sigma));
-  double free = normalCdf (a.distance / a.sigma) * in_front + beyond * normalCdf (b.distance / b.sigma);
-  const double pair_free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
-                           normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
+  // The pair alone, and (where the sheet's samples resolve its edges, below) the pair's ends
+  // extended along the query's surface: a point joined to a that lies farther in front of a's
+  // face (or to b, beyond the sheet) makes a crossing surer and deeper than the pair alone
+  // shows (a part pushed 50 mm through a 10 mm wall reads as a crossing by the pairs nearest
+  // the wall, each alone a few deviations from either face). The step only lowers P_free, and
+  // its search is made only where it can change the answer.
+  double free = normalCdf (a.distance / a.sigma) * normalCdf (g / b.sigma) +
+                normalCdf (-(a.distance + t) / a.sigma) * normalCdf (b.distance / b.sigma);
+  const Scratch::Outside* a_end = &a;
+  const Scratch::Outside* b_end = &b;
+  double a_reach = a.distance;
+  double b_reach = b.distance;
+  double stepped_free = -1.0;  // not yet searched
+  auto step = [&] () {
+    if (stepped_free >= 0.0)
+      return;
+    std::tie (a_end, a_reach) = farthestJoined (scratch, a, t);
+    std::tie (b_end, b_reach) = farthestJoined (scratch, b, t);
+    const double in_front = std::min (normalCdf (g / b.sigma), normalCdf (-(b_reach + t) / b_end->sigma));
+    const double beyond = std::min (normalCdf (-(a.distance + t) / a.sigma), normalCdf (-(a_reach + t) / a_end->sigma));
+    stepped_free = normalCdf (a.distance / a.sigma) * in_front + beyond * normalCdf (b.distance / b.sigma);
+  };
   auto zOf = [] (double p_free) { return normalQuantile (std::clamp (p_free, 1e-300, 1.0 - 1e-16)); };
   // A wedge rather than a slab: the region behind both face planes ends at the line where
   // they meet, and the pair's segment may pass beyond it. Along the segment its offsets
@@ -592,8 +605,13 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     through_tip = normalCdf (depth / std::hypot ((1.0 - s) * a.sigma, s * b.sigma));
   }
   // The edge term below only raises P_free: a pair already no better than the best is done.
-  if (!per_point && zOf (wedge ? 1.0 - (1.0 - free) * through_tip : free) >= best_z)
-    return;
+  auto withTip = [&] (double p_free) { return wedge ? 1.0 - (1.0 - p_free) * through_tip : p_free; };
+  if (!per_point && zOf (withTip (free)) >= best_z)
+  {
+    step ();
+    if (zOf (withTip (stepped_free)) >= best_z)
+      return;
+  }
   // Does the sheet reach where the pair meets a's face plane, or does the pair pass beside
   // or past its edge? Surrounded by samples of that face, it does. Otherwise the point may
   // lie past an edge: the edge lies anywhere within a spacing past the last sample (half a
@@ -606,9 +624,15 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     return;
   const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
   // Where the noise blurs the sheet's edges, the pair's own ends (kCrossingResolvedSigmas).
-  if (kCrossingResolvedSigmas * std::sqrt (std::max (first.variance, 0.0)) >= first.spacing)
+  if (kCrossingResolvedSigmas * std::sqrt (std::max (first.variance, 0.0)) < first.spacing)
   {
-    free = pair_free;
+    step ();
+    free = stepped_free;
+  }
+  else if (!per_point && zOf (withTip (free)) >= best_z)
+    return;  // only the step passed the check above
+  else
+  {
     a_end = &a;
     a_reach = a.distance;
     b_end = &b;
