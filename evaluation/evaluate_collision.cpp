@@ -20,8 +20,9 @@
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
 //                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...]
-//                      [--cap N,N,...] [--only SETTING,...] [--drop F,...]
+//                      [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
+// --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
 //   pcd_collision scans/W1_0.5_robot.pcd scans/W1_0.5_env.pcd -sigma S -surface -pose ...
@@ -87,12 +88,22 @@ struct Options
   /** \brief CollisionRequest::max_leaf_fits of the "cap<n>" settings (issue #17 item 2); empty
     * (default) leaves them out. */
   std::vector<double> cap;
-  /** \brief --only: the settings of ours run in the W1 cells (empty: all); the stability
-    * passes and the other workloads are not filtered. */
+  /** \brief --only: the settings of ours run in the W1 cells and on W2 (empty: all); the
+    * stability passes and W3 are not filtered. */
   std::vector<std::string> only;
   /** \brief --drop: controls "drop<f>", the separators on clouds with f % of the samples left
     * out at random (how much the answers move for a model change unrelated to the noise). */
   std::vector<double> drop;
+  /** \brief --workloads: the workloads to run (W1, W2, W3; empty: all, W1 alone with
+    * --ours-only). For studies of one workload; the summary's other rows read not run. */
+  std::vector<std::string> workloads;
+  bool
+  runs (const std::string& workload) const
+  {
+    if (!workloads.empty ())
+      return std::find (workloads.begin (), workloads.end (), workload) != workloads.end ();
+    return workload == "W1" || !ours_only;
+  }
 };
 
 double
@@ -706,6 +717,8 @@ evaluatePrimitives (const Options& o, Results& results)
       };
       for (const OursSetting& s : oursSettings (false))
       {
+        if (!o.only.empty () && std::find (o.only.begin (), o.only.end (), s.name) == o.only.end ())
+          continue;
         BuildRow unused;
         const PoseQuery q = buildOurs (pq.b, pq.a, pq.sigma, s, unused, nullptr);
         const auto start = Clock::now ();
@@ -1390,10 +1403,17 @@ parse (int argc, char** argv)
       o.drop = numbers (list (value ()));
     else if (a == "--only")
       o.only = list (value ());
+    else if (a == "--workloads")
+    {
+      o.workloads = list (value ());
+      for (const std::string& w : o.workloads)
+        if (w != "W1" && w != "W2" && w != "W3")
+          throw std::invalid_argument ("--workloads: unknown workload '" + w + "' (W1, W2 or W3)");
+    }
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");
@@ -1407,17 +1427,22 @@ main (int argc, char** argv)
   try
   {
     const Options o = parse (argc, argv);
+    std::filesystem::create_directories (o.out_dir);  // before hours of work, not after
     const auto start = Clock::now ();
     Results results;
-    if (!o.ours_only)
+    if (o.runs ("W3"))
     {
       evaluateScenes (o.data_dir, results.queries, results.scenes_right, results.scenes_total);
       progress ("W3 scenes: " + std::to_string (results.scenes_right) + " / " + std::to_string (results.scenes_total) +
                 " answered as SCENES.md lists (default setting)");
-      evaluatePrimitives (o, results);
     }
-    const PianoRoom w = loadPianoRoom (o, results);
-    evaluatePianoRoom (o, w, results);
+    if (o.runs ("W2"))
+      evaluatePrimitives (o, results);
+    if (o.runs ("W1"))
+    {
+      const PianoRoom w = loadPianoRoom (o, results);
+      evaluatePianoRoom (o, w, results);
+    }
     writeOutputs (o, results);
     progress ("done in " + std::to_string (millisecondsSince (start) / 1000.0) + " s; W3 " +
               std::to_string (results.scenes_right) + "/" + std::to_string (results.scenes_total));

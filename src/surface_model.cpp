@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <future>
+#include <limits>
 #include <queue>
 #include <tuple>
 #include <utility>
@@ -48,6 +49,84 @@ constexpr double kOpenLineRatio = 0.1;
   * (|cos| of the angle between normal and line of sight): at grazing angles the fitted normal's
   * own error can flip the side. */
 constexpr double kMinViewCosine = 0.2;
+
+/** \brief Auto takes a viewpoint outside the cloud for a scan's only if at most this share of
+  * the points lies hidden behind others as seen from it (hiddenFromView). One scan holds none
+  * (a sensor sees no point behind another; mixed pixels at depth edges, grazing surfaces a
+  * few); a closed object sampled all round, seen from a point outside it, about half (its far
+  * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
+constexpr double kMaxHiddenShare = 0.1;
+
+/** \brief The share of `points` hidden from `view` (outside their bounding box lo..hi) behind
+  * others: in one bin of directions from view (gnomonic, across the axis that separates view
+  * from the box; bins two median spacings wide at the median depth), farther than the bin's
+  * nearest point by more than three spacings (the point's and the median). */
+double
+hiddenFromView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
+                const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
+{
+  const std::size_t n = points.size ();
+  if (n < 2)
+    return 0.0;
+  // The axis along which view lies farthest outside the box: every point is in front of it.
+  int axis = 0;
+  double sign = 1.0, best = -1.0;
+  for (int d = 0; d < 3; ++d)
+  {
+    if (lo[d] - view[d] > best)
+    {
+      best = lo[d] - view[d];
+      axis = d;
+      sign = 1.0;
+    }
+    if (view[d] - hi[d] > best)
+    {
+      best = view[d] - hi[d];
+      axis = d;
+      sign = -1.0;
+    }
+  }
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  std::vector<double> depth (n), range (n), scratch;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    depth[i] = sign * (points[i][axis] - view[axis]);
+    range[i] = (points[i] - view).norm ();
+  }
+  auto median = [&scratch] (auto begin, auto end) {
+    scratch.assign (begin, end);
+    std::nth_element (scratch.begin (), scratch.begin () + static_cast<std::ptrdiff_t> (scratch.size () / 2), scratch.end ());
+    return scratch[scratch.size () / 2];
+  };
+  const double s_median = median (spacing.begin (), spacing.end ());
+  const double bin = 2.0 * s_median / std::max (median (depth.begin (), depth.end ()), 1e-300);
+  if (!(bin > 0.0) || !std::isfinite (bin))
+    return 0.0;
+  std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> cells (n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const double t = std::max (depth[i], 1e-300);
+    cells[i] = {{static_cast<std::int64_t> (std::floor ((points[i][u] - view[u]) / t / bin)),
+                 static_cast<std::int64_t> (std::floor ((points[i][v] - view[v]) / t / bin))},
+                i};
+  }
+  std::sort (cells.begin (), cells.end ());
+  std::size_t hidden = 0;
+  for (std::size_t b = 0; b < n;)
+  {
+    std::size_t e = b;
+    double nearest = std::numeric_limits<double>::infinity ();
+    for (; e < n && cells[e].first == cells[b].first; ++e)
+      nearest = std::min (nearest, range[cells[e].second]);
+    for (std::size_t j = b; j < e; ++j)
+    {
+      const std::size_t i = cells[j].second;
+      hidden += range[i] > nearest + 3.0 * std::max<double> (spacing[i], s_median) ? 1 : 0;
+    }
+    b = e;
+  }
+  return static_cast<double> (hidden) / static_cast<double> (n);
+}
 
 /** \brief Symmetric neighbour graph in compressed rows: the k-nearest-neighbour relation is
   * not symmetric, and propagation must be able to cross an edge from either end. */
@@ -158,6 +237,49 @@ forEachPoint (std::size_t n, std::size_t workers, Fn&& fn)
     for (std::size_t i = begin; i < end; ++i)
       fn (i);
   });
+}
+
+/** \brief Stray normals: a plane fit 90 degrees off its flat patch (on a randomly sampled
+  * noisy plane, a point lifted off it by its noise among neighbours that lie along a line:
+  * about 5 % of the points 3 sigma apart) is a face of its own for the surface layer, and no
+  * smoothing reaches it (no neighbour lies within kSmoothCosine). Where fewer than a quarter of
+  * at least four neighbours agree with a normal within 45 degrees, the others agree among
+  * themselves (their mean resultant length above 0.9) and the normal lies more than 45 degrees
+  * off their mean but not opposite it (a thin slab's other face), it takes their mean. Corners,
+  * edges and thin parts, whose neighbours do not agree, keep theirs. */
+void
+repairStrayNormals (const Graph& graph, std::vector<Eigen::Vector3f>& normals, std::size_t workers)
+{
+  constexpr float kAgreeCosine = 0.7071f;
+  constexpr float kFlatResultant = 0.9f;
+  std::vector<Eigen::Vector3f> next (normals);
+  forEachPoint (normals.size (), workers, [&] (std::size_t i) {
+    const Eigen::Vector3f& n = normals[i];
+    if (n.isZero ())
+      return;
+    int agree = 0, others = 0;
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero ();
+    for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
+    {
+      const Eigen::Vector3f& m = normals[static_cast<std::size_t> (graph.targets[static_cast<std::size_t> (e)])];
+      if (m.isZero ())
+        continue;
+      if (m.dot (n) >= kAgreeCosine)
+        ++agree;
+      else
+      {
+        ++others;
+        sum += m;
+      }
+    }
+    const float length = sum.norm ();
+    if (agree + others < 4 || 4 * agree >= agree + others || length <= kFlatResultant * static_cast<float> (others))
+      return;
+    const Eigen::Vector3f mean = sum / length;
+    if (std::abs (mean.dot (n)) < kAgreeCosine)
+      next[i] = mean;
+  });
+  normals.swap (next);
 }
 
 /** \brief Bilateral smoothing of oriented normals over the neighbour graph: each normal
@@ -399,9 +521,13 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   centroid /= std::max<std::size_t> (n, 1);
   const bool view_outside = in.viewpoint && in.viewpoint->allFinite () &&
                             ((in.viewpoint->array () < lo.array ()).any () || (in.viewpoint->array () > hi.array ()).any ());
+  hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
+  if (mode == NormalOrientation::Auto && !any_given && view_outside)
+    hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
   if (mode == NormalOrientation::Auto)
     mode = any_given ? NormalOrientation::PointNormals
-                     : view_outside ? NormalOrientation::Viewpoint : NormalOrientation::Propagate;
+                     : view_outside && hidden_from_view_ <= kMaxHiddenShare ? NormalOrientation::Viewpoint
+                                                                           : NormalOrientation::Propagate;
   if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
     mode = NormalOrientation::Propagate;
   orientation_ = mode;
@@ -497,6 +623,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       if (component[i] > 0 && volume[static_cast<std::size_t> (component[i])] < 0.0)
         normals_[i] = -normals_[i];
   }
+  repairStrayNormals (graph, normals_, workers);
   smoothNormals (graph, normals_, workers);
   unoriented_ = 0;
   propagated_ = 0;

@@ -117,6 +117,8 @@ struct Scratch
   std::vector<double> keys;
   std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
+  /** \brief The side's surface is two-sided: its orientation is not trusted (trustedOrientation). */
+  bool two_sided = false;
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs, grouped;
   std::vector<std::size_t> group_start;  ///< groupByFirst's counts, then offsets
   /** \brief The current query leaf's points found outside the other surface, for crossings. */
@@ -264,7 +266,7 @@ surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const s
 template <typename VarianceOf>
 bool
 evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vector<double>& keys, double x_key,
-          const std::vector<Sample>& samples, const VarianceOf& variance_of, Evaluation& out)
+          const std::vector<Sample>& samples, const VarianceOf& variance_of, bool two_sided, Evaluation& out)
 {
   std::array<int, kSurfaceNeighbours> nearest;
   std::array<double, kSurfaceNeighbours> d2;
@@ -423,6 +425,13 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     const bool concave = facing > kConcaveNoiseSigmas * std::sqrt (std::max (first.variance, 0.0));
     if (concave == (other.f < chosen.f))
       chosen = other;
+  }
+  // A two-sided surface (an orientation that is not trusted) has no inside: x is as far from it
+  // behind as in front, and faces it from its own side (crossings then find a part through it).
+  if (two_sided && chosen.f < 0.0)
+  {
+    chosen.f = -chosen.f;
+    chosen.normal = -chosen.normal;
   }
   // Where the surface runs between samples is uncertain within one gap of the last one (an
   // edge may lie there); a bridged hole continues the fitted plane. Inside a face, its
@@ -620,7 +629,7 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
   const Eigen::Vector3d x = a.x + (a.distance / (a.distance - g)) * v;
   Evaluation at;
   if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
-                 [] (const Eigen::Vector3d&) { return 0.0; }, at))
+                 [] (const Eigen::Vector3d&) { return 0.0; }, scratch.two_sided, at))
     return;
   const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
   // Where the noise blurs the sheet's edges, the pair's own ends (kCrossingResolvedSigmas).
@@ -734,6 +743,15 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
   scratch.earlier_leaves.push_back (leaf);
 }
 
+/** \brief Whether the surface's orientation says where its inside is: the points' own normals
+  * or a viewpoint. A propagated one does not: an open sheet's side is a coin toss, and a room
+  * seen from within is oriented inside out (its free space read as inside the walls). */
+bool
+trustedOrientation (const SurfaceModel& s)
+{
+  return s.orientation () != NormalOrientation::Propagate;
+}
+
 /** \brief True when the surface's area-weighted normals cancel to within kClosedFlux of its
   * area: a closed surface (exactly 0 by the divergence theorem; the evaluation's rooms sum to
   * under 1 %, its piano, with noisy normals on thin parts, to 6 %), not an open sheet (100 % when
@@ -759,6 +777,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const SurfaceModel& s_model = surface.surface ();
   const SurfaceModel& q_model = query.surface ();
   const bool behind_unseen = s_model.orientation () == NormalOrientation::Viewpoint;
+  scratch.two_sided = !trustedOrientation (s_model);
   // Behind a scan from one viewpoint or any open surface (winding about 1/2 behind a sheet) the
   // space is occupied; inside a closed surface means a winding number above 1/2.
   const double behind_threshold = behind_unseen || !closedSurface (s_model) ? kBehindWinding : kInsideWinding;
@@ -860,7 +879,8 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const PackedCovariance& cov = q_bvh.covariances ()[qi];
       Evaluation e;
       if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
-                     [&] (const Eigen::Vector3d& n) { return std::max (0.0, cov.quadratic (R_q.transpose () * n)); }, e))
+                     [&] (const Eigen::Vector3d& n) { return std::max (0.0, cov.quadratic (R_q.transpose () * n)); },
+                     scratch.two_sided, e))
         continue;
       ++answer.points_tested;
       // Clearly behind the local plane, or behind it farther than a spacing from its nearest
@@ -1092,12 +1112,11 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   // pushed 30 cm through a wall: the wall's samples inside the piano are far from its surface),
   // or one object entirely inside the other. Only a trusted orientation (the points' own normals,
   // a viewpoint) may declare it: a propagated one can be inside out (a room seen from within).
-  auto trusted = [] (const SurfaceModel& s) { return s.orientation () != NormalOrientation::Propagate; };
   const double margin = params.box_margin;
   DeepPoint deep;
-  if (trusted (b.surface ()))
+  if (trustedOrientation (b.surface ()))
     deep = deepInside (a, Eigen::Isometry3d::Identity (), b, T_a_b, margin, !may_stop, per_point_a);
-  if ((!deep.found || !may_stop) && trusted (a.surface ()))
+  if ((!deep.found || !may_stop) && trustedOrientation (a.surface ()))
   {
     DeepPoint other = deepInside (b, T_a_b, a, Eigen::Isometry3d::Identity (), margin, !may_stop, per_point_b);
     other.side = -1;

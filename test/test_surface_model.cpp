@@ -108,14 +108,14 @@ shift (double x, double y, double z)
 
 TEST (SurfaceModel, PropagationOrientsAClosedSurfaceOutward)
 {
-  // The sphere off the origin: PCL's default sensor_origin_ (0, 0, 0) lies outside it, so Auto
-  // would take it for a scan's viewpoint; a sampled closed object states Propagate.
-  CloudModelParams params = withSurface ();
-  params.orientation = NormalOrientation::Propagate;
-  const auto model = buildCloudModel (xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3))), params);
+  // The sphere off the origin: PCL's default sensor_origin_ (0, 0, 0) lies outside it, but is
+  // no scan's viewpoint (about half the samples lie behind the other half seen from there), so
+  // Auto propagates.
+  const auto model = buildCloudModel (xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3))), withSurface ());
   const SurfaceModel& s = model->surface ();
   ASSERT_FALSE (s.empty ());
   EXPECT_EQ (s.orientation (), NormalOrientation::Propagate);
+  EXPECT_GT (s.hiddenFromViewpoint (), 0.3);
   const auto& points = model->hierarchy ().means ();  // local frame: the sphere's centre at ~0
   std::size_t outward = 0;
   for (std::size_t i = 0; i < points.size (); ++i)
@@ -145,9 +145,34 @@ TEST (SurfaceModel, ViewpointOrientsASheetTowardTheSensor)
     const auto model = buildCloudModel (sheet (0.2, 0.01, 0.0, Eigen::Vector3f (0.0f, 0.0f, side)), noisy (0.001));
     const SurfaceModel& s = model->surface ();
     EXPECT_EQ (s.orientation (), NormalOrientation::Viewpoint);
+    EXPECT_EQ (s.hiddenFromViewpoint (), 0.0);  // one scan hides nothing from its sensor
     for (const Eigen::Vector3f& n : s.normals ())
       ASSERT_GT (n.z () * side, 0.99f);
   }
+}
+
+// A randomly sampled noisy plane (3 sigma apart, seen from above): a plane fit to a point lifted
+// off it among neighbours along a line lies about 90 degrees off (5 % of the points here), a
+// face of its own for the surface layer; the model takes its neighbours' normal instead.
+TEST (SurfaceModel, StrayNormalsOfANoisyPlaneAreRepaired)
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::mt19937_64 rng (3);
+  std::uniform_real_distribution<double> across (-0.1, 0.1);
+  std::normal_distribution<double> noise (0.0, 0.001);
+  for (int i = 0; i < 4444; ++i)
+  {
+    const double x = across (rng), y = across (rng);
+    cloud.push_back (pcl::PointXYZ (static_cast<float> (x), static_cast<float> (y), static_cast<float> (noise (rng))));
+  }
+  cloud.sensor_origin_ = Eigen::Vector4f (0.0f, 0.0f, 1.0f, 0.0f);
+  const auto model = buildCloudModel (cloud, noisy (0.001));
+  const SurfaceModel& s = model->surface ();
+  ASSERT_EQ (s.orientation (), NormalOrientation::Viewpoint);
+  std::size_t off = 0;
+  for (const Eigen::Vector3f& n : s.normals ())
+    off += n.z () < 0.7071f ? 1 : 0;
+  EXPECT_LT (off, cloud.size () / 100) << off << " of " << cloud.size () << " normals more than 45 degrees off";
 }
 
 TEST (SurfaceModel, OffByDefault)
@@ -224,6 +249,30 @@ TEST (SurfaceLayer, SignedDistanceOfASlabOverATable)
   const CollisionRequest classifier_only;
   ASSERT_TRUE (collide (*block, *table, shift (0, 0, -0.02), classifier_only, r));
   EXPECT_TRUE (std::isnan (r.signed_distance));
+}
+
+// A table without a viewpoint (its sensor origin within it) is oriented by propagation, which
+// cannot say which side is solid: a ball 10 mm above it and one 10 mm below read free alike.
+// Through its middle, the ball reads collision (its points on both sides of the table).
+TEST (SurfaceLayer, APropagatedSurfaceIsTwoSided)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f::Zero ()), noisy (0.001));
+  ASSERT_EQ (table->surface ().orientation (), NormalOrientation::Propagate);
+  const auto ball = buildCloudModel (sphere (2000, 0.05, Eigen::Vector3d::Zero ()), withSurface ());
+  std::vector<double> clearance;
+  for (const double table_z : {-0.06, 0.06})
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*ball, *table, shift (0, 0, table_z), surfaceRequest (), r)) << table_z;
+    EXPECT_EQ (r.verdict, Verdict::Free) << table_z << ": P " << r.probability << ", d " << r.signed_distance;
+    EXPECT_GT (r.signed_distance, 0.005) << table_z;
+    clearance.push_back (r.signed_distance);
+  }
+  EXPECT_NEAR (clearance[0], clearance[1], 0.002);  // the same from either side
+  CollisionResult through;
+  ASSERT_TRUE (collide (*ball, *table, shift (0, 0, 0.0), surfaceRequest (), through));
+  EXPECT_EQ (through.verdict, Verdict::InCollision) << "P " << through.probability << ", d " << through.signed_distance
+                                                    << " +- " << through.signed_distance_std;
 }
 
 // A scanned sheet has an unseen back: a table 1 cm behind a sheet seen from above is not read

@@ -493,7 +493,13 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
     case pcl_probcollision::NormalOrientation::Propagate: how = "propagated over the neighbours"; break;
     case pcl_probcollision::NormalOrientation::Auto: break;
   }
-  std::fprintf (log, "Orienting %s [%s: %s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how);
+  std::string why;
+  const double hidden = model.surface ().hiddenFromViewpoint ();
+  if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
+    why = "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
+          " % of the points lie behind others (one scan hides none)";
+  std::fprintf (log, "Orienting %s [%s: %s%s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how,
+                why.c_str ());
 }
 
 /** \brief "\r[12/300 poses]" on stderr when it is a terminal, at most every 0.2 s, first after

@@ -21,8 +21,9 @@ namespace pcl_probcollision
 enum class NormalOrientation
 {
   /** \brief Default: the point type's normals when it has finite ones (meshes: the faces'),
-    * else the viewpoint when the cloud's sensor_origin_ lies outside its bounding box (a scan),
-    * else propagation. */
+    * else the viewpoint when the cloud's sensor_origin_ lies outside its bounding box and sees
+    * it as one scan does (at most 10 % of the points hidden behind others from there:
+    * SurfaceModel::hiddenFromViewpoint), else propagation. */
   Auto,
   /** \brief The normals the points carry (PointNormal and the other *Normal types), taken as
     * outward; points without a finite one are oriented by propagation from their neighbours. */

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -88,6 +89,11 @@ public:
   double surfaceSpacing () const { return surface_spacing_; }
   /** \brief The orientation used (never Auto). */
   NormalOrientation orientation () const { return orientation_; }
+  /** \brief Where Auto weighed a viewpoint outside the cloud: the share of points hidden from
+    * it behind others (a scan from there hides none). Above 0.1 the viewpoint is not the
+    * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
+    * NaN where not weighed. */
+  double hiddenFromViewpoint () const { return hidden_from_view_; }
   /** \brief Points without a normal (too few distinct neighbours): they bound nothing. */
   std::size_t unorientedPoints () const { return unoriented_; }
   /** \brief Points whose orientation came from propagation alone in Viewpoint mode (grazing
@@ -118,5 +124,6 @@ private:
   NormalOrientation orientation_ = NormalOrientation::Auto;
   std::size_t unoriented_ = 0;
   std::size_t propagated_ = 0;
+  double hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
 };
 } // namespace pcl_probcollision

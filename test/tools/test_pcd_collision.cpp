@@ -1026,8 +1026,9 @@ pcdHeader (const std::string& fields, int n)
 // With -surface, a cloud whose file stores normals is oriented by them, taken as outward: a probe
 // 1.5 cm inside a sphere of radius 10 cm (its points 1 cm to 2 cm deep) collides with the sphere
 // whose normals point out and is free of the same sphere with its normals reversed (then the
-// probe is outside it). -ignore_normals orients both the same way (by propagation: outward), and
-// without -surface the normals change nothing.
+// probe is outside it). -ignore_normals orients both the same way (by propagation), which is not
+// trusted to say where the inside is: both answer alike, and a probe across the sphere's surface
+// collides with either. Without -surface the normals change nothing.
 TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
 {
   constexpr int kSphere = 2000, kProbe = 60;
@@ -1041,9 +1042,8 @@ TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
                                        sphereRows (kSphere, 0.1, +1.0, true));
   writeFile (dir_ / "probe.pcd", pcdHeader (xyz, kProbe) + sphereRows (kProbe, 0.005, 1.0, false));
   const std::string probe = (dir_ / "probe.pcd").string ();
-  auto query = [&] (const char* sphere, std::vector<std::string> extra) {
-    std::vector<std::string> args = {probe, (dir_ / sphere).string (), "-sigma", "0.001", "-pose", "0.085,0,0,0,0,0",
-                                     "-json"};
+  auto query = [&] (const char* sphere, std::vector<std::string> extra, const char* pose = "0.085,0,0,0,0,0") {
+    std::vector<std::string> args = {probe, (dir_ / sphere).string (), "-sigma", "0.001", "-pose", pose, "-json"};
     args.insert (args.end (), extra.begin (), extra.end ());
     const ToolRun r = run (args);
     EXPECT_EQ (r.status, 0) << r.err;
@@ -1076,13 +1076,17 @@ TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
     EXPECT_GT (out["signed_distance"].number, 0.005);
     EXPECT_NE (orienting (err, "inward.pcd").find ("[point_normals:"), std::string::npos) << err;
   }
+  std::vector<std::string> inside;
   for (const char* sphere : {"inward.pcd", "plain.pcd"})
   {
     SCOPED_TRACE (sphere);
     const auto [out, err] = query (sphere, {"-surface", "-ignore_normals"});
-    EXPECT_EQ (out["verdict"].text, "collision");
+    inside.push_back (out["probability"].text + " " + out["signed_distance"].text);
     EXPECT_NE (orienting (err, sphere).find ("[propagate:"), std::string::npos) << err;
+    const auto across = query (sphere, {"-surface", "-ignore_normals"}, "0.1,0,0,0,0,0");
+    EXPECT_EQ (across.first["verdict"].text, "collision");
   }
+  EXPECT_EQ (inside[0], inside[1]);
   // Without -surface the file's normals are not read: reversed or absent, the same answer, and
   // no Orienting line.
   const auto [plain, plain_err] = query ("plain.pcd", {});
