@@ -505,8 +505,8 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   else
     spacingStatistics ();
 
-  // Resolve Auto: the caller's normals, else a viewpoint outside the cloud (a scan), else
-  // propagation.
+  // Resolve Auto: the caller's normals, else a viewpoint outside the cloud that sees it as one
+  // scan does (hiddenFromView), else propagation.
   bool any_given = false;
   for (std::size_t i = 0; i < in.given.size () && !any_given; ++i)
     any_given = in.given[i] && !normals_[i].isZero ();
