@@ -97,6 +97,13 @@ struct Options
   /** \brief --workloads: the workloads to run (W1, W2, W3; empty: all, W1 alone with
     * --ours-only). For studies of one workload; the summary's other rows read not run. */
   std::vector<std::string> workloads;
+  /** \brief Whether workload W1, W2 or W3 runs (--workloads, --ours-only). */
+  /** \brief Whether --only lets setting `name` of ours run. */
+  bool
+  keeps (const std::string& name) const
+  {
+    return only.empty () || std::find (only.begin (), only.end (), name) != only.end ();
+  }
   bool
   runs (const std::string& workload) const
   {
@@ -460,7 +467,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
   for (const OursSetting& s : settings)
   {
-    if (!o.only.empty () && std::find (o.only.begin (), o.only.end (), s.name) == o.only.end ())
+    if (!o.keeps (s.name))
       continue;
     BuildRow b = buildRow ("ours", s.name);
     double leaf_pairs = 0, kernel = 0, features = 0, n = 0;
@@ -717,7 +724,7 @@ evaluatePrimitives (const Options& o, Results& results)
       };
       for (const OursSetting& s : oursSettings (false))
       {
-        if (!o.only.empty () && std::find (o.only.begin (), o.only.end (), s.name) == o.only.end ())
+        if (!o.keeps (s.name))
           continue;
         BuildRow unused;
         const PoseQuery q = buildOurs (pq.b, pq.a, pq.sigma, s, unused, nullptr);

@@ -1026,9 +1026,10 @@ pcdHeader (const std::string& fields, int n)
 // With -surface, a cloud whose file stores normals is oriented by them, taken as outward: a probe
 // 1.5 cm inside a sphere of radius 10 cm (its points 1 cm to 2 cm deep) collides with the sphere
 // whose normals point out and is free of the same sphere with its normals reversed (then the
-// probe is outside it). -ignore_normals orients both the same way (by propagation), which is not
-// trusted to say where the inside is: both answer alike, and a probe across the sphere's surface
-// collides with either. Without -surface the normals change nothing.
+// probe is outside it). -ignore_normals orients both the same way (by propagation), so both
+// answer alike; a propagated orientation is not trusted to say where the inside is, so only a
+// probe across the sphere's surface (a crossing) is asserted to collide. Without -surface the
+// normals change nothing.
 TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
 {
   constexpr int kSphere = 2000, kProbe = 60;
