@@ -417,7 +417,21 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   {
     if (face_size[static_cast<std::size_t> (c)] < kMinFaceSamples)
       continue;
-    const Fit other = fit (c);
+    Fit other = fit (c);
+    if (two_sided)
+    {
+      // A face's plane holds only about its samples: past the face's nearest sample by more
+      // than a gap across it, x is at least that far beyond the face's end (a thin plate's rim
+      // face, extended 19 mm past its samples, put a point 6 sigma clear of the plate on the
+      // surface). Only for a two-sided surface, whose faces' signs say nothing.
+      int k = 0;
+      while (face[static_cast<std::size_t> (k)] != c)
+        ++k;
+      const Sample& p = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (k)])];
+      const double across = std::sqrt (std::max (0.0, (x - p.position).squaredNorm () - other.f * other.f));
+      const double beyond = std::max (0.0, across - std::max (p.gap, p.spacing));
+      other.f = std::copysign (std::hypot (other.f, beyond), other.f);
+    }
     const double facing = nearest_face.normal.dot (other.center - nearest_face.center) +
                           other.normal.dot (nearest_face.center - other.center);
     // Noise blurs the two faces of a slab as thin as it into one sheet whose faces' order is
