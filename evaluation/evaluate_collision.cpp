@@ -97,13 +97,13 @@ struct Options
   /** \brief --workloads: the workloads to run (W1, W2, W3; empty: all, W1 alone with
     * --ours-only). For studies of one workload; the summary's other rows read not run. */
   std::vector<std::string> workloads;
-  /** \brief Whether workload W1, W2 or W3 runs (--workloads, --ours-only). */
   /** \brief Whether --only lets setting `name` of ours run. */
   bool
   keeps (const std::string& name) const
   {
     return only.empty () || std::find (only.begin (), only.end (), name) != only.end ();
   }
+  /** \brief Whether workload W1, W2 or W3 runs (--workloads, --ours-only). */
   bool
   runs (const std::string& workload) const
   {

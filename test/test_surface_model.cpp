@@ -291,7 +291,9 @@ TEST (SurfaceLayer, ATwoSidedFaceHoldsOnlyAboutItsSamples)
   for (const double face : {-0.001, 0.001})
     for (int i = 0; i < 4444; ++i)
     {
-      const Eigen::Vector3d p (across (rng), across (rng), 0.5 + face);
+      const double x = across (rng);  // one draw a statement (seeded_draws.h)
+      const double y = across (rng);
+      const Eigen::Vector3d p (x, y, 0.5 + face);
       const Eigen::Vector3d e = draw3 (noise, rng);
       plate.push_back (pcl::PointXYZ (static_cast<float> (p.x () + e.x ()), static_cast<float> (p.y () + e.y ()),
                                       static_cast<float> (p.z () + e.z ())));
