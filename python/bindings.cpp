@@ -798,11 +798,12 @@ PYBIND11_MODULE (_core, m)
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
-      "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental).")
+      "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental);\n"
+      "surface_calibrated: with surface, P in [0.1, 0.9] through the calibration map (default True).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
-                          bool surface_pooled) {
+                          bool surface_pooled, bool surface_calibrated) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -817,6 +818,7 @@ PYBIND11_MODULE (_core, m)
               r.max_leaf_fits = max_leaf_fits;
               r.surface = surface;
               r.surface_pooled = surface_pooled;
+              r.surface_calibrated = surface_calibrated;
               return r;
             }),
             py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
@@ -825,6 +827,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
             py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
+            py::arg ("surface_calibrated") = dr.surface_calibrated,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -842,6 +845,9 @@ PYBIND11_MODULE (_core, m)
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
                       "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).")
+      .def_readwrite ("surface_calibrated", &CollisionRequest::surface_calibrated,
+                      "With surface: P in [0.1, 0.9] through the calibration map fitted on evaluation runs "
+                      "(rankings and default verdicts kept; default True). False: the model's raw P.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {
@@ -853,7 +859,8 @@ PYBIND11_MODULE (_core, m)
                ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
                ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
                ", surface=" + (r.surface ? "True" : "False") +
-               ", surface_pooled=" + (r.surface_pooled ? "True" : "False") + ")";
+               ", surface_pooled=" + (r.surface_pooled ? "True" : "False") +
+               ", surface_calibrated=" + (r.surface_calibrated ? "True" : "False") + ")";
       });
 
   // --- CollisionResult ----------------------------------------------------------------------------

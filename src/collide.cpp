@@ -5,6 +5,7 @@
 #include <pcl_probcollision/detail/input_checks.h>
 
 #include "leaf_pair_test.h"
+#include "surface_calibration.h"
 #include "surface_test.h"
 
 #include <pcl/exceptions.h>
@@ -228,6 +229,13 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
       return false;
     }
     pool (result, separators, request);
+  }
+  if (surface && request.surface_calibrated)
+  {
+    result.probability = detail::calibratedSurfaceProbability (
+        result.probability, request.surface_pooled ? detail::SurfaceCalibration::Pooled
+                                                   : detail::SurfaceCalibration::SurfaceLayer);
+    result.verdict = verdictFor (result.probability, request);
   }
 
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.

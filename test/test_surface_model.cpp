@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -432,7 +433,8 @@ TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)
 }
 
 // Pooled with the separators, P is the mean of the surface layer's and the separators' on the
-// same pair, per point too; the signed distance stays the surface layer's.
+// same pair, per point too; the signed distance stays the surface layer's. (Raw: the
+// calibration map, tested below, acts on the pool's mean.)
 TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
 {
   const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
@@ -442,6 +444,7 @@ TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
     CollisionRequest surface = surfaceRequest ();
     surface.exhaustive = true;
     surface.per_point = true;
+    surface.surface_calibrated = false;
     CollisionRequest separators = surface;
     separators.surface = false;
     CollisionRequest pooled = surface;
@@ -463,6 +466,57 @@ TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
       else
         EXPECT_FLOAT_EQ (rp.probabilities_a[i], expected) << "point " << i << " at z = " << z;
     }
+  }
+}
+
+// The calibration map (CollisionRequest::surface_calibrated) moves the pair's P inside the
+// default contact band only, keeps its order and the verdicts, and leaves the distance, its
+// deviation and the per-point values as the model gives them.
+TEST (SurfaceLayer, CalibrationMovesOnlyTheContactBand)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.002));
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.002));
+  for (const bool pooled : {false, true})
+  {
+    std::vector<std::pair<double, double>> raw_and_mapped;
+    std::size_t moved = 0;
+    for (double z = -0.006; z <= 0.0081; z += 0.0005)
+    {
+      CollisionRequest raw = surfaceRequest ();
+      raw.per_point = true;
+      raw.surface_pooled = pooled;
+      raw.surface_calibrated = false;
+      CollisionRequest calibrated = raw;
+      calibrated.surface_calibrated = true;
+      CollisionResult r0, r1;
+      ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), raw, r0));
+      ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), calibrated, r1));
+      const double p0 = r0.probability, p1 = r1.probability;
+      if (p0 < raw.free_below || p0 > raw.collision_above)
+        EXPECT_EQ (p1, p0) << "z = " << z;
+      else
+      {
+        EXPECT_GE (p1, raw.free_below) << "z = " << z;
+        EXPECT_LE (p1, raw.collision_above) << "z = " << z;
+        moved += std::abs (p1 - p0) > 0.01 ? 1 : 0;
+      }
+      EXPECT_EQ (r1.verdict, r0.verdict) << "z = " << z;
+      EXPECT_EQ (r1.signed_distance, r0.signed_distance);
+      EXPECT_EQ (r1.signed_distance_std, r0.signed_distance_std);
+      ASSERT_EQ (r1.probabilities_a.size (), r0.probabilities_a.size ());
+      for (std::size_t i = 0; i < r0.probabilities_a.size (); ++i)
+        if (!std::isnan (r0.probabilities_a[i]))
+          EXPECT_EQ (r1.probabilities_a[i], r0.probabilities_a[i]);
+      raw_and_mapped.emplace_back (p0, p1);
+    }
+    // Strictly increasing: a higher raw P never maps lower, a different one never to the same.
+    std::sort (raw_and_mapped.begin (), raw_and_mapped.end ());
+    for (std::size_t i = 1; i < raw_and_mapped.size (); ++i)
+      if (raw_and_mapped[i].first > raw_and_mapped[i - 1].first + 1e-9)
+        EXPECT_GT (raw_and_mapped[i].second, raw_and_mapped[i - 1].second)
+            << "pooled " << pooled << ": raw " << raw_and_mapped[i - 1].first << " and " << raw_and_mapped[i].first;
+    // The sweep crosses the band: some answers inside it were moved.
+    EXPECT_GE (moved, 1u) << "pooled " << pooled;
   }
 }
 

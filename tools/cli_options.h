@@ -47,6 +47,7 @@ struct Defaults
   static inline const int n_noise_max = model.hierarchy.n_noise_max;
   static inline const bool surface = request.surface;
   static inline const bool surface_pooled = request.surface_pooled;
+  static inline const bool surface_calibrated = request.surface_calibrated;
   static inline const bool measured = !model.surface_projection;
   static inline const int n_max = model.hierarchy.n_max;
   static inline const int n_min = model.hierarchy.n_min;
@@ -108,6 +109,8 @@ struct Options
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;
+  /** \brief Not -surface_raw: CollisionRequest::surface_calibrated. */
+  bool surface_calibrated = Defaults::surface_calibrated;
   /** \brief -ignore_normals: with -surface, a cloud file's normal_x normal_y normal_z are not
     * read (the cloud is oriented by its viewpoint or by propagation, as one without normals). */
   bool ignore_normals = false;

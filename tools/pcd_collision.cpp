@@ -238,6 +238,7 @@ requestFor (const Options& o)
   r.defer_kernel_fits = o.defer_kernel_fits;
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
+  r.surface_calibrated = o.surface_calibrated;
   r.per_point = o.output.has_value ();
   r.enable_timings = true;
   r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
@@ -373,6 +374,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("noise_stop").number (o.noise_stop);
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);
+  j.key ("surface_calibrated").boolean (rq.surface_calibrated);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);

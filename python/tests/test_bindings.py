@@ -324,12 +324,16 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
     # separators' on the same pair; the signed distance stays the surface layer's.
     _, _, A, B = sheets
     T = translation(0.005, -0.003, -0.002)
-    surface = pc.collide(A, B, T, pc.CollisionRequest(surface=True, exhaustive=True))
+    # The mean is the raw one: the calibration map (surface_calibrated) acts on it afterwards.
+    surface = pc.collide(A, B, T, pc.CollisionRequest(surface=True, exhaustive=True, surface_calibrated=False))
     separators = pc.collide(A, B, T, pc.CollisionRequest(exhaustive=True))
-    pooled = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_pooled=True, exhaustive=True))
+    pooled = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_pooled=True, exhaustive=True,
+                                                     surface_calibrated=False))
     assert pooled.probability == 0.5 * (surface.probability + separators.probability)
     assert pooled.signed_distance == surface.signed_distance
     assert "surface_pooled=True" in repr(pc.CollisionRequest(surface=True, surface_pooled=True))
+    assert pc.CollisionRequest().surface_calibrated
+    assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
 
 
 def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
