@@ -15,14 +15,19 @@
 //   model_size.csv, densities.csv (the W1 rooms' counts and spacing / sigma), targets.csv
 //                    (issue 16's targets: measured, threshold, met / missed / not measured;
 //                    also printed at the end)
-// scripts/evaluate.sh renders the charts. Nothing is fitted on these workloads.
+// scripts/evaluate.sh renders the charts. Nothing is fitted on the reported run (seed 1): the
+// surface layer's calibration maps were fitted on quick runs with seeds 2-10
+// (scripts/fit-surface-calibration.py).
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
+//                      [--surface-raw]
 //                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...]
 //                      [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
 // --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
+// --surface-raw gives the surface layer's raw P (CollisionRequest::surface_calibrated off): the
+// runs its calibration maps are fitted on (scripts/fit-surface-calibration.py).
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
 //   pcd_collision scans/W1_0.5_robot.pcd scans/W1_0.5_env.pcd -sigma S -surface -pose ...
@@ -69,6 +74,9 @@ struct Options
   int rescans = 0;                ///< re-scans of both objects (0: 8 quick, 10 full)
   std::size_t rescan_poses = 0;   ///< near-band poses re-scanned per cell (0: 20 quick, 100 full)
   bool ours_only = false;         ///< skip the baselines, W2 and W3 (for quick studies)
+  /** \brief --surface-raw: the surface layer's raw P, without its calibration maps (the runs the
+    * maps are fitted on: scripts/fit-surface-calibration.py). */
+  bool surface_raw = false;
   /** \brief Also write each W1 cell's scans and poses into DIR/scans, so that any query can be
     * re-run alone with pcd_collision (dumpCell). */
   bool dump = false;
@@ -366,7 +374,7 @@ struct SharedBuild
 };
 
 SharedBuild
-sharedBuild ()
+sharedBuild (bool surface_raw)
 {
   SharedBuild b;
   b.model = OursSetting ().model;
@@ -380,6 +388,8 @@ sharedBuild ()
         throw std::logic_error ("sharedBuild: setting " + s.name + " needs its own model");
       b.settings.push_back (s);
     }
+  if (surface_raw)
+    rawSurface (b.settings);
   return b;
 }
 
@@ -444,6 +454,8 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
   std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop, o.cap);
+  if (o.surface_raw)
+    rawSurface (settings);
   for (const double f : o.drop)
   {
     // A control for model changes that do not follow the geometry: the separators with f % of
@@ -599,7 +611,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const CloudXYZ::ConstPtr env_r = addNoise (*den.env_clean, sigma, seed + 1);
       // default, classifier and surface on one build (the model with its surface built; a
       // request without the surface layer ignores it); max on its own.
-      const SharedBuild shared = sharedBuild ();
+      const SharedBuild shared = sharedBuild (o.surface_raw);
       BuildRow unused;
       const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, den.sides ());
       for (const OursSetting& s : shared.settings)
@@ -649,7 +661,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
     auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
       results.rescan[{den.workload, pct, method, setting}].record (k, scan_poses.size (), a);
     };
-    const SharedBuild shared = sharedBuild ();
+    const SharedBuild shared = sharedBuild (o.surface_raw);
     for (int r = 0; r < rescans; ++r)
     {
       // Sampling seeds depend on the density and the re-scan, not the noise level (as the main
@@ -722,7 +734,10 @@ evaluatePrimitives (const Options& o, Results& results)
         row.query_us = us;
         results.queries.push_back (row);
       };
-      for (const OursSetting& s : oursSettings (false))
+      std::vector<OursSetting> w2_settings = oursSettings (false);
+      if (o.surface_raw)
+        rawSurface (w2_settings);
+      for (const OursSetting& s : w2_settings)
       {
         if (!o.keeps (s.name))
           continue;
@@ -1394,6 +1409,8 @@ parse (int argc, char** argv)
       o.rescan_poses = std::stoull (value ());
     else if (a == "--ours-only")
       o.ours_only = true;
+    else if (a == "--surface-raw")
+      o.surface_raw = true;
     else if (a == "--dump")
       o.dump = true;
     else if (a == "--noise")
@@ -1420,7 +1437,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-raw] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

@@ -21,6 +21,13 @@ namespace pcl_probcollision_eval
 {
 using namespace pcl_probcollision;
 
+void
+rawSurface (std::vector<OursSetting>& settings)
+{
+  for (OursSetting& s : settings)
+    s.request.surface_calibrated = false;
+}
+
 std::vector<OursSetting>
 oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate,
               const std::vector<double>& stop, const std::vector<double>& cap)
