@@ -86,9 +86,10 @@ struct CollisionRequest
   /** \brief With surface on: P (the surface layer's, or the pool's) goes through a calibration
     * map inside the default contact band [0.1, 0.9]: strictly increasing, onto the band, the
     * identity outside it, so rankings and the default thresholds' verdicts are kept. Raw, the
-    * surface layer over-states collisions there (on the evaluation's W1 poses near contact,
-    * answers of P 0.3-0.4 collided in 11-18 % of cases, those of 0.1-0.2 in 4 %). The maps were fitted on evaluation runs
-    * with seeds other than the reported one (docs/SURFACE.md, "Calibration"). Per-point values,
+    * surface layer over-states collisions there (its near-contact answers of P 0.3-0.4 collided
+    * in 11-18 % of cases, those of 0.1-0.2 in 4 %: W1 at 0.5 %, quick runs of seeds 2-10). The
+    * maps were fitted on those runs: the same workload as the reported one, other scenes
+    * (docs/SURFACE.md, "Calibration"). Per-point values,
     * signed_distance and its std are not mapped: P no longer equals Phi(-d / std) inside the
     * band. Off: the model's raw P. */
   bool surface_calibrated = true;
