@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # The driver: every method on every workload, CSV out (scripts/evaluate.sh renders the charts).
-add_executable(evaluate_collision evaluate_collision.cpp workloads.cpp scenes.cpp)
+add_executable(evaluate_collision evaluate_collision.cpp workloads.cpp scenes.cpp fit_scenes.cpp)
 target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io
   pcl_probcollision pcl_io FLANN::FLANN)
 target_compile_options(evaluate_collision PRIVATE -Wall -Wextra)

@@ -21,19 +21,22 @@
 //
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
-//                      [--surface-raw]
+//                      [--surface-calibrated] [--fit-scene]
 //                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...]
 //                      [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
 // --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
-// --surface-raw gives the surface layer's raw P (CollisionRequest::surface_calibrated off): the
-// runs its calibration maps are fitted on (scripts/fit-surface-calibration.py).
+// --surface-calibrated passes the surface layer's P through its calibration maps
+// (CollisionRequest::surface_calibrated, off by default). --fit-scene runs W1's pipeline on a
+// procedural scene instead of the piano and room (fit_scenes.h), the data those maps are fitted on
+// (scripts/fit-surface-calibration.py) and nothing the evaluation reports.
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
 //   pcd_collision scans/W1_0.5_robot.pcd scans/W1_0.5_env.pcd -sigma S -surface -pose ...
 // with S and the pose from scans/W1_0.5_poses.txt.
 
 #include "baselines.h"
+#include "fit_scenes.h"
 #include "ground_truth.h"
 #include "mesh_sampling.h"
 #include "metrics.h"
@@ -74,9 +77,13 @@ struct Options
   int rescans = 0;                ///< re-scans of both objects (0: 8 quick, 10 full)
   std::size_t rescan_poses = 0;   ///< near-band poses re-scanned per cell (0: 20 quick, 100 full)
   bool ours_only = false;         ///< skip the baselines, W2 and W3 (for quick studies)
-  /** \brief --surface-raw: the surface layer's raw P, without its calibration maps (the runs the
-    * maps are fitted on: scripts/fit-surface-calibration.py). */
-  bool surface_raw = false;
+  /** \brief --surface-calibrated: the surface layer's P through its calibration maps
+    * (CollisionRequest::surface_calibrated, off by default). */
+  bool surface_calibrated = false;
+  /** \brief --fit-scene: W1's pipeline on the procedural scene of --seed (fit_scenes.h) instead of
+    * the piano and room, its workloads named F1 and F1-sparse, nothing else run: the data the
+    * calibration maps are fitted on (scripts/fit-surface-calibration.py), never reported. */
+  bool fit_scene = false;
   /** \brief Also write each W1 cell's scans and poses into DIR/scans, so that any query can be
     * re-run alone with pcd_collision (dumpCell). */
   bool dump = false;
@@ -115,6 +122,8 @@ struct Options
   bool
   runs (const std::string& workload) const
   {
+    if (fit_scene)
+      return workload == "W1";
     if (!workloads.empty ())
       return std::find (workloads.begin (), workloads.end (), workload) != workloads.end ();
     return workload == "W1" || !ours_only;
@@ -262,8 +271,14 @@ loadPianoRoom (const Options& o, Results& results)
   PianoRoom w;
   std::string error;
   const std::string dir = o.data_dir + "/meshes/";
-  if (!pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_rob.obj", w.rob_mesh, error) ||
-      !pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_env.obj", w.env_mesh, error))
+  if (o.fit_scene)
+  {
+    FitScene scene = makeFitScene (o.seed);
+    w.rob_mesh = std::move (scene.robot);
+    w.env_mesh = std::move (scene.env);
+  }
+  else if (!pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_rob.obj", w.rob_mesh, error) ||
+           !pcl_probcollision::io::loadTriangleMesh (dir + "piano_room_env.obj", w.env_mesh, error))
     throw std::runtime_error (error);
   w.exact.reset (new ExactMeshPair (w.rob_mesh, w.env_mesh));
   w.diagonal = w.exact->robotDiagonal ();
@@ -276,8 +291,9 @@ loadPianoRoom (const Options& o, Results& results)
   const double sigma05 = sigmaOf (w, 0.5);
   const auto sparse_max = static_cast<std::size_t> (std::floor (w.env_area / ((10.0 * sigma05) * (10.0 * sigma05))));
   const std::size_t sparse = std::min<std::size_t> (10000, sparse_max);
-  w.densities.push_back ({"dense", "W1", 10000, 50000, nullptr, nullptr, {}, {}});
-  w.densities.push_back ({"sparse", "W1-sparse", 10000, sparse, nullptr, nullptr, {}, {}});
+  const std::string name = o.fit_scene ? "F1" : "W1";
+  w.densities.push_back ({"dense", name, 10000, 50000, nullptr, nullptr, {}, {}});
+  w.densities.push_back ({"sparse", name + "-sparse", 10000, sparse, nullptr, nullptr, {}, {}});
   for (std::size_t d = 0; d < w.densities.size (); ++d)
   {
     Density& den = w.densities[d];
@@ -374,7 +390,7 @@ struct SharedBuild
 };
 
 SharedBuild
-sharedBuild (bool surface_raw)
+sharedBuild (bool surface_calibrated)
 {
   SharedBuild b;
   b.model = OursSetting ().model;
@@ -388,8 +404,8 @@ sharedBuild (bool surface_raw)
         throw std::logic_error ("sharedBuild: setting " + s.name + " needs its own model");
       b.settings.push_back (s);
     }
-  if (surface_raw)
-    rawSurface (b.settings);
+  if (surface_calibrated)
+    calibratedSurface (b.settings);
   return b;
 }
 
@@ -454,8 +470,8 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
   std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop, o.cap);
-  if (o.surface_raw)
-    rawSurface (settings);
+  if (o.surface_calibrated)
+    calibratedSurface (settings);
   for (const double f : o.drop)
   {
     // A control for model changes that do not follow the geometry: the separators with f % of
@@ -611,7 +627,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const CloudXYZ::ConstPtr env_r = addNoise (*den.env_clean, sigma, seed + 1);
       // default, classifier and surface on one build (the model with its surface built; a
       // request without the surface layer ignores it); max on its own.
-      const SharedBuild shared = sharedBuild (o.surface_raw);
+      const SharedBuild shared = sharedBuild (o.surface_calibrated);
       BuildRow unused;
       const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, den.sides ());
       for (const OursSetting& s : shared.settings)
@@ -661,7 +677,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
     auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
       results.rescan[{den.workload, pct, method, setting}].record (k, scan_poses.size (), a);
     };
-    const SharedBuild shared = sharedBuild (o.surface_raw);
+    const SharedBuild shared = sharedBuild (o.surface_calibrated);
     for (int r = 0; r < rescans; ++r)
     {
       // Sampling seeds depend on the density and the re-scan, not the noise level (as the main
@@ -735,8 +751,8 @@ evaluatePrimitives (const Options& o, Results& results)
         results.queries.push_back (row);
       };
       std::vector<OursSetting> w2_settings = oursSettings (false);
-      if (o.surface_raw)
-        rawSurface (w2_settings);
+      if (o.surface_calibrated)
+        calibratedSurface (w2_settings);
       for (const OursSetting& s : w2_settings)
       {
         if (!o.keeps (s.name))
@@ -1409,8 +1425,10 @@ parse (int argc, char** argv)
       o.rescan_poses = std::stoull (value ());
     else if (a == "--ours-only")
       o.ours_only = true;
-    else if (a == "--surface-raw")
-      o.surface_raw = true;
+    else if (a == "--surface-calibrated")
+      o.surface_calibrated = true;
+    else if (a == "--fit-scene")
+      o.fit_scene = true;
     else if (a == "--dump")
       o.dump = true;
     else if (a == "--noise")
@@ -1437,7 +1455,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-raw] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

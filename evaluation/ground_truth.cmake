@@ -26,7 +26,7 @@ if(BUILD_TESTING)
   # GTest's imported targets from test/CMakeLists.txt are not visible in this directory.
   find_package(GTest REQUIRED)
   include(GoogleTest)
-  add_executable(test_ground_truth ${CMAKE_CURRENT_LIST_DIR}/test_ground_truth.cpp)
+  add_executable(test_ground_truth ${CMAKE_CURRENT_LIST_DIR}/test_ground_truth.cpp ${CMAKE_CURRENT_LIST_DIR}/fit_scenes.cpp)
   target_link_libraries(test_ground_truth PRIVATE eval_ground_truth GTest::gtest GTest::gtest_main)
   target_compile_options(test_ground_truth PRIVATE -Wall -Wextra)
   target_compile_definitions(test_ground_truth PRIVATE

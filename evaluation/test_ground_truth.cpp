@@ -2,6 +2,7 @@
 // Ground truth and baselines of the evaluation suite (evaluation/ground_truth.h, baselines.h):
 // closed-form cases on tiny meshes and clouds, and consistency on FCL's piano-in-a-room models.
 #include "baselines.h"
+#include "fit_scenes.h"
 #include "ground_truth.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 using namespace pcl_probcollision_eval;
 
@@ -393,4 +395,71 @@ TEST (ReconstructBaseline, SpheresCollideWhenOverlapping)
   EXPECT_FALSE (rec.collide (translation (3.0, 0.0, 0.0)));
   EXPECT_FALSE (rec.collide (translation (0.0, 0.0, 2.2)));
   EXPECT_THROW (reconstructMesh (CloudXYZ ()), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The calibration's fit scenes (fit_scenes.h): a seed gives one scene, every part a closed box
+// with outward faces, the lid opened above the body, nothing of the scene reported.
+
+namespace
+{
+/** \brief Signed volume of triangles [first, first + 12) (the divergence theorem), and the
+  * volume of the box their 8 vertices [8 b, 8 b + 8) span. */
+std::pair<double, double>
+boxVolumes (const pcl_probcollision::io::TriangleMesh& mesh, std::size_t b)
+{
+  auto v = [&] (std::size_t i) {
+    const auto& p = mesh.vertices[i];
+    return Eigen::Vector3d (p[0], p[1], p[2]);
+  };
+  double signed_volume = 0.0;
+  for (std::size_t t = 12 * b; t < 12 * b + 12; ++t)
+  {
+    const auto& tri = mesh.triangles[t];
+    signed_volume += v (static_cast<std::size_t> (tri[0])).dot (
+                         v (static_cast<std::size_t> (tri[1])).cross (v (static_cast<std::size_t> (tri[2])))) / 6.0;
+  }
+  const Eigen::Vector3d o = v (8 * b);
+  const double box = std::abs ((v (8 * b + 1) - o).dot ((v (8 * b + 2) - o).cross (v (8 * b + 4) - o)));
+  return {signed_volume, box};
+}
+} // namespace
+
+TEST (FitScene, ASeedGivesOneSceneOfOutwardBoxes)
+{
+  const FitScene a = makeFitScene (3), again = makeFitScene (3), other = makeFitScene (4);
+  EXPECT_EQ (a.env.vertices, again.env.vertices);
+  EXPECT_EQ (a.robot.vertices, again.robot.vertices);
+  EXPECT_NE (a.env.vertices, other.env.vertices);
+  for (const auto* mesh : {&a.env, &a.robot})
+  {
+    ASSERT_EQ (mesh->vertices.size () % 8, 0u);
+    ASSERT_EQ (mesh->triangles.size (), mesh->vertices.size () / 8 * 12);
+    for (std::size_t b = 0; b < mesh->vertices.size () / 8; ++b)
+    {
+      const auto [signed_volume, box] = boxVolumes (*mesh, b);
+      EXPECT_GT (box, 0.0) << "box " << b;
+      EXPECT_NEAR (signed_volume, box, 1e-9 * box) << "box " << b << " is not closed with outward faces";
+    }
+  }
+  // The robot: centred on the origin, about a piano's size; its lid (the part after the legs)
+  // lies on or above the body's top.
+  Eigen::AlignedBox3d robot_box;
+  for (const auto& p : a.robot.vertices)
+    robot_box.extend (Eigen::Vector3d (p[0], p[1], p[2]));
+  EXPECT_LT (robot_box.center ().norm (), 1e-9);
+  EXPECT_GT (robot_box.diagonal ().norm (), 1000.0);
+  EXPECT_LT (robot_box.diagonal ().norm (), 2500.0);
+  double body_top = -1e300;
+  for (std::size_t i = 0; i < 8; ++i)
+    body_top = std::max (body_top, a.robot.vertices[i][2]);
+  const std::size_t lid = a.robot.vertices.size () - 16;  // the lid, then the block
+  for (std::size_t i = lid; i < lid + 8; ++i)
+    EXPECT_GE (a.robot.vertices[i][2], body_top - 1e-9);
+  // FCL takes both; the robot lifted 3 m above the floor and furniture is clear of them.
+  ExactMeshPair exact (a.robot, a.env);
+  Eigen::Isometry3d up = Eigen::Isometry3d::Identity ();
+  up.translation () = Eigen::Vector3d (0.0, 0.0, 3000.0);
+  EXPECT_FALSE (exact.collide (up));
+  EXPECT_GT (exact.distance (up), 500.0);
 }

@@ -22,10 +22,10 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 void
-rawSurface (std::vector<OursSetting>& settings)
+calibratedSurface (std::vector<OursSetting>& settings)
 {
   for (OursSetting& s : settings)
-    s.request.surface_calibrated = false;
+    s.request.surface_calibrated = true;
 }
 
 std::vector<OursSetting>

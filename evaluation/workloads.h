@@ -73,10 +73,9 @@ std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& mer
                                        const std::vector<double>& gate = {}, const std::vector<double>& stop = {},
                                        const std::vector<double>& cap = {});
 
-/** \brief evaluate_collision --surface-raw: the settings with the surface layer answer its raw P
-  * (CollisionRequest::surface_calibrated off), the runs its calibration maps are fitted on
-  * (scripts/fit-surface-calibration.py). */
-void rawSurface (std::vector<OursSetting>& settings);
+/** \brief evaluate_collision --surface-calibrated: the settings with the surface layer answer
+  * with its calibration maps (CollisionRequest::surface_calibrated, off by default). */
+void calibratedSurface (std::vector<OursSetting>& settings);
 
 /** \brief A query's answer: score in [0, 1] and a verdict; ours also the signed distance and
   * its std (NaN when not computed, e.g. before the surface layer or with surface off) and the

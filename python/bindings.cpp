@@ -799,7 +799,8 @@ PYBIND11_MODULE (_core, m)
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
       "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental);\n"
-      "surface_calibrated: with surface, P in [0.1, 0.9] through the calibration map (default True).")
+      "surface_calibrated: with surface, P in [0.1, 0.9] through the calibration map fitted on the evaluation's\n"
+      "procedural scenes (default False: the model's raw P).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
@@ -846,8 +847,8 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
                       "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).")
       .def_readwrite ("surface_calibrated", &CollisionRequest::surface_calibrated,
-                      "With surface: P in [0.1, 0.9] through the calibration map fitted on evaluation runs "
-                      "(rankings and default verdicts kept; default True). False: the model's raw P.")
+                      "With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's "
+                      "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Fit the surface layer's calibration maps (src/surface_calibration.cpp) from evaluation runs.
 
-The surface layer's P, and its pool with the separators, over-state collisions inside the
-contact band (docs/SURFACE.md, "Calibration"). Each of the two gets a map of the band
+The surface layer's P, and its pool with the separators, is off inside the contact band, by
+scene: on the fit scenes below it under-states collisions there, on W1's piano and room it
+over-states them (docs/SURFACE.md, "Calibration"; the maps are off by default for that reason,
+CollisionRequest::surface_calibrated). Each of the two gets a map of the band
 [free_below, collision_above] = [0.1, 0.9] onto itself,
 
     P' = 0.1 + 0.8 u^gamma,   u = (P - 0.1) / 0.8,
@@ -10,26 +12,29 @@ contact band (docs/SURFACE.md, "Calibration"). Each of the two gets a map of the
 pinned at both ends (no verdict at the default thresholds changes), strictly increasing (every
 ranking kept: ROC AUC unchanged) and the identity outside the band. gamma is the one that
 minimises the Brier score of the near-band poses (|d| <= 2.8 sigma_eff), searched on a grid of
-0.05 from 1 to 4.
+0.05 from 0.5 to 4 (below 1 the map raises P in the band, above 1 it lowers it).
 
-Fit on runs that are NOT reported: the committed values come from the quick evaluation's seeds
-2-10 at 0.5 % noise (W1, both rooms), never from seed 1, which docs/RESULTS.md reports:
+Fit on scenes the evaluation never reports: the procedural furnished floors and box-built
+objects of `evaluate_collision --fit-scene` (evaluation/fit_scenes.h; workloads F1 and
+F1-sparse), never W1's piano and room, W2's primitives or W3's scans. The committed values come
+from these runs (the seed draws the scene as well as its samples):
 
-    for s in 2 3 4 5 6 7 8 9 10; do
-      build/evaluation/evaluate_collision --out runs/s$s --data ../shared/data --quick \\
-          --ours-only --surface-raw --seed $s
+    for s in 1 2 3 4 5 6 7 8 9 10 11 12; do
+      build/evaluation/evaluate_collision --out runs/s$s --data ../shared/data --quick \
+          --ours-only --fit-scene --seed $s
     done
     python3 scripts/fit-surface-calibration.py runs/s*
 
---surface-raw matters: the fit needs the raw P (CollisionRequest::surface_calibrated off), and
-nothing in queries.csv says which one a run wrote. Standard library only.
+Rows of any other workload are refused. The runs must give the raw P (CollisionRequest::surface_calibrated off, the default; not
+--surface-calibrated): nothing in queries.csv says which one a run wrote. Standard library only.
 """
 import csv
 import sys
 
 LOW, HIGH = 0.1, 0.9       # CollisionRequest's default free_below and collision_above
-GRID = [1.0 + 0.05 * k for k in range(61)]
+GRID = [0.5 + 0.05 * k for k in range(71)]
 SETTINGS = (("surface", "kSurfaceLayerGamma"), ("pooled", "kPooledGamma"))
+FIT_WORKLOAD = "F1"        # evaluate_collision --fit-scene: F1 and F1-sparse
 
 
 def mapped(p, gamma):
@@ -53,9 +58,13 @@ def main(dirs):
                 rows.extend(csv.DictReader(f))
         except OSError as e:
             sys.exit(f"fit-surface-calibration.py: cannot read {path}: {e.strerror}")
+    reported = sorted({r["workload"] for r in rows if not r["workload"].startswith(FIT_WORKLOAD)})
+    if reported:
+        sys.exit(f"fit-surface-calibration.py: the runs hold workload(s) {', '.join(reported)}; fit only on "
+                 f"evaluate_collision --fit-scene runs ({FIT_WORKLOAD}), never on what the evaluation reports")
     for setting, name in SETTINGS:
         points = [(float(r["score"]), int(r["exact_collision"])) for r in rows
-                  if r["method"] == "ours" and r["setting"] == setting and r["workload"].startswith("W1")
+                  if r["method"] == "ours" and r["setting"] == setting
                   and r["noise_pct"] == "0.5" and r["near_sigma"] == "1"]
         if len(points) < 100:
             sys.exit(f"fit-surface-calibration.py: only {len(points)} near-band '{setting}' answers at 0.5 %")

@@ -42,7 +42,8 @@ const std::set<std::string> kValueFlags = {
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
   "-noise_stop", "-max_leaf_fits"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
-                                            "-measured", "-surface", "-surface_pooled", "-surface_raw", "-ignore_normals", "-v"};
+                                            "-measured", "-surface", "-surface_pooled", "-surface_calibrated", "-ignore_normals",
+                                            "-v"};
 
 ParseResult
 usage (const std::string& message)
@@ -290,8 +291,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.surface = true;
       else if (a == "-surface_pooled")
         o.surface = o.surface_pooled = true;
-      else if (a == "-surface_raw")
-        o.surface_calibrated = false;
+      else if (a == "-surface_calibrated")
+        o.surface_calibrated = true;
       else if (a == "-ignore_normals")
         o.ignore_normals = true;
       else if (a == "-json")
@@ -560,9 +561,9 @@ helpText ()
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
        "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"
-       "  -surface_raw    with -surface: P as the model gives it, without the calibration map (by\n"
-       "                  default P in [0.1, 0.9] is mapped onto the collision share observed on\n"
-       "                  evaluation runs; rankings and verdicts at 0.1,0.9 unchanged)\n"
+       "  -surface_calibrated  with -surface: P in [0.1, 0.9] through the calibration map fitted on\n"
+       "                  the evaluation's procedural scenes (rankings and verdicts at 0.1,0.9\n"
+       "                  unchanged; off by default: it does not carry over to other scenes)\n"
        "  -ignore_normals with -surface: orient clouds as if their files had no normal_x normal_y\n"
        "                  normal_z (by default a cloud's stored normals are its outward ones)\n"
        "  -nmax N         = "

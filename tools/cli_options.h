@@ -109,7 +109,7 @@ struct Options
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;
-  /** \brief Not -surface_raw: CollisionRequest::surface_calibrated. */
+  /** \brief -surface_calibrated: CollisionRequest::surface_calibrated. */
   bool surface_calibrated = Defaults::surface_calibrated;
   /** \brief -ignore_normals: with -surface, a cloud file's normal_x normal_y normal_z are not
     * read (the cloud is oriented by its viewpoint or by propagation, as one without normals). */

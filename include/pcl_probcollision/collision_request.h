@@ -85,14 +85,14 @@ struct CollisionRequest
   bool surface_pooled = false;
   /** \brief With surface on: P (the surface layer's, or the pool's) goes through a calibration
     * map inside the default contact band [0.1, 0.9]: strictly increasing, onto the band, the
-    * identity outside it, so rankings and the default thresholds' verdicts are kept. Raw, the
-    * surface layer over-states collisions there (its near-contact answers of P 0.3-0.4 collided
-    * in 11-18 % of cases, those of 0.1-0.2 in 4 %: W1 at 0.5 %, quick runs of seeds 2-10). The
-    * maps were fitted on those runs: the same workload as the reported one, other scenes
-    * (docs/SURFACE.md, "Calibration"). Per-point values,
-    * signed_distance and its std are not mapped: P no longer equals Phi(-d / std) inside the
-    * band. Off: the model's raw P. */
-  bool surface_calibrated = true;
+    * identity outside it, so rankings and the default thresholds' verdicts are kept. The maps
+    * are fitted on procedural scenes the evaluation never reports (evaluate_collision
+    * --fit-scene), where the raw P under-states collisions in the band, so they raise it; on the
+    * reported piano-and-room scenes the raw P over-states them, and the maps make it worse
+    * (docs/SURFACE.md, "Calibration"). No map fitted apart from those scenes helps them, so the
+    * default is the model's raw P, P = Phi(-signed_distance / signed_distance_std). Per-point
+    * values, signed_distance and its std are never mapped. */
+  bool surface_calibrated = false;
   /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
   ClassifierParams classifier;
 

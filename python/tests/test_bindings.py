@@ -332,7 +332,7 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
     assert pooled.probability == 0.5 * (surface.probability + separators.probability)
     assert pooled.signed_distance == surface.signed_distance
     assert "surface_pooled=True" in repr(pc.CollisionRequest(surface=True, surface_pooled=True))
-    assert pc.CollisionRequest().surface_calibrated
+    assert not pc.CollisionRequest().surface_calibrated
     assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
 
 

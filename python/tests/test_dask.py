@@ -197,7 +197,7 @@ def cli_inputs(tmp_path_factory, table_points):
     ["-sensor_b", "kinect", "-k", "12", "-thresholds=0.2,0.8", "-exhaustive", "-nmax", "16", "-split", "octree"],
     ["-sigma", "0.0015", "-surface"],
     ["-sigma", "0.0015", "-surface_pooled"],
-    ["-sigma", "0.0015", "-surface", "-surface_raw"],
+    ["-sigma", "0.0015", "-surface", "-surface_calibrated"],
 ])
 def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     args = [str(cli_inputs / "gripper.pcd"), str(cli_inputs / "table.pcd")]
@@ -215,7 +215,7 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     distances = [a["signed_distance"] for a in answers]
     assert all(isinstance(a["unobserved"], bool) for a in answers)  # never null
     assert all(a["parameters"]["surface_pooled"] == ("-surface_pooled" in flags) for a in answers)
-    assert all(a["parameters"]["surface_calibrated"] == ("-surface_raw" not in flags) for a in answers)
+    assert all(a["parameters"]["surface_calibrated"] == ("-surface_calibrated" in flags) for a in answers)
     if "-surface" in flags or "-surface_pooled" in flags:
         assert all(a["parameters"]["surface"] for a in answers)
         assert sum(d is not None for d in distances) >= 10

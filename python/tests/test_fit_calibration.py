@@ -9,7 +9,7 @@ SCRIPT = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "fit-surface-
 FIELDS = ["workload", "noise_pct", "method", "setting", "near_sigma", "score", "exact_collision"]
 
 
-def write_run(directory, gamma, count, seed):
+def write_run(directory, gamma, count, seed, workloads=("F1", "F1-sparse")):
     """A run whose near-band poses collide with chance 0.1 + 0.8 u^gamma in the band (u the
     position of P in it), with P itself outside the band; both settings alike."""
     rng = random.Random(seed)
@@ -21,7 +21,7 @@ def write_run(directory, gamma, count, seed):
             for _ in range(count):
                 p = rng.random()
                 truth = 0.1 + 0.8 * ((p - 0.1) / 0.8) ** gamma if 0.1 <= p <= 0.9 else p
-                w.writerow({"workload": rng.choice(["W1", "W1-sparse"]), "noise_pct": "0.5", "method": "ours",
+                w.writerow({"workload": rng.choice(list(workloads)), "noise_pct": "0.5", "method": "ours",
                             "setting": setting, "near_sigma": "1", "score": f"{p:.6f}",
                             "exact_collision": int(rng.random() < truth)})
 
@@ -59,3 +59,9 @@ def test_refuses_missing_runs_and_too_few_answers(tmp_path):
     out = run(tmp_path / "small")
     assert out.returncode != 0 and "near-band" in out.stderr
     assert run().returncode != 0
+
+
+def test_refuses_runs_of_a_reported_workload(tmp_path):
+    write_run(tmp_path / "w1", gamma=2.0, count=4000, seed=3, workloads=("W1", "F1"))
+    out = run(tmp_path / "w1")
+    assert out.returncode != 0 and "W1" in out.stderr and "--fit-scene" in out.stderr

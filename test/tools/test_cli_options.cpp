@@ -67,8 +67,8 @@ TEST (CliOptions, Defaults)
   EXPECT_TRUE (parse ({"-defer_kernel_fits"}).options.defer_kernel_fits);
   EXPECT_EQ (parse ({"-noise_stop", "2"}).options.noise_stop, 2.0);
   EXPECT_FALSE (o.surface_pooled);
-  EXPECT_TRUE (o.surface_calibrated);  // the calibration map, unless -surface_raw
-  EXPECT_FALSE (parse ({"-surface", "-surface_raw"}).options.surface_calibrated);
+  EXPECT_FALSE (o.surface_calibrated);  // the model's raw P, unless -surface_calibrated
+  EXPECT_TRUE (parse ({"-surface", "-surface_calibrated"}).options.surface_calibrated);
   EXPECT_FALSE (o.ignore_normals);
   EXPECT_FALSE (o.mesh_spacing);
   EXPECT_FALSE (o.output);

@@ -64,9 +64,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "surface": _REQUEST.surface,
     # The surface layer pooled with the separators (the mean of the two P); implies surface.
     "surface_pooled": _REQUEST.surface_pooled,
-    # With surface: P as the model gives it, without the calibration map (pcd_collision's
-    # -surface_raw; CollisionRequest.surface_calibrated is its negation).
-    "surface_raw": not _REQUEST.surface_calibrated,
+    # With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's
+    # procedural scenes (pcd_collision's -surface_calibrated; off: the model's raw P).
+    "surface_calibrated": _REQUEST.surface_calibrated,
     # With surface: a cloud file's normal_x normal_y normal_z are not read (pcd_collision's
     # -ignore_normals); the cloud is oriented as one without them.
     "ignore_normals": False,
@@ -149,7 +149,7 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
         seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), defer_kernel_fits=bool(o["defer_kernel_fits"]),
         surface=bool(o["surface"]),
-        surface_pooled=bool(o["surface_pooled"]), surface_calibrated=not o["surface_raw"])
+        surface_pooled=bool(o["surface_pooled"]), surface_calibrated=bool(o["surface_calibrated"]))
 
 
 # ------------------------------------------------------------------------------------------------
