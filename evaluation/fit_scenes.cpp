@@ -58,7 +58,7 @@ makeFitScene (std::uint64_t seed)
 
   // The floor and its walls.
   const double half_x = uniform (2700.0, 3200.0), half_y = uniform (2700.0, 3200.0), floor_top = 15.0;
-  addBox (scene.env, {0.0, 0.0, 0.0}, {half_x, half_y, 15.0});
+  addBox (scene.env, {0.0, 0.0, 0.0}, {half_x, half_y, floor_top});  // 30 mm thick, centred on z = 0
   const int walls = 2 + static_cast<int> (uniform (0.0, 2.0));
   for (int w = 0; w < walls; ++w)
   {

@@ -20,13 +20,14 @@ F1-sparse), never W1's piano and room, W2's primitives or W3's scans. The commit
 from these runs (the seed draws the scene as well as its samples):
 
     for s in 1 2 3 4 5 6 7 8 9 10 11 12; do
-      build/evaluation/evaluate_collision --out runs/s$s --data ../shared/data --quick \
+      build/evaluation/evaluate_collision --out runs/s$s --data ../shared/data --quick \\
           --ours-only --fit-scene --seed $s
     done
     python3 scripts/fit-surface-calibration.py runs/s*
 
-Rows of any other workload are refused. The runs must give the raw P (CollisionRequest::surface_calibrated off, the default; not
---surface-calibrated): nothing in queries.csv says which one a run wrote. Standard library only.
+Rows of any other workload are refused. The runs must give the raw P
+(CollisionRequest::surface_calibrated off, the default; not --surface-calibrated): nothing in
+queries.csv says which one a run wrote. Standard library only.
 """
 import csv
 import sys
