@@ -187,6 +187,9 @@ splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<
   return 0.5 * (pmin + pmax);
 }
 
+// The node layout its documentation promises (ProbabilisticBVH::Node).
+static_assert (sizeof (ProbabilisticBVH::Node) == 136, "a hierarchy node is 136 bytes");
+
 // Per-node geometry: everything computed from the node's own points.
 struct NodeGeometry
 {
@@ -235,9 +238,9 @@ computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, doubl
   g.mean = mean;
   g.axes.col (0) = V.col (2);
   g.axes.col (1) = V.col (1);
-  g.axes.col (2) = V.col (0);
-  if (g.axes.determinant () < 0.0)
-    g.axes.col (2) = -g.axes.col (2);
+  // e1 is implied by e3 x e2, as the node's box stores it (OrientedBox), so the extents and the
+  // leakage below are those of the stored box exactly.
+  g.axes.col (2) = g.axes.col (0).cross (g.axes.col (1));
   const double l1 = std::max (0.0, lambda (0));
   const double sum = l1 + std::max (0.0, lambda (1)) + std::max (0.0, lambda (2));
   g.variation = sum > 0.0 ? l1 / sum : 0.0;
@@ -506,15 +509,15 @@ makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& t
   const std::size_t m = pts.size ();
   NodeGeometry& g = s.g;
   computeGeometry (points, pts, params.k_sigma, g);
-  node.box.axes = g.axes;
+  node.box.setAxes (g.axes);
   node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
   node.box.half_extents = 0.5 * (g.hi - g.lo);
   for (int k = 0; k < 3; ++k)
     node.max_sigma (k) = static_cast<float> (g.s_max (k));
-  node.leakage = nodeLeakage (points, pts, g, params.leakage_bound);
+  node.leakage = static_cast<float> (nodeLeakage (points, pts, g, params.leakage_bound));
   node.variation = static_cast<float> (g.variation);
   node.num_points = static_cast<std::int32_t> (m);
-  node.depth = task.depth;
+  node.depth = static_cast<std::uint16_t> (task.depth);
   node.first_child = -1;
   node.num_children = 0;
 
@@ -527,6 +530,8 @@ makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& t
   else if (params.noise_stop > 0.0 && m <= static_cast<std::size_t> (params.n_noise_max) &&
            withinNoise (g, params.noise_stop, s.tmp))
     node.leaf_reason = ProbabilisticBVH::LeafReason::NoiseStop;
+  else if (task.depth >= ProbabilisticBVH::maxDepth ())
+    node.leaf_reason = ProbabilisticBVH::LeafReason::NoProgress;
   else
   {
     split = params.split_style == BVHParams::SplitStyle::Pca ? splitPca (pts, g, params.epsilon, s.tmp, s.children)
@@ -708,7 +713,7 @@ joinParts (std::vector<TopPart>& parts, Tree& out)
       continue;
     }
     Node nd = part.node;
-    out.max_depth = std::max (out.max_depth, nd.depth);
+    out.max_depth = std::max (out.max_depth, static_cast<int> (nd.depth));
     if (part.children.empty ())
     {
       nd.begin = static_cast<std::int32_t> (out.indices.size ());

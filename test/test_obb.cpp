@@ -39,11 +39,11 @@ bruteSeparationGap (const OrientedBox& a, const OrientedBox& b_in_a)
   std::vector<Eigen::Vector3d> axes;
   for (int i = 0; i < 3; ++i)
   {
-    axes.push_back (a.axes.col (i));
-    axes.push_back (b_in_a.axes.col (i));
+    axes.push_back (a.axes ().col (i));
+    axes.push_back (b_in_a.axes ().col (i));
     for (int j = 0; j < 3; ++j)
     {
-      const Eigen::Vector3d c = a.axes.col (i).cross (b_in_a.axes.col (j));
+      const Eigen::Vector3d c = a.axes ().col (i).cross (b_in_a.axes ().col (j));
       if (c.norm () > 1e-6)
         axes.push_back (c.normalized ());
     }
@@ -66,13 +66,39 @@ randomBox (std::mt19937_64& rng, bool allow_flat)
   std::uniform_real_distribution<double> h (0.0, 1.0);
   OrientedBox b;
   b.center = draw3 (u, rng);
-  b.axes = randomRotation (rng);
+  b.setAxes (randomRotation (rng));
   b.half_extents = draw3 (h, rng);
   if (allow_flat && h (rng) < 0.3)
     b.half_extents (static_cast<int> (3 * h (rng)) % 3) = 0.0;
   return b;
 }
 } // namespace
+
+TEST (OrientedBox, KeepsTwoAxesAndImpliesTheThird)
+{
+  // The box stores the first two columns of its frame; axes() completes them to a rotation,
+  // boxCoordinates() and transformed() agree with it, and a reflection given to setAxes() comes
+  // back as the rotation with the same first two columns.
+  std::mt19937_64 rng (17);
+  std::uniform_real_distribution<double> u (-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    Eigen::Matrix3d given = randomRotation (rng);
+    if (trial % 2)
+      given.col (2) = -given.col (2);
+    OrientedBox b;
+    b.center = draw3 (u, rng);
+    b.setAxes (given);
+    const Eigen::Matrix3d A = b.axes ();
+    EXPECT_TRUE (A.leftCols<2> () == given.leftCols<2> ());
+    EXPECT_NEAR ((A.transpose () * A - Eigen::Matrix3d::Identity ()).norm (), 0.0, 1e-14);
+    EXPECT_NEAR (A.determinant (), 1.0, 1e-14);
+    const Eigen::Vector3d p = draw3 (u, rng);
+    EXPECT_NEAR ((b.boxCoordinates (p) - A.transpose () * (p - b.center)).norm (), 0.0, 1e-14);
+    const Eigen::Isometry3d T = randomPose (rng, 1.0);
+    EXPECT_NEAR ((b.transformed (T).axes () - T.linear () * A).norm (), 0.0, 1e-14);
+  }
+}
 
 TEST (OrientedBox, SeparatedByConstructionAreDisjoint)
 {
@@ -87,8 +113,8 @@ TEST (OrientedBox, SeparatedByConstructionAreDisjoint)
     // Push B along a random direction n until its support leaves A's by `gap`.
     const Eigen::Vector3d n = draw3 (g, rng).normalized ();
     const OrientedBox b_in_a = b.transformed (T);
-    const double top_a = n.dot (a.center) + (a.axes.transpose () * n).cwiseAbs ().dot (a.half_extents);
-    const double bottom_b = n.dot (b_in_a.center) - (b_in_a.axes.transpose () * n).cwiseAbs ().dot (b.half_extents);
+    const double top_a = n.dot (a.center) + (a.axes ().transpose () * n).cwiseAbs ().dot (a.half_extents);
+    const double bottom_b = n.dot (b_in_a.center) - (b_in_a.axes ().transpose () * n).cwiseAbs ().dot (b.half_extents);
     const double gap = gap_dist (rng);
     T.translation () += (top_a - bottom_b + gap) * n;
     EXPECT_TRUE (detail::disjoint (a, b, T)) << "trial " << trial;
@@ -111,8 +137,8 @@ TEST (OrientedBox, OverlappingByConstructionAreNotDisjoint)
     const OrientedBox a = randomBox (rng, true);
     const OrientedBox b = randomBox (rng, true);
     // A point of B (its local coordinates) placed on a point of A: they share it.
-    const Eigen::Vector3d pa = a.center + a.axes * draw3 (u, rng).cwiseProduct (a.half_extents);
-    const Eigen::Vector3d pb = b.center + b.axes * draw3 (u, rng).cwiseProduct (b.half_extents);
+    const Eigen::Vector3d pa = a.center + a.axes () * draw3 (u, rng).cwiseProduct (a.half_extents);
+    const Eigen::Vector3d pb = b.center + b.axes () * draw3 (u, rng).cwiseProduct (b.half_extents);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
     T.linear () = randomRotation (rng);
     T.translation () = pa - T.linear () * pb;
@@ -189,7 +215,7 @@ TEST (OrientedBox, SampledCommonPointImpliesOverlap)
     bool common = false;
     for (int s = 0; s < 400 && !common; ++s)
     {
-      const Eigen::Vector3d pb = b.center + b.axes * draw3 (u, rng).cwiseProduct (b.half_extents);
+      const Eigen::Vector3d pb = b.center + b.axes () * draw3 (u, rng).cwiseProduct (b.half_extents);
       common = a.contains (T * pb);
     }
     if (common)

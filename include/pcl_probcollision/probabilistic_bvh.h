@@ -104,18 +104,22 @@ public:
     NotLeaf,    ///< internal node
     StopRule,   ///< m <= n_max and variation <= sigma_max
     MinSize,    ///< the stop rule failed but m <= n_min
-    NoProgress, ///< a split was wanted but could not separate the points (METHOD.md 8.2 guard)
+    NoProgress, ///< a split was wanted but could not separate the points (METHOD.md 8.2 guard),
+                ///< or the node is at maxDepth()
     NoiseStop   ///< a split was wanted but the node is within the noise (BVHParams::noise_stop)
   };
 
-  /** \brief One node. Children of a node are stored contiguously. */
+  /** \brief One node. Children of a node are stored contiguously. A node is 136 bytes (the
+    * nodes are most of a large cloud's model, 0.6 a point at 1,000,000 points), so the box keeps
+    * two of its axes, the leakage is single precision and the depth 16 bits. */
   struct Node
   {
     /** \brief Inflated oriented box in the cloud's frame (metres). */
     detail::OrientedBox box;
     /** \brief P_leak: area-weighted mean over the node's points of the probability of lying
-      * outside box (METHOD.md 8.4), in [0, 1]. */
-    double leakage = 0.0;
+      * outside box (METHOD.md 8.4), in [0, 1]; computed in double and stored in single
+      * precision (a relative error of 2^-24, far below what the estimate is worth). */
+    float leakage = 0.0f;
     /** \brief Per box axis, the largest point standard deviation sqrt(a^T Sigma a) (metres);
       * lets a traversal inflate the box further (ExpandedBV). */
     Eigen::Vector3f max_sigma = Eigen::Vector3f::Zero ();
@@ -131,8 +135,8 @@ public:
     std::int32_t end = 0;
     /** \brief Number of distinct points of the node (m). */
     std::int32_t num_points = 0;
-    /** \brief Depth below the root (root = 0). */
-    std::int32_t depth = 0;
+    /** \brief Depth below the root (root = 0), at most maxDepth(). */
+    std::uint16_t depth = 0;
     /** \brief Number of children: 0 (leaf), 2 (Pca) or 1..8 (Octree). */
     std::uint8_t num_children = 0;
     /** \brief Why the node is a leaf, NotLeaf for internal nodes. */
@@ -206,6 +210,12 @@ public:
 
   /** \brief Id of the root node. */
   static constexpr std::int32_t rootId () { return 0; }
+
+  /** \brief The deepest level a node may have; a node there is a leaf (LeafReason::NoProgress).
+    * No cloud comes near it: a split that separates points must leave a child on each side of
+    * the parent's mean, which needs coordinates spread over many orders of magnitude to repeat
+    * more than a few hundred times. */
+  static constexpr int maxDepth () { return 65535; }
 
   /** \brief The flat index array: leaves' point indices (into means()), leaves in depth-first
     * order, ascending within a leaf. Its length is storedPoints(). */

@@ -73,9 +73,10 @@ pointOutsideProbability (const OrientedBox& box, const Eigen::Vector3d& mean,
 {
   double out[3];
   const Eigen::Vector3d d = mean - box.center;
+  const Eigen::Matrix3d axes = box.axes ();
   for (int k = 0; k < 3; ++k)
   {
-    const Eigen::Vector3d a = box.axes.col (k);
+    const Eigen::Vector3d a = axes.col (k);
     const double s = std::sqrt (std::max (0.0, a.dot (covariance * a)));
     out[k] = slabOutsideProbability (-box.half_extents (k), box.half_extents (k), a.dot (d), s);
   }

@@ -16,18 +16,40 @@ namespace detail
 /** \brief Oriented bounding box: a centre, a right-handed orthonormal frame and half extents
   * along its three axes (METHOD.md 8.3).
   *
-  * A point x lies inside when |axes.col(k)^T (x - center)| <= half_extents(k) for k = 0, 1, 2.
+  * A point x lies inside when |axes().col(k)^T (x - center)| <= half_extents(k) for k = 0, 1, 2.
   * Lengths are in the units of the data (metres for PCL scans). In the hierarchy, axis 0 is the
   * longest principal direction e3, axis 1 is e2 and axis 2 is e1 (the normal of a surface patch).
+  *
+  * Only the first two axes are stored; the third is their cross product, so the frame is
+  * right-handed by construction and a hierarchy node is 24 bytes smaller (issue #17's memory
+  * target). Everything that reads the frame, the box's own fit included, reads axes().
   */
 struct OrientedBox
 {
   /** \brief Centre of the box, in the frame the box is expressed in (metres). */
   Eigen::Vector3d center = Eigen::Vector3d::Zero ();
-  /** \brief Unit axes as columns, a rotation (det +1): maps box coordinates to the frame. */
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity ();
-  /** \brief Half extents along the columns of axes (metres, >= 0). */
+  /** \brief The first two unit axes as columns (set through setAxes()). */
+  Eigen::Matrix<double, 3, 2, Eigen::DontAlign> first_axes = Eigen::Matrix<double, 3, 2>::Identity ();
+  /** \brief Half extents along the columns of axes() (metres, >= 0). */
   Eigen::Vector3d half_extents = Eigen::Vector3d::Zero ();
+
+  /** \brief The unit axes as columns, a rotation (det +1) mapping box coordinates to the frame:
+    * first_axes, then their cross product. */
+  Eigen::Matrix3d
+  axes () const
+  {
+    Eigen::Matrix3d a;
+    a.leftCols<2> () = first_axes;
+    a.col (2) = first_axes.col (0).cross (first_axes.col (1));
+    return a;
+  }
+
+  /** \brief Sets the frame from a rotation's first two columns (its third is implied). */
+  void
+  setAxes (const Eigen::Matrix3d& rotation)
+  {
+    first_axes = rotation.leftCols<2> ();
+  }
 
   /** \brief The same box expressed in another frame: T_dst_src maps this box's frame into dst. */
   OrientedBox
@@ -35,16 +57,25 @@ struct OrientedBox
   {
     OrientedBox out;
     out.center = T_dst_src * center;
-    out.axes = T_dst_src.linear () * axes;
+    out.first_axes = T_dst_src.linear () * first_axes;
     out.half_extents = half_extents;
     return out;
+  }
+
+  /** \brief p (in the box's frame) in box coordinates: axes()^T (p - center). */
+  Eigen::Vector3d
+  boxCoordinates (const Eigen::Vector3d& p) const
+  {
+    const Eigen::Vector3d d = p - center;
+    return Eigen::Vector3d (first_axes.col (0).dot (d), first_axes.col (1).dot (d),
+                            first_axes.col (0).cross (first_axes.col (1)).dot (d));
   }
 
   /** \brief True when p lies inside the box grown by tolerance (metres) on every side. */
   bool
   contains (const Eigen::Vector3d& p, double tolerance = 0.0) const
   {
-    const Eigen::Vector3d local = axes.transpose () * (p - center);
+    const Eigen::Vector3d local = boxCoordinates (p);
     for (int k = 0; k < 3; ++k)
       if (std::abs (local (k)) > half_extents (k) + tolerance)
         return false;
@@ -71,10 +102,11 @@ struct OrientedBox
   corners () const
   {
     Eigen::Matrix<double, 3, 8> c;
+    const Eigen::Matrix3d a = axes ();
     for (int i = 0; i < 8; ++i)
     {
       Eigen::Vector3d s ((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0);
-      c.col (i) = center + axes * s.cwiseProduct (half_extents);
+      c.col (i) = center + a * s.cwiseProduct (half_extents);
     }
     return c;
   }
@@ -171,10 +203,17 @@ inline bool
 disjointInflated (const OrientedBox& a, const Eigen::Vector3d& extra_a, const OrientedBox& b,
                   const Eigen::Vector3d& extra_b, const Eigen::Isometry3d& T_a_b)
 {
-  const Eigen::Matrix3d axes_b_in_a = T_a_b.linear () * b.axes;
-  const Eigen::Vector3d center_b_in_a = T_a_b * b.center;
-  const Eigen::Matrix3d R = a.axes.transpose () * axes_b_in_a;
-  const Eigen::Vector3d t = a.axes.transpose () * (center_b_in_a - a.center);
+  // R(i, j) = a_i . (L b_j), L = T_a_b's rotation, from the two stored axes of each box: A's
+  // third axis is the cross product of its first two, and so is R's third column (R is a
+  // rotation). Fewer products than with the full frames, and no call to axes() in this hot path.
+  const Eigen::Vector3d a2 = a.first_axes.col (0).cross (a.first_axes.col (1));
+  const Eigen::Matrix<double, 3, 2> Lb = T_a_b.linear () * b.first_axes;
+  Eigen::Matrix3d R;
+  R.topLeftCorner<2, 2> () = a.first_axes.transpose () * Lb;
+  R.block<1, 2> (2, 0) = a2.transpose () * Lb;
+  R.col (2) = R.col (0).cross (R.col (1));
+  const Eigen::Vector3d d = T_a_b * b.center - a.center;
+  const Eigen::Vector3d t (a.first_axes.col (0).dot (d), a.first_axes.col (1).dot (d), a2.dot (d));
   return disjointLocal (a.half_extents + extra_a, R, t, b.half_extents + extra_b);
 }
 
@@ -191,7 +230,8 @@ disjoint (const OrientedBox& a, const OrientedBox& b, const Eigen::Isometry3d& T
 /** \brief Fits the box with the given axes around Gaussian points: along each axis a the extent
   * is [min_j a^T x_j - k_sigma s_j, max_j a^T x_j + k_sigma s_j] with s_j = sqrt(a^T Sigma_j a)
   * (METHOD.md 8.3).
-  * \param[in] axes box axes as columns (a rotation)
+  * \param[in] axes box axes as columns (a rotation; its first two columns are kept and the
+  *            third taken as their cross product, see OrientedBox)
   * \param[in] means point means (metres)
   * \param[in] covariances point covariances (square metres) or nullptr for exact points
   * \param[in] indices the points to use, or nullptr for 0 .. count-1
@@ -203,9 +243,10 @@ fitOrientedBox (const Eigen::Matrix3d& axes, const Eigen::Vector3d* means,
                 double k_sigma)
 {
   OrientedBox box;
-  box.axes = axes;
+  box.setAxes (axes);
   if (count == 0)
     return box;
+  const Eigen::Matrix3d A = box.axes ();
   // Project relative to the first point so large coordinates keep their precision.
   const Eigen::Vector3d origin = means[indices ? indices[0] : 0];
   Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
@@ -213,17 +254,17 @@ fitOrientedBox (const Eigen::Matrix3d& axes, const Eigen::Vector3d* means,
   for (std::size_t n = 0; n < count; ++n)
   {
     const int j = indices ? indices[n] : static_cast<int> (n);
-    const Eigen::Vector3d q = axes.transpose () * (means[j] - origin);
+    const Eigen::Vector3d q = A.transpose () * (means[j] - origin);
     for (int k = 0; k < 3; ++k)
     {
       double s = 0.0;
       if (covariances)
-        s = std::sqrt (std::max (0.0, axes.col (k).dot (covariances[j] * axes.col (k))));
+        s = std::sqrt (std::max (0.0, A.col (k).dot (covariances[j] * A.col (k))));
       lo (k) = std::min (lo (k), q (k) - k_sigma * s);
       hi (k) = std::max (hi (k), q (k) + k_sigma * s);
     }
   }
-  box.center = origin + axes * (0.5 * (lo + hi));
+  box.center = origin + A * (0.5 * (lo + hi));
   box.half_extents = 0.5 * (hi - lo);
   return box;
 }
