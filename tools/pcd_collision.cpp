@@ -72,9 +72,14 @@ msSince (std::chrono::steady_clock::time_point start)
 // ---------------------------------------------------------------------------------------------
 /** \brief Sizes (bounding-box diagonals) differing by more than this get a units warning. */
 constexpr double kScaleWarningRatio = 100.0;
-/** \brief Fewest finite points of a cloud whose extent the units warning judges. A handful of
+/** \brief Fewest finite points of a cloud whose extent the units warnings judge. A handful of
   * points (a probe, two points 1 mm apart) has no telling size; a scan has thousands. */
 constexpr std::size_t kScaleWarningMinPoints = 50;
+/** \brief An isotropic sigma below this fraction of its cloud's bounding-box diagonal gets a
+  * units warning. No sensor is that precise on what it scans (10 um on a 1 m part is 1e-5);
+  * the default sigma, 5 mm in metres, given to a millimetre scan of a metre-sized object is
+  * 5 um there, 2.8e-6 of a piano's diagonal. */
+constexpr double kNoiseWarningRatio = 1e-5;
 
 struct Input
 {
@@ -478,6 +483,24 @@ warnIfScalesDiffer (const Input& a, const Input& b)
                   ratio, da, a.path.c_str (), db, b.path.c_str ());
 }
 
+/** \brief -sigma is in the data's units (docs/CLI.md). Warn on stderr when a cloud's isotropic
+  * sigma is below kNoiseWarningRatio of its size: most likely the default, 0.005 (metres), on a
+  * cloud in millimetres. The answer is then for a near noise-free cloud, and its classifier fits
+  * are the hardest there are. */
+void
+warnIfNoiseImplausible (const Input& in, const std::string& sensor, double sigma)
+{
+  if (in.kind != InputKind::Cloud || sensor != "isotropic" || in.finite < kScaleWarningMinPoints)
+    return;
+  const double diagonal = inputDiagonal (in);
+  if (sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal) && sigma < kNoiseWarningRatio * diagonal)
+    std::fprintf (stderr,
+                  "pcd_collision: warning: the noise sigma %.6g of '%s' is %.2g of its size (bounding-box "
+                  "diagonal %.6g); sigma is in the data's units (the default 0.005 is 5 mm in metres), so give "
+                  "-sigma in the cloud's units (e.g. -sigma 5 for millimetres)\n",
+                  sigma, in.path.c_str (), sigma / diagonal, diagonal);
+}
+
 /** \brief The stage line of -surface that says where an input's surface normals got their
   * orientation (NormalOrientation, resolved by the model's build). */
 void
@@ -589,6 +612,8 @@ run (int argc, char** argv)
   loadInput (a, with_normals, log);
   loadInput (b, with_normals, log);
   warnIfScalesDiffer (a, b);
+  warnIfNoiseImplausible (a, o.sensor_a, o.sigma_a);
+  warnIfNoiseImplausible (b, o.sensor_b, o.sigma_b);
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at

@@ -334,6 +334,32 @@ TEST_F (CliReliability, MillimetresAgainstMetresWarnsOnStderr)
   EXPECT_EQ (same.err.find ("warning"), std::string::npos) << same.err;
 }
 
+TEST_F (CliReliability, NoiseFarBelowTheDataWarnsOnStderr)
+{
+  // Both inputs in millimetres (no size warning), the default sigma 0.005 (5 mm in metres, 5 um
+  // here): warned once per cloud. -sigma 5, the millimetre equivalent, is not warned.
+  Cloud mm;
+  pcl::io::loadPCDFile (kScene.string (), mm);
+  for (auto& p : mm.points)
+    p.getVector3fMap () *= 1000.0f;
+  const std::string scene_mm = save ("table_mug_mm.pcd", mm);
+  const Run warned = run ({scene_mm, scene_mm, "-pose", "0,0,50,0,0,0"});
+  EXPECT_EQ (warned.status, 0) << warned.err;
+  EXPECT_EQ (warned.err.find ("sizes differ"), std::string::npos) << warned.err;
+  const std::string message = "pcd_collision: warning: the noise sigma 0.005 of";
+  const std::size_t first = warned.err.find (message);
+  ASSERT_NE (first, std::string::npos) << warned.err;
+  EXPECT_NE (warned.err.find (message, first + 1), std::string::npos) << "one warning per cloud\n" << warned.err;
+  EXPECT_NE (warned.err.find ("-sigma 5 for millimetres"), std::string::npos) << warned.err;
+  ASSERT_EQ (warned.json.size (), 1u);  // stdout stays pure JSON
+  const Run scaled = run ({scene_mm, scene_mm, "-pose", "0,0,50,0,0,0", "-sigma", "5"});
+  EXPECT_EQ (scaled.status, 0) << scaled.err;
+  EXPECT_EQ (scaled.err.find ("warning"), std::string::npos) << scaled.err;
+  // Only the isotropic model's sigma is judged.
+  const Run none = run ({scene_mm, scene_mm, "-pose", "0,0,50,0,0,0", "-sensor", "none"});
+  EXPECT_EQ (none.err.find ("noise sigma"), std::string::npos) << none.err;
+}
+
 // A few points have no telling extent: a two-point probe 1 mm long against the 0.74 m scene
 // (740x) is legitimate. From 50 finite points on (docs/CLI.md) the extent is judged.
 TEST_F (CliReliability, UnitsWarningNeedsEnoughPoints)
