@@ -24,6 +24,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -926,13 +927,14 @@ TEST (RobustClassifier, AKernelSolveStalledAtRoundingStops)
       {-233.88785821356805, 621.34300067317827, 281.66463408972106, 0.0060025934734524132, -0.78567300748626123, -0.29192910745799228, 103.26581091433967, 38.370023209863263, 14.257009212237698},
       {-252.82923847131997, 626.24671770607119, 303.82831497277834, 0.49373065148476353, -12.257806706888356, -4.5670948134211837, 304.33892151024764, 113.39260277286223, 42.248592366561198},
   };
+  constexpr std::size_t kPointsOfA = 4;
   Cloud a, b;
-  for (int i = 0; i < 23; ++i)
+  for (std::size_t i = 0; i < std::size (rows); ++i)
   {
     const double* r = rows[i];
     Eigen::Matrix3d c;
     c << r[3], r[4], r[5], r[4], r[6], r[7], r[5], r[7], r[8];
-    (i < 4 ? a : b).add (Eigen::Vector3d (r[0], r[1], r[2]), c);
+    (i < kPointsOfA ? a : b).add (Eigen::Vector3d (r[0], r[1], r[2]), c);
   }
   ClassifierResult r;
   ASSERT_TRUE (RobustClassifier (ClassifierParams ()).classify (a.view (), b.view (), r));

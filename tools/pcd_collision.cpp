@@ -466,12 +466,11 @@ inputDiagonal (const Input& in)
   * not an error: a screw against a room is legitimate. Clouds under kScaleWarningMinPoints are not
   * judged (a mesh always is: its vertices span the whole object). */
 void
-warnIfScalesDiffer (const Input& a, const Input& b)
+warnIfScalesDiffer (const Input& a, double da, const Input& b, double db)
 {
   for (const Input* in : {&a, &b})
     if (in->kind == InputKind::Cloud && in->finite < kScaleWarningMinPoints)
       return;
-  const double da = inputDiagonal (a), db = inputDiagonal (b);
   if (!(da > 0.0 && db > 0.0 && std::isfinite (da) && std::isfinite (db)))
     return;
   const double ratio = std::max (da, db) / std::min (da, db);
@@ -486,13 +485,12 @@ warnIfScalesDiffer (const Input& a, const Input& b)
 /** \brief -sigma is in the data's units (docs/CLI.md). Warn on stderr when a cloud's isotropic
   * sigma is below kNoiseWarningRatio of its size: most likely the default, 0.005 (metres), on a
   * cloud in millimetres. The answer is then for a near noise-free cloud, and its classifier fits
-  * are the hardest there are. */
+  * are the hardest there are. diagonal is inputDiagonal (in). */
 void
-warnIfNoiseImplausible (const Input& in, const std::string& sensor, double sigma)
+warnIfNoiseImplausible (const Input& in, double diagonal, const std::string& sensor, double sigma)
 {
   if (in.kind != InputKind::Cloud || sensor != "isotropic" || in.finite < kScaleWarningMinPoints)
     return;
-  const double diagonal = inputDiagonal (in);
   if (sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal) && sigma < kNoiseWarningRatio * diagonal)
     std::fprintf (stderr,
                   "pcd_collision: warning: the noise sigma %.6g of '%s' is %.2g of its size (bounding-box "
@@ -611,9 +609,11 @@ run (int argc, char** argv)
   const bool with_normals = o.surface && !o.ignore_normals;
   loadInput (a, with_normals, log);
   loadInput (b, with_normals, log);
-  warnIfScalesDiffer (a, b);
-  warnIfNoiseImplausible (a, o.sensor_a, o.sigma_a);
-  warnIfNoiseImplausible (b, o.sensor_b, o.sigma_b);
+  // One pass over each input for both units warnings (5,000,000 points are 60 MB to read).
+  const double diagonal_a = inputDiagonal (a), diagonal_b = inputDiagonal (b);
+  warnIfScalesDiffer (a, diagonal_a, b, diagonal_b);
+  warnIfNoiseImplausible (a, diagonal_a, o.sensor_a, o.sigma_a);
+  warnIfNoiseImplausible (b, diagonal_b, o.sensor_b, o.sigma_b);
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at

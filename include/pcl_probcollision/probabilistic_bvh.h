@@ -212,9 +212,8 @@ public:
   static constexpr std::int32_t rootId () { return 0; }
 
   /** \brief The deepest level a node may have; a node there is a leaf (LeafReason::NoProgress).
-    * No cloud comes near it: a split that separates points must leave a child on each side of
-    * the parent's mean, which needs coordinates spread over many orders of magnitude to repeat
-    * more than a few hundred times. */
+    * It bounds the 16-bit Node::depth on pathological input only: balanced splits of the
+    * largest cloud accepted (2^28 points) take a few dozen levels. */
   static constexpr int maxDepth () { return 65535; }
 
   /** \brief The flat index array: leaves' point indices (into means()), leaves in depth-first

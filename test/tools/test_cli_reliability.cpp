@@ -316,13 +316,23 @@ TEST_F (CliReliability, DuplicatedPointsAndFarFromTheOrigin)
   }
 }
 
-TEST_F (CliReliability, MillimetresAgainstMetresWarnsOnStderr)
+namespace
+{
+/** \brief The table-and-mug scene in millimetres. */
+Cloud
+sceneInMillimetres ()
 {
   Cloud mm;
   pcl::io::loadPCDFile (kScene.string (), mm);
   for (auto& p : mm.points)
     p.getVector3fMap () *= 1000.0f;
-  const std::string scene_mm = save ("table_mug_mm.pcd", mm);
+  return mm;
+}
+} // namespace
+
+TEST_F (CliReliability, MillimetresAgainstMetresWarnsOnStderr)
+{
+  const std::string scene_mm = save ("table_mug_mm.pcd", sceneInMillimetres ());
   const Run warned = run ({kGripper.string (), scene_mm, "-pose", "0,0,250,0,0,0"});
   EXPECT_EQ (warned.status, 0) << warned.err;
   EXPECT_NE (warned.err.find ("pcd_collision: warning: the inputs' sizes differ by"), std::string::npos) << warned.err;
@@ -338,11 +348,7 @@ TEST_F (CliReliability, NoiseFarBelowTheDataWarnsOnStderr)
 {
   // Both inputs in millimetres (no size warning), the default sigma 0.005 (5 mm in metres, 5 um
   // here): warned once per cloud. -sigma 5, the millimetre equivalent, is not warned.
-  Cloud mm;
-  pcl::io::loadPCDFile (kScene.string (), mm);
-  for (auto& p : mm.points)
-    p.getVector3fMap () *= 1000.0f;
-  const std::string scene_mm = save ("table_mug_mm.pcd", mm);
+  const std::string scene_mm = save ("table_mug_mm.pcd", sceneInMillimetres ());
   const Run warned = run ({scene_mm, scene_mm, "-pose", "0,0,50,0,0,0"});
   EXPECT_EQ (warned.status, 0) << warned.err;
   EXPECT_EQ (warned.err.find ("sizes differ"), std::string::npos) << warned.err;
