@@ -436,7 +436,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     v = norm > 0.0f && std::isfinite (norm) ? Eigen::Vector3f (v / norm) : Eigen::Vector3f::Zero ();
   }
   spacing_.resize (n);
-  open_.assign (n, Eigen::Vector4f::Zero ());
+  std::vector<Eigen::Vector4f> open (n, Eigen::Vector4f::Zero ());
   const double scale = std::sqrt (kPi / in.k);
   const std::size_t k = static_cast<std::size_t> (in.k);
   const std::size_t workers = detail::threadCount (in.threads);
@@ -475,8 +475,10 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       s = std::min (s, std::sqrt (area / static_cast<double> (count)));
     }
     spacing_[i] = static_cast<float> (s);
-    open_[i] = openingOf (points, normals_[i], i, &in.neighbours[i * k], k, in.radii[i]);
+    open[i] = openingOf (points, normals_[i], i, &in.neighbours[i * k], k, in.radii[i]);
   });
+  packOpenings (open);
+  open = std::vector<Eigen::Vector4f> ();
   // The spacing's statistics (a sort of every point's) need nothing of what follows until the
   // end: on a thread of their own when the build has several.
   auto spacingStatistics = [this, n] {
@@ -638,15 +640,47 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
 
   // Dipoles: each point counts in the first leaf holding it (leaves overlap by epsilon).
   const auto& nodes = bvh.nodes ();
-  owner_.assign (n, -1);
-  for (std::size_t id = 0; id < nodes.size (); ++id)
-    if (nodes[id].isLeaf ())
-      for (const int i : bvh.indices (nodes[id]))
-        if (owner_[static_cast<std::size_t> (i)] < 0)
-          owner_[static_cast<std::size_t> (i)] = static_cast<std::int32_t> (id);
+  const std::size_t positions = bvh.pointIndices ().size ();
+  owned_.assign ((positions + 63) / 64, 0);
+  {
+    std::vector<std::uint8_t> counted (n, 0);
+    for (std::size_t id = 0; id < nodes.size (); ++id)
+      if (nodes[id].isLeaf ())
+        for (std::int32_t j = nodes[id].begin; j < nodes[id].end; ++j)
+        {
+          const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
+          if (!counted[i])
+          {
+            counted[i] = 1;
+            owned_[static_cast<std::size_t> (j) / 64] |= std::uint64_t {1} << (j % 64);
+          }
+        }
+  }
   dipoles_.assign (nodes.size (), Dipole ());
+  area_ = 0.0;
   if (nodes.empty ())
     return;
+  // Summed in double, stored in single precision (Dipole).
+  struct Sum
+  {
+    Eigen::Vector3d center = Eigen::Vector3d::Zero ();
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero ();
+    double area = 0.0;
+    double radius = 0.0;
+  };
+  std::vector<Sum> sums (nodes.size ());
+  // Stored in float: the centre moves by at most 2^-24 of each coordinate, so the radius (taken
+  // from the centre in double) grows by 2^-23 of the centre's and its own magnitude before it is
+  // rounded up, and still bounds the node's samples from the stored centre. (Not by measuring
+  // from the centre rounded to float and back: GCC 12 at -O2 folded that round trip away here.)
+  auto store = [&] (std::size_t id) {
+    const Sum& sum = sums[id];
+    Dipole& d = dipoles_[id];
+    d.center = sum.center.cast<float> ();
+    d.moment = sum.moment.cast<float> ();
+    const double moved = std::ldexp (sum.center.cwiseAbs ().sum () + sum.radius, -23);
+    d.radius = sum.area > 0.0 ? std::nextafter (static_cast<float> (sum.radius + moved), std::numeric_limits<float>::infinity ()) : -1.0f;
+  };
   // A leaf's dipole reads only its own points: the leaves on the workers, then the internal
   // nodes from their children, children first (a child's id is larger than its parent's).
   std::vector<std::int32_t> leaves;
@@ -656,22 +690,29 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   detail::parallelChunks (leaves.size (), 1024, workers, [&] (std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t l = begin; l < end; ++l)
     {
-      const std::int32_t id = leaves[l];
-      const auto& node = nodes[static_cast<std::size_t> (id)];
-      Dipole& d = dipoles_[static_cast<std::size_t> (id)];
-      for (const int i : bvh.indices (node))
-        if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
+      const std::size_t id = static_cast<std::size_t> (leaves[l]);
+      const auto& node = nodes[id];
+      Sum& d = sums[id];
+      for (std::int32_t j = node.begin; j < node.end; ++j)
+      {
+        const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
+        if (owns (static_cast<std::size_t> (j)) && !normals_[i].isZero ())
         {
-          const double a = static_cast<double> (spacing_[static_cast<std::size_t> (i)]) * spacing_[static_cast<std::size_t> (i)];
+          const double a = static_cast<double> (spacing_[i]) * spacing_[i];
           d.area += a;
-          d.center += a * points[static_cast<std::size_t> (i)];
-          d.moment += a * normals_[static_cast<std::size_t> (i)].cast<double> ();
+          d.center += a * points[i];
+          d.moment += a * normals_[i].cast<double> ();
         }
+      }
       if (d.area > 0.0)
         d.center /= d.area;
-      for (const int i : bvh.indices (node))
-        if (owner_[static_cast<std::size_t> (i)] == id && !normals_[static_cast<std::size_t> (i)].isZero ())
-          d.radius = std::max (d.radius, (points[static_cast<std::size_t> (i)] - d.center).norm ());
+      for (std::int32_t j = node.begin; j < node.end; ++j)
+      {
+        const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
+        if (owns (static_cast<std::size_t> (j)) && !normals_[i].isZero ())
+          d.radius = std::max (d.radius, (points[i] - d.center).norm ());
+      }
+      store (id);
     }
   });
   for (std::size_t id = nodes.size (); id-- > 0;)
@@ -679,10 +720,10 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     const auto& node = nodes[id];
     if (node.isLeaf ())
       continue;
-    Dipole& d = dipoles_[id];
+    Sum& d = sums[id];
     for (int c = 0; c < node.num_children; ++c)
     {
-      const Dipole& child = dipoles_[static_cast<std::size_t> (node.first_child + c)];
+      const Sum& child = sums[static_cast<std::size_t> (node.first_child + c)];
       d.area += child.area;
       d.center += child.area * child.center;
       d.moment += child.moment;
@@ -691,12 +732,34 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       d.center /= d.area;
     for (int c = 0; c < node.num_children; ++c)
     {
-      const Dipole& child = dipoles_[static_cast<std::size_t> (node.first_child + c)];
-      if (child.area > 0.0)
-        d.radius = std::max (d.radius, (child.center - d.center).norm () + child.radius);
+      const std::size_t child = static_cast<std::size_t> (node.first_child + c);
+      if (sums[child].area > 0.0)
+        d.radius = std::max (d.radius, (sums[child].center - d.center).norm () + sums[child].radius);
     }
+    store (id);
   }
+  area_ = sums[static_cast<std::size_t> (ProbabilisticBVH::rootId ())].area;
 }
+
+void
+SurfaceModel::packOpenings (const std::vector<Eigen::Vector4f>& open)
+{
+  open_words_.assign ((open.size () + 63) / 64, OpenWord ());
+  open_values_.clear ();
+  for (std::size_t i = 0; i < open.size (); ++i)
+  {
+    OpenWord& word = open_words_[i / 64];
+    if (i % 64 == 0)
+      word.rank = static_cast<std::uint32_t> (open_values_.size ());
+    if (open[i].isZero ())
+      continue;
+    word.bits |= std::uint64_t {1} << (i % 64);
+    open_values_.push_back (open[i]);
+  }
+  open_values_.shrink_to_fit ();
+}
+
+static_assert (sizeof (SurfaceModel::Dipole) == 28, "a dipole is 28 bytes");
 
 double
 SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d& q) const
@@ -704,6 +767,7 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
   if (dipoles_.empty ())
     return 0.0;
   const std::vector<Eigen::Vector3d>& points = bvh.means ();
+  const int* indices = bvh.pointIndices ().data ();
   // A node farther than this many radii is one dipole (Barill et al. use beta = 2).
   constexpr double kBeta = 2.0;
   double w = 0.0;
@@ -714,13 +778,13 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
     const std::int32_t id = stack.back ();
     stack.pop_back ();
     const Dipole& d = dipoles_[static_cast<std::size_t> (id)];
-    if (d.area <= 0.0)
+    if (d.empty ())
       continue;
-    const Eigen::Vector3d v = d.center - q;
+    const Eigen::Vector3d v = d.center.cast<double> () - q;
     const double dist = v.norm ();
     if (dist > kBeta * d.radius && dist > 0.0)
     {
-      w += d.moment.dot (v) / (dist * dist * dist);
+      w += d.moment.cast<double> ().dot (v) / (dist * dist * dist);
       continue;
     }
     const auto& node = bvh.node (id);
@@ -730,10 +794,12 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
         stack.push_back (node.first_child + c);
       continue;
     }
-    for (const int i : bvh.indices (node))
+    for (std::size_t j = static_cast<std::size_t> (node.begin); j < static_cast<std::size_t> (node.end); ++j)
     {
-      const std::size_t s = static_cast<std::size_t> (i);
-      if (owner_[s] != id || normals_[s].isZero ())
+      if (!owns (j))
+        continue;
+      const std::size_t s = static_cast<std::size_t> (indices[j]);
+      if (normals_[s].isZero ())
         continue;
       const Eigen::Vector3d u = points[s] - q;
       // Each sample is a disc of radius ~ s_i / 2: regularised so that a query on a sample
@@ -750,7 +816,7 @@ std::size_t
 SurfaceModel::bytes () const
 {
   return normals_.capacity () * sizeof (Eigen::Vector3f) + spacing_.capacity () * sizeof (float) +
-         open_.capacity () * sizeof (Eigen::Vector4f) +
-         owner_.capacity () * sizeof (std::int32_t) + dipoles_.capacity () * sizeof (Dipole);
+         open_words_.capacity () * sizeof (OpenWord) + open_values_.capacity () * sizeof (Eigen::Vector4f) +
+         owned_.capacity () * sizeof (std::uint64_t) + dipoles_.capacity () * sizeof (Dipole);
 }
 } // namespace pcl_probcollision

@@ -788,7 +788,7 @@ closedSurface (const SurfaceModel& s)
   if (s.dipoles ().empty ())
     return false;
   const SurfaceModel::Dipole& root = s.dipoles ()[static_cast<std::size_t> (ProbabilisticBVH::rootId ())];
-  return root.area > 0.0 && root.moment.norm () < kClosedFlux * root.area;
+  return s.area () > 0.0 && root.moment.cast<double> ().norm () < kClosedFlux * s.area ();
 }
 
 /** \brief The points of `query` (mapped by T_q into A's frame) against `surface` (mapped by
@@ -820,7 +820,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       return;
     scratch.cached[sj] = cache_stamp;
     const Eigen::Vector3d n = s_model.normals ()[sj].cast<double> ();
-    const Eigen::Vector4f& open = s_model.openings ()[sj];
+    const Eigen::Vector4f open = s_model.opening (sj);
     scratch.cache[sj] = {T_s * s_bvh.means ()[sj], R_s * n, s_model.spacing ()[sj],
                          std::max (0.0, s_bvh.covariances ()[sj].quadratic (n)),
                          std::max<double> (s_model.spacing ()[sj], s_model.surfaceSpacing ()),

@@ -128,6 +128,53 @@ TEST (SurfaceModel, PropagationOrientsAClosedSurfaceOutward)
   EXPECT_NEAR (s.medianSpacing (), std::sqrt (4.0 * M_PI * 0.01 / 800), 0.004);
 }
 
+// The dipoles are summed in double and stored in float: each oriented sample counts once
+// (area() is the sum of their areas although leaves overlap), the root's moment is their summed
+// area-weighted normal, and every node's rounded radius still bounds, from its rounded centre,
+// the samples it can hold (the root all of them; a leaf's within it when no other leaf holds
+// them). The wider far-field test is then exact on where a node's samples are.
+TEST (SurfaceModel, SinglePrecisionDipolesBoundTheirSamples)
+{
+  const auto model = buildCloudModel (xyz (sphere (2000, 0.1, Eigen::Vector3d (1, 2, 3))), withSurface ());
+  const SurfaceModel& s = model->surface ();
+  const ProbabilisticBVH& bvh = model->hierarchy ();
+  const auto& points = bvh.means ();
+  double area = 0.0;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero ();
+  for (std::size_t i = 0; i < points.size (); ++i)
+  {
+    const double a = static_cast<double> (s.spacing ()[i]) * s.spacing ()[i];
+    area += s.normals ()[i].isZero () ? 0.0 : a;
+    moment += a * s.normals ()[i].cast<double> ();
+  }
+  ASSERT_GT (area, 0.0);
+  EXPECT_NEAR (s.area (), area, 1e-12 * area);
+  const SurfaceModel::Dipole& root = s.dipoles ()[static_cast<std::size_t> (ProbabilisticBVH::rootId ())];
+  EXPECT_LT ((root.moment.cast<double> () - moment).norm (), 1e-6 * area);
+  // Points held by one leaf only.
+  std::vector<int> holders (points.size (), 0);
+  for (const auto& node : bvh.nodes ())
+    if (node.isLeaf ())
+      for (const int i : bvh.indices (node))
+        ++holders[static_cast<std::size_t> (i)];
+  std::size_t checked = 0;
+  for (std::size_t id = 0; id < bvh.nodes ().size (); ++id)
+  {
+    const auto& node = bvh.nodes ()[id];
+    const SurfaceModel::Dipole& d = s.dipoles ()[id];
+    for (const int i : bvh.indices (node))
+    {
+      const std::size_t p = static_cast<std::size_t> (i);
+      if (s.normals ()[p].isZero () || (static_cast<std::int32_t> (id) != ProbabilisticBVH::rootId () && holders[p] != 1))
+        continue;
+      ASSERT_FALSE (d.empty ()) << "node " << id;
+      EXPECT_LE ((points[p] - d.center.cast<double> ()).norm (), static_cast<double> (d.radius)) << "node " << id;
+      ++checked;
+    }
+  }
+  EXPECT_GT (checked, points.size ());
+}
+
 TEST (SurfaceModel, GivenNormalsAreKeptEvenInsideOut)
 {
   const auto model = buildCloudModel (sphere (400, 0.1, Eigen::Vector3d::Zero (), true), withSurface ());
@@ -362,8 +409,9 @@ TEST (SurfaceLayer, BesideAnEdgeTheSurfaceMayEnd)
   const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (sigma));
   // The table's samples on its rim are open toward the outside, inner ones are not.
   std::size_t open = 0;
-  for (const Eigen::Vector4f& o : table->surface ().openings ())
-    open += o.head<3> ().isZero () ? 0u : 1u;
+  for (std::size_t i = 0; i < table->hierarchy ().size (); ++i)
+    open += table->surface ().opening (i).head<3> ().isZero () ? 0u : 1u;
+  EXPECT_EQ (open, table->surface ().openPoints ());
   EXPECT_GE (open, 4u * 40u - 4u);
   EXPECT_LE (open, 4u * 40u + 4u);
   pcl::PointCloud<pcl::PointXYZ> probe;
@@ -394,7 +442,7 @@ TEST (SurfaceModel, ARowOfVerticesIsNoEdge)
     if (std::abs (p.y () - 0.001) > 1e-4 || std::abs (p.x ()) > 0.08)
       continue;
     ++row;
-    open += model->surface ().openings ()[i].head<3> ().isZero () ? 0u : 1u;
+    open += model->surface ().opening (i).head<3> ().isZero () ? 0u : 1u;
   }
   EXPECT_GE (row, 70u);
   EXPECT_EQ (open, 0u);
