@@ -188,7 +188,7 @@ splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<
 }
 
 // The node layout its documentation promises (ProbabilisticBVH::Node).
-static_assert (sizeof (ProbabilisticBVH::Node) == 136, "a hierarchy node is 136 bytes");
+static_assert (sizeof (ProbabilisticBVH::Node) == 128, "a hierarchy node is 128 bytes");
 
 // Per-node geometry: everything computed from the node's own points.
 struct NodeGeometry
@@ -511,7 +511,11 @@ makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& t
   computeGeometry (points, pts, params.k_sigma, g);
   node.box.setAxes (g.axes);
   node.box.center = g.mean + g.axes * (0.5 * (g.lo + g.hi));
-  node.box.half_extents = 0.5 * (g.hi - g.lo);
+  node.box.setHalfExtents (0.5 * (g.hi - g.lo));
+  // The leakage is the stored box's, whose extents are rounded up to float.
+  const Eigen::Vector3d mid = 0.5 * (g.lo + g.hi);
+  g.lo = mid - node.box.halfExtents ();
+  g.hi = mid + node.box.halfExtents ();
   for (int k = 0; k < 3; ++k)
     node.max_sigma (k) = static_cast<float> (g.s_max (k));
   node.leakage = static_cast<float> (nodeLeakage (points, pts, g, params.leakage_bound));
@@ -825,6 +829,12 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
   means_ = std::move (copy.means);
   covariances_ = std::move (covariances);
   source_indices_ = std::move (copy.source_indices);
+  // Every point kept, in order (a cloud without NaNs): sourceIndex() is i, 4 bytes a point less.
+  bool identity = true;
+  for (std::size_t i = 0; i < source_indices_.size () && identity; ++i)
+    identity = source_indices_[i] == static_cast<int> (i);
+  if (identity)
+    source_indices_ = std::vector<int> ();
   params_ = params;
   nodes_ = std::move (tree.nodes);
   indices_ = std::move (tree.indices);

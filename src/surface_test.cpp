@@ -840,7 +840,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const ProbabilisticBVH::Node& node = s_bvh.node (scratch.stack.back ());
       scratch.stack.pop_back ();
       const OrientedBox& b = node.box;
-      if ((b.boxCoordinates (x_s).cwiseAbs () - b.half_extents).cwiseMax (0.0).norm () > reach)
+      if ((b.boxCoordinates (x_s).cwiseAbs () - b.halfExtents ()).cwiseMax (0.0).norm () > reach)
         continue;
       if (!node.isLeaf ())
       {
@@ -1062,7 +1062,7 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
     const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (first)];
     // Outside the surface's bounding box a point is outside it (behind an open sheet's box
     // edge the winding number is below 1/2 too): no winding number needed.
-    if ((bound.boxCoordinates (x).cwiseAbs () - bound.half_extents).maxCoeff () > 0.0 ||
+    if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0 ||
         surface.surface ().windingNumber (s_bvh, x) <= kInsideWinding)
       continue;
     // In decision mode the first inside node decides; otherwise the deepest one sets the depth.

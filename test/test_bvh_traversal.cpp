@@ -321,8 +321,13 @@ TEST (BVHTraversal, ExpectedWeightWeightsAreProductsOfQ)
   };
   TraversalParams tp;
   const TraversalResult r = detail::traverseHierarchies (a, b, Eigen::Isometry3d::Identity (), tp, leaf);
-  // Each node's leakage is 2 Phi(-1), kept in single precision.
-  const double leak = static_cast<float> (2.0 * Phi (-1.0));
+  // Each node's leakage is 2 Phi(-h / s), about 2 Phi(-1): the box's half extent h is the
+  // point's standard deviation s rounded up to a float (OrientedBox::setHalfExtents); kept in
+  // single precision.
+  const double h = a.node (0).box.half_extents (0);
+  const double s = std::sqrt (a.covariances ()[0].matrix () (0, 0));
+  const double leak = static_cast<float> (2.0 * Phi (-h / s));
+  EXPECT_NEAR (h / s, 1.0, 1e-6);
   EXPECT_NEAR (q, 1.0 - (1.0 - leak) * (1.0 - leak), 1e-12);
   EXPECT_DOUBLE_EQ (seen, q);
   EXPECT_DOUBLE_EQ (r.probability, 0.8 * q);

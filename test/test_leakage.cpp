@@ -25,21 +25,23 @@ using pcl_probcollision_test::randomPose;
 
 TEST (Leakage, PointOracles)
 {
-  // Box [-0.05, 0.05]^3, isotropic sigma = 0.01 (METHOD.md 11.7).
+  // Box [-0.05, 0.05]^3, isotropic sigma = 0.01 (METHOD.md 11.7). The box keeps its half
+  // extents in float: h = 0.05f, and the exact forms below use h.
   OrientedBox box;
-  box.half_extents = Eigen::Vector3d::Constant (0.05);
+  box.half_extents = Eigen::Vector3f::Constant (0.05f);
+  const double h = box.half_extents (0);
   const Eigen::Matrix3d cov = Eigen::Matrix3d::Identity () * 1e-4;
   // Centre: 2 Phi(-5) = 5.733e-7 (exact form; relative accuracy).
   const double centre = detail::pointOutsideProbability (box, Eigen::Vector3d::Zero (), cov);
-  EXPECT_NEAR (centre, 2.0 * Phi (-5.0), 1e-15);
+  EXPECT_NEAR (centre, 2.0 * Phi (-h / 0.01), 1e-15);
   EXPECT_NEAR (centre, 5.733e-7, 1e-10);
   // 0.01 inside a face: Phi(-1) + Phi(-9) = 0.158655.
   EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (0, 0, 0.04), cov), 0.158655, 1e-6);
   // On a face: 0.5 + Phi(-10) ~ 0.5.
-  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (0.05, 0, 0), cov), 0.5, 1e-12);
+  EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d (h, 0, 0), cov), 0.5, 1e-12);
   // Union bound at the centre: 3 * 2 Phi(-5).
   EXPECT_NEAR (detail::pointOutsideProbability (box, Eigen::Vector3d::Zero (), cov, detail::LeakageBound::UnionBound),
-               6.0 * Phi (-5.0), 1e-15);
+               6.0 * Phi (-h / 0.01), 1e-15);
   // Rotating box and point together changes nothing.
   std::mt19937_64 rng (3);
   Eigen::Isometry3d T = randomPose (rng, 2.0);
@@ -91,13 +93,18 @@ TEST (Leakage, SinglePointNodeOracle)
   ASSERT_EQ (bvh.nodes ().size (), 1u);
   // The node keeps its leakage in single precision (ProbabilisticBVH::Node).
   EXPECT_FLOAT_EQ (bvh.node (0).leakage, static_cast<float> (2.0 * Phi (-1.0)));
-  EXPECT_NEAR (bvh.node (0).box.half_extents.maxCoeff (), sigma, 1e-12);
-  EXPECT_NEAR (bvh.node (0).box.half_extents.minCoeff (), sigma, 1e-12);
-  // k_sigma = 3: 2 Phi(-3).
+  // (The extents one float step above sigma: stored rounded up, OrientedBox::setHalfExtents.)
+  EXPECT_NEAR (bvh.node (0).box.half_extents.maxCoeff (), sigma, std::ldexp (sigma, -22));
+  EXPECT_NEAR (bvh.node (0).box.half_extents.minCoeff (), sigma, std::ldexp (sigma, -22));
+  EXPECT_GE (bvh.node (0).box.half_extents.minCoeff (), sigma);
+  // k_sigma = 3: 2 Phi(-h / sigma), h = 3 sigma rounded up to the next float: 2 Phi(-3) to
+  // within 2e-6 of its value.
   BVHParams p;
   p.k_sigma = 3.0;
   bvh.build (c, p);
-  EXPECT_FLOAT_EQ (bvh.node (0).leakage, static_cast<float> (2.0 * Phi (-3.0)));
+  const double h = bvh.node (0).box.half_extents (0);
+  EXPECT_FLOAT_EQ (bvh.node (0).leakage, static_cast<float> (2.0 * Phi (-h / sigma)));
+  EXPECT_NEAR (bvh.node (0).leakage, 2.0 * Phi (-3.0), 2e-6 * 2.0 * Phi (-3.0));
 }
 
 TEST (Leakage, AreaWeightsWeightTheMean)

@@ -397,9 +397,11 @@ TEST_P (BVHInvariants, Hold)
   EXPECT_EQ (bvh.depth (), max_depth + 1);
   EXPECT_EQ (nodes[0].begin, 0);
   EXPECT_EQ (static_cast<std::size_t> (nodes[0].end), stored);
-  // Means, packed covariances (48 bytes) and source indices; the area weights are not kept.
-  const std::size_t floor_bytes = n * (sizeof (Eigen::Vector3d) + sizeof (PackedCovariance) + sizeof (int)) +
-                                  nodes.size () * sizeof (Node) + stored * sizeof (int);
+  // Means, packed covariances (48 bytes) and source indices unless they are 0 .. n - 1; the
+  // area weights are not kept.
+  const std::size_t floor_bytes = n * (sizeof (Eigen::Vector3d) + sizeof (PackedCovariance)) +
+                                  bvh.sourceIndices ().size () * sizeof (int) + nodes.size () * sizeof (Node) +
+                                  stored * sizeof (int);
   EXPECT_GE (bvh.bytes (), floor_bytes);
   EXPECT_LE (bvh.bytes (), floor_bytes + sizeof (ProbabilisticBVH));
 
@@ -611,6 +613,24 @@ TEST (ProbabilisticBVH, EmptyCloudGivesEmptyHierarchy)
   EXPECT_EQ (bvh.size (), 0u);
 }
 
+// Source indices 0, 1, ..., n - 1 are not stored (sourceIndex(i) is i); any others are.
+TEST (ProbabilisticBVH, KeepsOnlySourceIndicesThatAreNotTheIdentity)
+{
+  UncertainCloud c = shapeCloud (Shape::Box, 10, 2);
+  c.source_indices.clear ();
+  for (std::size_t i = 0; i < c.means.size (); ++i)
+    c.source_indices.push_back (static_cast<int> (i));
+  ProbabilisticBVH identity (c);
+  EXPECT_TRUE (identity.sourceIndices ().empty ());
+  EXPECT_EQ (identity.sourceIndex (7), 7);
+  c.source_indices[7] = 1000;
+  ProbabilisticBVH other (c);
+  ASSERT_EQ (other.sourceIndices ().size (), c.means.size ());
+  EXPECT_EQ (other.sourceIndex (7), 1000);
+  EXPECT_EQ (other.sourceIndex (6), 6);
+  EXPECT_LT (identity.bytes (), other.bytes ());
+}
+
 TEST (ProbabilisticBVH, SinglePointIsOneLeaf)
 {
   UncertainCloud c;
@@ -624,7 +644,7 @@ TEST (ProbabilisticBVH, SinglePointIsOneLeaf)
   EXPECT_EQ (r.num_points, 1);
   EXPECT_EQ (r.variation, 0.0f);
   EXPECT_EQ (r.leakage, 0.0) << "an exact point inside its box";
-  EXPECT_EQ (r.box.half_extents, Eigen::Vector3d::Zero ());
+  EXPECT_EQ (r.box.half_extents, Eigen::Vector3f::Zero ());
   EXPECT_LE ((r.box.center - c.means[0]).norm (), 1e-15);
   EXPECT_EQ (bvh.depth (), 1);
 }

@@ -109,9 +109,10 @@ public:
     NoiseStop   ///< a split was wanted but the node is within the noise (BVHParams::noise_stop)
   };
 
-  /** \brief One node. Children of a node are stored contiguously. A node is 136 bytes (the
+  /** \brief One node. Children of a node are stored contiguously. A node is 128 bytes (the
     * nodes are most of a large cloud's model, 0.6 a point at 1,000,000 points), so the box keeps
-    * two of its axes, the leakage is single precision and the depth 16 bits. */
+    * two of its axes and its half extents in single precision (rounded up), the leakage is
+    * single precision and the depth 16 bits. */
   struct Node
   {
     /** \brief Inflated oriented box in the cloud's frame (metres). */
@@ -248,7 +249,7 @@ public:
     * float already). Area weights are not kept: they only weight the leakage at build time. */
   const std::vector<PackedCovariance>& covariances () const { return covariances_; }
   /** \brief The source index of every point (the built cloud's source_indices), or empty when
-    * the built cloud had none. */
+    * the built cloud had none or they were 0, 1, ..., n - 1 (every point kept, in order). */
   const std::vector<int>& sourceIndices () const { return source_indices_; }
   /** \brief The caller's index of point i: sourceIndices()[i], or i when there are none. */
   int sourceIndex (int i) const { return source_indices_.empty () ? i : source_indices_[static_cast<std::size_t> (i)]; }
@@ -282,7 +283,7 @@ public:
 private:
   bool buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers);
 
-  // The points, in the cloud's own frame: 52 bytes a point.
+  // The points, in the cloud's own frame: 48 bytes a point, 52 with source indices.
   std::vector<Eigen::Vector3d> means_;
   std::vector<PackedCovariance> covariances_;
   std::vector<int> source_indices_;

@@ -78,7 +78,8 @@ pointOutsideProbability (const OrientedBox& box, const Eigen::Vector3d& mean,
   {
     const Eigen::Vector3d a = axes.col (k);
     const double s = std::sqrt (std::max (0.0, a.dot (covariance * a)));
-    out[k] = slabOutsideProbability (-box.half_extents (k), box.half_extents (k), a.dot (d), s);
+    const double h = static_cast<double> (box.half_extents (k));
+    out[k] = slabOutsideProbability (-h, h, a.dot (d), s);
   }
   return combineSlabs (out[0], out[1], out[2], bound);
 }

@@ -22,7 +22,9 @@ namespace detail
   *
   * Only the first two axes are stored; the third is their cross product, so the frame is
   * right-handed by construction and a hierarchy node is 24 bytes smaller (issue #17's memory
-  * target). Everything that reads the frame, the box's own fit included, reads axes().
+  * target). Everything that reads the frame, the box's own fit included, reads axes(). The half
+  * extents are stored in single precision, rounded up (setHalfExtents()): the box never shrinks
+  * below what was fitted, and a node is 8 bytes smaller again.
   */
 struct OrientedBox
 {
@@ -30,8 +32,23 @@ struct OrientedBox
   Eigen::Vector3d center = Eigen::Vector3d::Zero ();
   /** \brief The first two unit axes as columns (set through setAxes()). */
   Eigen::Matrix<double, 3, 2, Eigen::DontAlign> first_axes = Eigen::Matrix<double, 3, 2>::Identity ();
-  /** \brief Half extents along the columns of axes() (metres, >= 0). */
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero ();
+  /** \brief Half extents along the columns of axes() (metres, >= 0), in single precision (set
+    * through setHalfExtents(), read through halfExtents()). */
+  Eigen::Vector3f half_extents = Eigen::Vector3f::Zero ();
+
+  /** \brief The half extents in double precision. */
+  Eigen::Vector3d halfExtents () const { return half_extents.cast<double> (); }
+
+  /** \brief Sets the half extents from h (>= 0), each rounded up to a float: the stored box
+    * contains the box h describes. Zero stays zero. (One float step up from the nearest float,
+    * not a comparison with h: that can only overshoot, by at most 2^-23 of h.) */
+  void
+  setHalfExtents (const Eigen::Vector3d& h)
+  {
+    for (int k = 0; k < 3; ++k)
+      half_extents (k) = h (k) > 0.0 ? std::nextafter (static_cast<float> (h (k)), std::numeric_limits<float>::infinity ())
+                                     : static_cast<float> (h (k));
+  }
 
   /** \brief The unit axes as columns, a rotation (det +1) mapping box coordinates to the frame:
     * first_axes, then their cross product. */
@@ -58,7 +75,7 @@ struct OrientedBox
     OrientedBox out;
     out.center = T_dst_src * center;
     out.first_axes = T_dst_src.linear () * first_axes;
-    out.half_extents = half_extents;
+    out.half_extents = half_extents;  // the same floats: the box is only moved
     return out;
   }
 
@@ -77,7 +94,7 @@ struct OrientedBox
   {
     const Eigen::Vector3d local = boxCoordinates (p);
     for (int k = 0; k < 3; ++k)
-      if (std::abs (local (k)) > half_extents (k) + tolerance)
+      if (std::abs (local (k)) > static_cast<double> (half_extents (k)) + tolerance)
         return false;
     return true;
   }
@@ -86,7 +103,8 @@ struct OrientedBox
   double
   volume () const
   {
-    return 8.0 * half_extents (0) * half_extents (1) * half_extents (2);
+    const Eigen::Vector3d h = halfExtents ();
+    return 8.0 * h (0) * h (1) * h (2);
   }
 
   /** \brief Squared half diagonal (square metres): the size measure used to pick which node
@@ -94,7 +112,7 @@ struct OrientedBox
   double
   halfDiagonalSquared () const
   {
-    return half_extents.squaredNorm ();
+    return halfExtents ().squaredNorm ();
   }
 
   /** \brief The eight corners as columns (metres), corner c has sign (-1)^bit k on axis k. */
@@ -106,7 +124,7 @@ struct OrientedBox
     for (int i = 0; i < 8; ++i)
     {
       Eigen::Vector3d s ((i & 1) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 4) ? 1.0 : -1.0);
-      c.col (i) = center + a * s.cwiseProduct (half_extents);
+      c.col (i) = center + a * s.cwiseProduct (halfExtents ());
     }
     return c;
   }
@@ -195,9 +213,9 @@ disjointLocal (const Eigen::Vector3d& half_a, const Eigen::Matrix3d& R, const Ei
 /** \brief True when box a (in frame A) and box b (in frame B, mapped into A by T_a_b) are
   * disjoint, each grown by its own extra half extents first.
   * \param[in] a box in frame A
-  * \param[in] extra_a added to a.half_extents (metres, >= 0)
+  * \param[in] extra_a added to a.halfExtents() (metres, >= 0)
   * \param[in] b box in frame B
-  * \param[in] extra_b added to b.half_extents (metres, >= 0)
+  * \param[in] extra_b added to b.halfExtents() (metres, >= 0)
   * \param[in] T_a_b rigid transform mapping B-frame points into frame A */
 inline bool
 disjointInflated (const OrientedBox& a, const Eigen::Vector3d& extra_a, const OrientedBox& b,
@@ -214,7 +232,7 @@ disjointInflated (const OrientedBox& a, const Eigen::Vector3d& extra_a, const Or
   R.col (2) = R.col (0).cross (R.col (1));
   const Eigen::Vector3d d = T_a_b * b.center - a.center;
   const Eigen::Vector3d t (a.first_axes.col (0).dot (d), a.first_axes.col (1).dot (d), a2.dot (d));
-  return disjointLocal (a.half_extents + extra_a, R, t, b.half_extents + extra_b);
+  return disjointLocal (a.halfExtents () + extra_a, R, t, b.halfExtents () + extra_b);
 }
 
 /** \brief True when box a (frame A) and box b (frame B, mapped into A by T_a_b) are disjoint
@@ -265,7 +283,7 @@ fitOrientedBox (const Eigen::Matrix3d& axes, const Eigen::Vector3d* means,
     }
   }
   box.center = origin + A * (0.5 * (lo + hi));
-  box.half_extents = 0.5 * (hi - lo);
+  box.setHalfExtents (0.5 * (hi - lo));
   return box;
 }
 } // namespace detail
