@@ -181,13 +181,15 @@ measureBuild (benchmark::State& state, bool surface)
   params.surface = surface;
   double ms = 0.0;  // summed over the iterations
   double hierarchy_ms = 0.0;
-  std::size_t bytes = 0, stored = 0, nodes = 0;
+  std::size_t bytes = 0, hierarchy_bytes = 0, surface_bytes = 0, stored = 0, nodes = 0;
   for (auto _ : state)
   {
     const CloudModel::ConstPtr model = buildCloudModel (*room, params);
     ms += model->buildMilliseconds ();
     hierarchy_ms += model->hierarchy ().buildMilliseconds ();
     bytes = model->bytes ();
+    hierarchy_bytes = model->hierarchy ().bytes ();
+    surface_bytes = model->surface ().bytes ();
     stored = model->hierarchy ().storedPoints ();
     nodes = model->hierarchy ().nodes ().size ();
   }
@@ -201,6 +203,9 @@ measureBuild (benchmark::State& state, bool surface)
   state.counters["ms_per_10k_points"] = ms / n * 1e4;
   state.counters["hierarchy_ms"] = hierarchy_ms;
   state.counters["bytes_per_point"] = static_cast<double> (bytes) / n;
+  // Where they are: the hierarchy (points, covariances, nodes, indices) and the surface model.
+  state.counters["hierarchy_bytes_per_point"] = static_cast<double> (hierarchy_bytes) / n;
+  state.counters["surface_bytes_per_point"] = static_cast<double> (surface_bytes) / n;
   state.counters["stored_per_point"] = static_cast<double> (stored) / n;
   state.counters["nodes"] = static_cast<double> (nodes);
 }
