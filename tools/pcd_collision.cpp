@@ -404,9 +404,12 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
   char buf[512];
   const std::string prefix = pose_index >= 0 ? "pose " + std::to_string (pose_index) + ": " : std::string ();
   // The signed distance, when the surface layer computed one (NaN is never printed).
-  char distance[96] = "";
+  // A query that stopped early (lower_bound) reports the first point that decided the collision,
+  // not the deepest: say so, as "P >=" says it of P.
+  char distance[128] = "";
   if (std::isfinite (r.signed_distance))
-    std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f", r.signed_distance, r.signed_distance_std);
+    std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", r.signed_distance, r.signed_distance_std,
+                   r.lower_bound ? " (first deciding point)" : "");
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";

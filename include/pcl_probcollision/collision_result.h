@@ -40,7 +40,10 @@ struct CollisionResult
   /** \brief Signed distance between the two surfaces in data units (METHOD.md 10a, the
     * surface layer): > 0 the gap, < 0 minus the penetration depth. NaN when not computed: the
     * surface layer is off (CollisionRequest::surface) or the query never came within reach of
-    * both surfaces (no_leaf_tested without a far-field inside answer). */
+    * both surfaces (no_leaf_tested without a far-field inside answer). The distance at the
+    * query's most significant point (lowest d / std); when the query stopped early at a
+    * collision (lower_bound), at the first point that decided it: the deepest may lie elsewhere
+    * (CollisionRequest::exhaustive visits every pair). */
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
     * surfaces' own uncertainty and the discretisation between samples); NaN with it. */

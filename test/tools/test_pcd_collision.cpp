@@ -404,6 +404,41 @@ TEST_F (PcdCollisionTool, DemoPosesVerdicts)
   EXPECT_GE (v[2]["probability"].number, v[1]["probability"].number);
 }
 
+// With -surface the penetrating demo pose stops at the first point that decides the collision
+// (P >=): its distance is that point's, and the human line says so; -exhaustive visits every
+// pair and reports the most significant point, here the fingers' full 2 cm (a deeper distance
+// than the stopped query's), without the marker.
+TEST_F (PcdCollisionTool, AStoppedQueryNamesItsDistanceTheFirstDecidingPoint)
+{
+  const std::string marker = " (first deciding point)";
+  std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface"};
+  const auto stopped = runJson (args);
+  const ToolRun text = run (args);
+  ASSERT_EQ (text.status, 0) << text.err;
+  args.push_back ("-exhaustive");
+  const auto full = runJson (args);
+  const ToolRun full_text = run (args);
+  ASSERT_EQ (full_text.status, 0) << full_text.err;
+  const auto human = lines (text.out), full_human = lines (full_text.out);
+  ASSERT_EQ (stopped.size (), 3u);
+  ASSERT_EQ (full.size (), 3u);
+  ASSERT_EQ (human.size (), 3u) << text.out;
+  ASSERT_EQ (full_human.size (), 3u) << full_text.out;
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    SCOPED_TRACE ("pose " + std::to_string (i));
+    const bool marked = stopped[i]["lower_bound"].boolean && stopped[i]["signed_distance"].type == Value::Type::Number;
+    EXPECT_EQ (human[i].find (marker) != std::string::npos, marked) << human[i];
+    EXPECT_EQ (full_human[i].find (marker), std::string::npos) << full_human[i];
+    EXPECT_FALSE (full[i]["lower_bound"].boolean);
+  }
+  ASSERT_TRUE (stopped[2]["lower_bound"].boolean);
+  ASSERT_EQ (stopped[2]["signed_distance"].type, Value::Type::Number);
+  ASSERT_EQ (full[2]["signed_distance"].type, Value::Type::Number);
+  EXPECT_LT (full[2]["signed_distance"].number, stopped[2]["signed_distance"].number);
+  EXPECT_NEAR (full[2]["signed_distance"].number, -0.02, 3.0 * full[2]["signed_distance_std"].number + 0.002);
+}
+
 // -max_leaf_fits N caps the fits of a query (budget_exhausted, P a lower bound: P >= in the human
 // line with its marker); -noise_resolution C merges samples (fewer model points); -noise_stop C
 // keeps nodes within C noise sigmas whole (fewer, larger leaves: fewer box tests). All are in the
