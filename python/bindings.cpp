@@ -880,7 +880,9 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("signed_distance", &CollisionResult::signed_distance,
                      "Signed distance between the two surfaces in data units (the surface layer, METHOD.md 10a):\n"
                      "> 0 the gap, < 0 minus the penetration depth. NaN when not computed: request.surface off, a\n"
-                     "model built without CloudModelParams.surface, or the surfaces never came within reach.")
+                     "model built without CloudModelParams.surface, or the surfaces never came within reach.\n"
+                     "When the query stopped early at a collision (lower_bound), the distance at the first point\n"
+                     "that decided it, not the deepest (request.exhaustive visits every pair).")
       .def_readonly ("signed_distance_std", &CollisionResult::signed_distance_std,
                      "Standard deviation of signed_distance (both clouds' noise, the fitted surfaces' uncertainty,\n"
                      "the discretisation between samples); NaN with it.")
