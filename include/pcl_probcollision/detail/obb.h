@@ -40,8 +40,9 @@ struct OrientedBox
   Eigen::Vector3d halfExtents () const { return half_extents.cast<double> (); }
 
   /** \brief Sets the half extents from h (>= 0), each rounded up to a float: the stored box
-    * contains the box h describes. Zero stays zero. (One float step up from the nearest float,
-    * not a comparison with h: that can only overshoot, by at most 2^-23 of h.) */
+    * contains the box h describes. Zero stays zero. (Always one float step above the nearest
+    * float, not only where the nearest lies below h: at most 2^-23 of h too large, and no
+    * float-to-double comparison for a compiler to fold.) */
   void
   setHalfExtents (const Eigen::Vector3d& h)
   {
