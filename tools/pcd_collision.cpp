@@ -711,9 +711,10 @@ run (int argc, char** argv)
     cloud_build_ms += pc.getTargetModel ()->buildMilliseconds ();
   for (const auto& [in, model] : {std::pair (&a, pc.getInputModel ()), std::pair (&b, pc.getTargetModel ())})
     if (model)
-      std::fprintf (log, "Building %s [done, %.1f ms : %zu points, %zu hierarchy nodes%s]\n", in->path.c_str (),
+      // The model's memory (CloudModel::bytes), for whoever sizes a large map.
+      std::fprintf (log, "Building %s [done, %.1f ms : %zu points, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
                     model->buildMilliseconds (), model->size (), model->hierarchy ().nodes ().size (),
-                    model->params ().surface ? ", surface model" : "");
+                    model->params ().surface ? ", surface model" : "", static_cast<double> (model->bytes ()) / 1e6);
   pc.setRequest (requestFor (o));
 
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));

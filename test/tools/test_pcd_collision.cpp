@@ -937,6 +937,16 @@ TEST_F (PcdCollisionTool, NormalRunsPrintOnlyStageLinesOnStderr)
     EXPECT_NE (built_a, std::string::npos) << r.err;
     EXPECT_NE (built_b, std::string::npos) << r.err;
     EXPECT_LT (built_a, built_b) << r.err;
+    // The scene's model memory ends its line: 10,848 points at 40-400 bytes a point.
+    if (built_b != std::string::npos)
+    {
+      const std::size_t end = r.err.find (" MB]", built_b), start = r.err.rfind (", ", end);
+      ASSERT_NE (end, std::string::npos) << r.err;
+      ASSERT_NE (start, std::string::npos) << r.err;
+      const double bytes = std::stod (r.err.substr (start + 2, end - start - 2)) * 1e6;
+      EXPECT_GT (bytes, 40.0 * 10848) << r.err;
+      EXPECT_LT (bytes, 400.0 * 10848) << r.err;
+    }
     for (std::string l : lines (r.err))
     {
       EXPECT_TRUE (l.rfind ("Loading ", 0) == 0 || l.rfind ("Sampling ", 0) == 0 || l.rfind ("Building ", 0) == 0) << l;
