@@ -640,22 +640,27 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
 
   // Dipoles: each point counts in the first leaf holding it (leaves overlap by epsilon).
   const auto& nodes = bvh.nodes ();
-  const std::size_t positions = bvh.pointIndices ().size ();
-  owned_.assign ((positions + 63) / 64, 0);
+  const int* indices = bvh.pointIndices ().data ();
+  // Positions [begin, end) of a node's range in pointIndices().
+  auto begin_of = [] (const ProbabilisticBVH::Node& node) { return static_cast<std::size_t> (node.begin); };
+  auto end_of = [] (const ProbabilisticBVH::Node& node) { return static_cast<std::size_t> (node.end); };
+  owned_.assign ((bvh.pointIndices ().size () + 63) / 64, 0);
   {
     std::vector<std::uint8_t> counted (n, 0);
-    for (std::size_t id = 0; id < nodes.size (); ++id)
-      if (nodes[id].isLeaf ())
-        for (std::int32_t j = nodes[id].begin; j < nodes[id].end; ++j)
-        {
-          const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
-          if (!counted[i])
+    for (const auto& node : nodes)
+      if (node.isLeaf ())
+        for (std::size_t j = begin_of (node); j < end_of (node); ++j)
+          if (!counted[static_cast<std::size_t> (indices[j])])
           {
-            counted[i] = 1;
-            owned_[static_cast<std::size_t> (j) / 64] |= std::uint64_t {1} << (j % 64);
+            counted[static_cast<std::size_t> (indices[j])] = 1;
+            owned_[j / 64] |= std::uint64_t {1} << (j % 64);
           }
-        }
   }
+  // The point at position j when the dipoles count it (its owner leaf, and oriented), else n.
+  auto countedPoint = [&] (std::size_t j) {
+    const std::size_t i = static_cast<std::size_t> (indices[j]);
+    return owns (j) && !normals_[i].isZero () ? i : n;
+  };
   dipoles_.assign (nodes.size (), Dipole ());
   area_ = 0.0;
   if (nodes.empty ())
@@ -672,7 +677,8 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // Stored in float: the centre moves by at most 2^-24 of each coordinate, so the radius (taken
   // from the centre in double) grows by 2^-23 of the centre's and its own magnitude before it is
   // rounded up, and still bounds the node's samples from the stored centre. (Not by measuring
-  // from the centre rounded to float and back: GCC 12 at -O2 folded that round trip away here.)
+  // from the centre rounded to float and back: GCC 12 at -O2 folded that round trip away in this
+  // function.)
   auto store = [&] (std::size_t id) {
     const Sum& sum = sums[id];
     Dipole& d = dipoles_[id];
@@ -693,25 +699,19 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       const std::size_t id = static_cast<std::size_t> (leaves[l]);
       const auto& node = nodes[id];
       Sum& d = sums[id];
-      for (std::int32_t j = node.begin; j < node.end; ++j)
-      {
-        const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
-        if (owns (static_cast<std::size_t> (j)) && !normals_[i].isZero ())
+      for (std::size_t j = begin_of (node); j < end_of (node); ++j)
+        if (const std::size_t i = countedPoint (j); i < n)
         {
           const double a = static_cast<double> (spacing_[i]) * spacing_[i];
           d.area += a;
           d.center += a * points[i];
           d.moment += a * normals_[i].cast<double> ();
         }
-      }
       if (d.area > 0.0)
         d.center /= d.area;
-      for (std::int32_t j = node.begin; j < node.end; ++j)
-      {
-        const std::size_t i = static_cast<std::size_t> (bvh.pointIndices ()[static_cast<std::size_t> (j)]);
-        if (owns (static_cast<std::size_t> (j)) && !normals_[i].isZero ())
+      for (std::size_t j = begin_of (node); j < end_of (node); ++j)
+        if (const std::size_t i = countedPoint (j); i < n)
           d.radius = std::max (d.radius, (points[i] - d.center).norm ());
-      }
       store (id);
     }
   });

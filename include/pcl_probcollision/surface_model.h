@@ -92,9 +92,9 @@ public:
   opening (std::size_t i) const
   {
     const OpenWord& word = open_words_[i / 64];
-    const std::uint64_t below = (std::uint64_t {1} << (i % 64)) - 1;
     if (!((word.bits >> (i % 64)) & 1u))
       return Eigen::Vector4f::Zero ();
+    const std::uint64_t below = (std::uint64_t {1} << (i % 64)) - 1;
     return open_values_[word.rank + static_cast<std::size_t> (popcount (word.bits & below))];
   }
   /** \brief Number of points with a non-zero opening(). */
