@@ -106,7 +106,12 @@ public:
       a->resize (d_);
     exact_ = n <= kExactPoints;
     if (exact_)
-      gram_.noalias () = phi_ * phi_.transpose ();
+    {
+      // the lower triangle by a symmetric rank-D update (half a product's work), then mirrored
+      gram_.setZero (n, n);
+      gram_.selfadjointView<Eigen::Lower> ().rankUpdate (phi_);
+      gram_.triangularView<Eigen::StrictlyUpper> () = gram_.transpose ();
+    }
     else
       buildPreconditionerBasis ();
     const Eigen::Index dim = d_ + 1;
