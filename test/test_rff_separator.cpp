@@ -79,6 +79,7 @@ struct Solved
 {
   Eigen::VectorXd theta;
   int standard_iterations = 0;
+  double standard_objective = 0.0;
   bool converged = false;
 };
 
@@ -95,6 +96,7 @@ solve (const SeparatorProblem& p, double gamma)
   s.theta = Eigen::VectorXd::Zero (kFeatures + 1);
   const detail::SolverReport standard = solver.solve (s.theta, 0.0, 10000, 1e-9);
   s.standard_iterations = standard.iterations;
+  s.standard_objective = standard.objective;
   const detail::SolverReport robust = solver.solve (s.theta, gamma, 10000, 1e-9);
   s.converged = standard.converged && robust.converged;
   return s;
@@ -130,4 +132,21 @@ TEST (RffSeparatorSolver, ExactAndSubspacePreconditionersReachTheSameMinimiser)
   std::cout << "[ C = 1000 ] Standard solve " << stiff.standard_iterations << " iterations (exact)\n";
   EXPECT_TRUE (stiff.converged);
   EXPECT_LE (stiff.standard_iterations, 10);
+}
+
+TEST (RffSeparatorSolver, AStiffNewtonSolveStopsAtRounding)
+{
+  // At C = 1e9 the tolerance on |grad J| is out of reach of rounding; full Newton steps that
+  // leave J equal were accepted until the iteration cap (10,000 here). The solve must stop
+  // near the optimum instead: this problem is separable, so J(C) rises to the hard-margin
+  // value as C grows, and J at 1e9 lies just above J at 1e6.
+  const double gamma = 0.0;  // the Standard solve only (the second one starts at its end)
+  const Solved soft = solve (wavySheet (40, 1, 1e6), gamma);
+  const Solved stiff = solve (wavySheet (40, 1, 1e9), gamma);
+  std::cout << "[ C = 1e6 / 1e9 ] Standard solve " << soft.standard_iterations << " / "
+            << stiff.standard_iterations << " iterations, J " << soft.standard_objective << " / "
+            << stiff.standard_objective << "\n";
+  EXPECT_LE (stiff.standard_iterations, 30);
+  EXPECT_GE (stiff.standard_objective, soft.standard_objective * (1.0 - 1e-9));
+  EXPECT_LE (stiff.standard_objective, soft.standard_objective * 1.001);
 }

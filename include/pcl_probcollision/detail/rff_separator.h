@@ -134,7 +134,8 @@ public:
     * the approximate Armijo condition of Hager and Zhang (2005) accepts a step that keeps J
     * within 1e-14 |J| and whose directional derivative has dropped below 0.8 |slope|.
     * Converged when |grad J| <= tolerance * max(1, |J|); it also stops after max_iterations,
-    * when no step is accepted, or when rounding has ended the descent (kShortestStep). */
+    * when no step is accepted, or when rounding has ended the descent (kShortestStep, or a
+    * Newton step that does not lower J). */
   SolverReport
   solve (Eigen::VectorXd& theta, double gamma, int max_iterations, double tolerance)
   {
@@ -194,7 +195,10 @@ public:
                     trial_gradient_.dot (direction_) <= -0.8 * slope);
         step = t;
       }
-      if (!accepted || step < kShortestStep || (step < kShortStep && !(trial_value < value)))
+      // A Newton step of a convex piecewise quadratic that does not lower J is at rounding
+      // (seen at C = 1e9: full steps accepted by the approximate Armijo condition, J equal,
+      // until the iteration cap).
+      if (!accepted || step < kShortestStep || ((newton || step < kShortStep) && !(trial_value < value)))
         break;
       // curvature pair; s^T y >= |s_w|^2 > 0 for this strictly convex J, but guard rounding
       s_mem_.col (next) = trial_ - theta;
