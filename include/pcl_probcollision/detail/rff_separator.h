@@ -312,6 +312,10 @@ private:
     coefficients_.resize (k + 1);
   }
 
+  /** \brief h_i = C_i l''(v_i) at the last evaluation (v_): point i's weight in the Standard
+    * Hessian, for both preconditioners. */
+  double curvatureWeight (Eigen::Index i) const { return p_.weight (i) * loss_.second (v_ (i)); }
+
   /** \brief The subspace block of M from the curvature weights h_i = C_i l''(v_i) at the
     * current iterate (v_ holds the last evaluation, which is the accepted point). Rebuilt at
     * the start of a solve, then updated by rank one for the points whose h_i changed (with
@@ -329,7 +333,7 @@ private:
     {
       refresh_curvature_ = false;
       for (Eigen::Index i = 0; i < p_.n; ++i)
-        curvature_ (i) = p_.weight (i) * loss_.second (v_ (i));
+        curvature_ (i) = curvatureWeight (i);
       weighted_projected_ = projected_.array ().colwise () * curvature_;
       small_.setZero ();
       small_.topLeftCorner (m, m).noalias () = projected_.transpose ().lazyProduct (weighted_projected_);
@@ -341,7 +345,7 @@ private:
     {
       for (Eigen::Index i = 0; i < p_.n; ++i)
       {
-        const double h = p_.weight (i) * loss_.second (v_ (i));
+        const double h = curvatureWeight (i);
         const double delta = h - curvature_ (i);
         if (delta == 0.0)
           continue;
@@ -373,7 +377,7 @@ private:
     refresh_curvature_ = false;
     for (Eigen::Index i = 0; i < p_.n; ++i)
     {
-      const double h = p_.weight (i) * loss_.second (v_ (i));
+      const double h = curvatureWeight (i);
       changed = changed || h != curvature_ (i);
       curvature_ (i) = h;
     }
