@@ -800,11 +800,13 @@ PYBIND11_MODULE (_core, m)
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
       "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental);\n"
       "surface_calibrated: with surface, P in [0.1, 0.9] through the calibration map fitted on the evaluation's\n"
-      "procedural scenes (default False: the model's raw P).")
+      "procedural scenes (default False: the model's raw P);\n"
+      "distance: beyond the query's reach, signed_distance is the distance between the nearest samples\n"
+      "(CollisionResult.sample_distance, nearest_point_a/_b), as FCL's distance request.")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
-                          bool surface_pooled, bool surface_calibrated) {
+                          bool surface_pooled, bool surface_calibrated, bool distance) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -820,6 +822,7 @@ PYBIND11_MODULE (_core, m)
               r.surface = surface;
               r.surface_pooled = surface_pooled;
               r.surface_calibrated = surface_calibrated;
+              r.distance = distance;
               return r;
             }),
             py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
@@ -828,7 +831,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
             py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
-            py::arg ("surface_calibrated") = dr.surface_calibrated,
+            py::arg ("surface_calibrated") = dr.surface_calibrated, py::arg ("distance") = dr.distance,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -849,6 +852,9 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("surface_calibrated", &CollisionRequest::surface_calibrated,
                       "With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's "
                       "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.")
+      .def_readwrite ("distance", &CollisionRequest::distance,
+                      "Beyond the query's reach (no_leaf_tested), signed_distance is the nearest samples' distance,\n"
+                      "its std their covariances' along the line between them (result.sample_distance). Default False.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {
@@ -861,7 +867,8 @@ PYBIND11_MODULE (_core, m)
                ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
                ", surface=" + (r.surface ? "True" : "False") +
                ", surface_pooled=" + (r.surface_pooled ? "True" : "False") +
-               ", surface_calibrated=" + (r.surface_calibrated ? "True" : "False") + ")";
+               ", surface_calibrated=" + (r.surface_calibrated ? "True" : "False") +
+               ", distance=" + (r.distance ? "True" : "False") + ")";
       });
 
   // --- CollisionResult ----------------------------------------------------------------------------
@@ -886,6 +893,11 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("signed_distance_std", &CollisionResult::signed_distance_std,
                      "Standard deviation of signed_distance (both clouds' noise, the fitted surfaces' uncertainty,\n"
                      "the discretisation between samples); NaN with it.")
+      .def_readonly ("sample_distance", &CollisionResult::sample_distance,
+                     "True when signed_distance is the distance between the two clouds' nearest samples\n"
+                     "(request.distance, the objects beyond the query's reach); nearest_point_a/_b are then those samples.")
+      .def_property_readonly ("nearest_point_a", [] (const CollisionResult& r) { return vec3 (r.nearest_point_a); })
+      .def_property_readonly ("nearest_point_b", [] (const CollisionResult& r) { return vec3 (r.nearest_point_b); })
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
       .def_readonly ("budget_exhausted", &CollisionResult::budget_exhausted,
                      "True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound.")
@@ -920,6 +932,8 @@ PYBIND11_MODULE (_core, m)
           s += ", signed_distance=" + num (r.signed_distance);
         if (!std::isnan (r.signed_distance_std))
           s += ", signed_distance_std=" + num (r.signed_distance_std);
+        if (r.sample_distance)  // shown only when set
+          s += ", sample_distance=True";
         if (r.unobserved)  // shown only when set, like the signed distance only when computed
           s += ", unobserved=True";
         if (r.budget_exhausted)  // shown only when set

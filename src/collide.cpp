@@ -5,6 +5,7 @@
 #include <pcl_probcollision/detail/input_checks.h>
 
 #include "leaf_pair_test.h"
+#include "nearest_samples.h"
 #include "surface_calibration.h"
 #include "surface_test.h"
 
@@ -174,6 +175,30 @@ pool (CollisionResult& into, const CollisionResult& separators, const CollisionR
   mean (into.probabilities_b, separators.probabilities_b);
   into.verdict = verdictFor (into.probability, request);
 }
+/** \brief CollisionRequest::distance beyond reach: the nearest samples' distance and its std,
+  * the points in the query frame. */
+void
+sampleDistance (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_local, CollisionResult& result)
+{
+  const detail::NearestSamples n = detail::nearestSamples (a.hierarchy (), b.hierarchy (), T_local);
+  if (n.index_a < 0)
+    return;
+  const Eigen::Vector3d d = n.point_a - n.point_b;
+  const double length = d.norm ();
+  double variance = 0.0;
+  if (length > 0.0)
+  {
+    const Eigen::Vector3d u = d / length;
+    variance = a.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_a)].quadratic (u) +
+               b.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_b)].quadratic (T_local.linear ().transpose () * u);
+  }
+  result.signed_distance = length;
+  result.signed_distance_std = std::sqrt (std::max (variance, 0.0));
+  result.sample_distance = true;
+  result.nearest_point_a = n.point_a + a.origin ();
+  result.nearest_point_b = n.point_b + a.origin ();
+  result.bv_tests += n.node_pairs;
+}
 } // namespace
 
 Verdict
@@ -239,6 +264,8 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   }
 
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
+  if (request.distance && result.no_leaf_tested && std::isnan (result.signed_distance))
+    sampleDistance (a, b, T_local, result);
   if (result.witness_side != 0)
   {
     result.witness_point += a.origin ();

@@ -35,7 +35,7 @@ CollisionRequest::operator== (const CollisionRequest& o) const
          per_point == o.per_point && enable_timings == o.enable_timings && traversal == o.traversal &&
          rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && classifier == o.classifier &&
          defer_kernel_fits == o.defer_kernel_fits && max_leaf_fits == o.max_leaf_fits && surface == o.surface &&
-         surface_pooled == o.surface_pooled && surface_calibrated == o.surface_calibrated;
+         surface_pooled == o.surface_pooled && surface_calibrated == o.surface_calibrated && distance == o.distance;
 }
 
 const char*

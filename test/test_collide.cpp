@@ -34,6 +34,9 @@ using pcl_probcollision_test::patchWithHole;
 using pcl_probcollision_test::poseSweep;
 using pcl_probcollision_test::randomAxisAnglePose;
 using pcl_probcollision_test::randomSheet;
+using pcl_probcollision_test::Shape;
+using pcl_probcollision_test::shapeCloud;
+using pcl_probcollision_test::shapeName;
 using pcl_probcollision_test::verdictCounts;
 
 namespace
@@ -47,6 +50,16 @@ constexpr int kPoses = 9;            // still three poses per thread
 constexpr int kConcurrentPoses = 48;
 constexpr int kPoses = 30;
 #endif
+
+/** \brief Two organized patches, 0.1 and 0.2 m across at z = 0, with 2 mm of isotropic noise. */
+void
+setPatches (ProbabilisticCollision<pcl::PointXYZ>& pc)
+{
+  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.001, 12));
+  pc.setTargetCloud (organizedPatch (0.2, 0.01, 0.0, 0.001, 13));
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+}
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -55,10 +68,7 @@ constexpr int kPoses = 30;
 TEST (Collide, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
 {
   ProbabilisticCollision<pcl::PointXYZ> pc;
-  pc.setInputCloud (organizedPatch (0.1, 0.01, 0.0, 0.001, 12));
-  pc.setTargetCloud (organizedPatch (0.2, 0.01, 0.0, 0.001, 13));
-  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
-  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+  setPatches (pc);
   CollisionResult warmup;
   ASSERT_TRUE (pc.compute (warmup));
   const auto a = pc.getInputModel ();
@@ -220,6 +230,156 @@ TEST (Collide, DeferredKernelFitsKeepTheAnswer)
 // collide() under numerical stress and concurrency (issue #7, docs/RELIABILITY.md)
 
 // The core in double: collide() on hierarchies of noisy sheets, then the same sheets moved by 1e5.
+// ---------------------------------------------------------------------------------------------
+// CollisionRequest::distance: the nearest samples' distance beyond reach
+
+namespace
+{
+/** \brief The nearest pair of a and b mapped by T, by brute force: the oracle. */
+struct BrutePair
+{
+  double distance = std::numeric_limits<double>::infinity ();
+  std::size_t i = 0, j = 0;
+};
+BrutePair
+bruteNearest (const UncertainCloud& a, const UncertainCloud& b, const Eigen::Isometry3d& T)
+{
+  BrutePair best;
+  for (std::size_t j = 0; j < b.size (); ++j)
+  {
+    const Eigen::Vector3d q = T * b.means[j];
+    for (std::size_t i = 0; i < a.size (); ++i)
+    {
+      const double d = (a.means[i] - q).norm ();
+      if (d < best.distance)
+        best = {d, i, j};
+    }
+  }
+  return best;
+}
+} // namespace
+
+TEST (CollideDistance, BeyondReachTheNearestSamplesAreFoundExactlyWithTheirDeviation)
+{
+  // Three shapes against each other at random rotations, their centres 2.5 to 5 object sizes apart: the
+  // best-first descent must find the brute-force pair whatever the boxes' orientations.
+  const Shape shapes[] = {Shape::Box, Shape::Sphere, Shape::NoisyPlane};
+  CollisionRequest rq;
+  rq.distance = true;
+  std::mt19937 rng (31);
+  std::uniform_real_distribution<double> unit (-1.0, 1.0), length (2.5, 5.0);
+  int checked = 0;
+  for (const Shape sa : shapes)
+    for (const Shape sb : shapes)
+    {
+      const UncertainCloud ca = shapeCloud (sa, 500, 40 + static_cast<int> (sa));
+      const UncertainCloud cb = shapeCloud (sb, 700, 50 + static_cast<int> (sb));
+      const CloudModel a (ca), b (cb);
+      for (int k = 0; k < 12; ++k)
+      {
+        Eigen::Isometry3d T = randomAxisAnglePose (rng, 0.0);
+        const Eigen::Vector3d direction = Eigen::Vector3d (unit (rng), unit (rng), unit (rng)).normalized ();
+        T.translation () = length (rng) * direction;
+        SCOPED_TRACE (std::string (shapeName (sa)) + " against " + shapeName (sb) + ", pose " + std::to_string (k));
+        CollisionResult r;
+        ASSERT_TRUE (collide (a, b, T, rq, r)) << r.message;
+        ASSERT_TRUE (r.no_leaf_tested);  // beyond reach: the distance comes from the samples
+        ASSERT_TRUE (r.sample_distance);
+        const BrutePair oracle = bruteNearest (ca, cb, T);
+        EXPECT_NEAR (r.signed_distance, oracle.distance, 1e-12);
+        EXPECT_LT ((r.nearest_point_a - ca.means[oracle.i]).norm (), 1e-12);
+        EXPECT_LT ((r.nearest_point_b - T * cb.means[oracle.j]).norm (), 1e-12);
+        // Both samples' covariances along the line between them (stored in single precision).
+        const Eigen::Vector3d u = (ca.means[oracle.i] - T * cb.means[oracle.j]).normalized ();
+        const double variance = u.dot (ca.covariances[oracle.i] * u) +
+                                u.dot (T.linear () * cb.covariances[oracle.j] * T.linear ().transpose () * u);
+        EXPECT_NEAR (r.signed_distance_std, std::sqrt (variance), 1e-6 * std::sqrt (variance));
+        EXPECT_EQ (r.verdict, Verdict::Free);
+        ++checked;
+      }
+    }
+  EXPECT_EQ (checked, 108);
+}
+
+TEST (CollideDistance, OnlyBeyondReachAndOnlyWhenAsked)
+{
+  const UncertainCloud ca = randomSheet (400, 0.2, 0.0, 0.002, 12);
+  const UncertainCloud cb = randomSheet (400, 0.2, 0.0, 0.002, 13);
+  const CloudModel a (ca), b (cb);
+  Eigen::Isometry3d far = Eigen::Isometry3d::Identity ();
+  far.translation () = Eigen::Vector3d (0.0, 0.0, 0.5);
+  CollisionRequest rq;
+  CollisionResult r;
+  // Not asked: no distance, as before.
+  ASSERT_TRUE (collide (a, b, far, rq, r)) << r.message;
+  EXPECT_TRUE (r.no_leaf_tested);
+  EXPECT_FALSE (r.sample_distance);
+  EXPECT_TRUE (std::isnan (r.signed_distance));
+  EXPECT_TRUE (r.nearest_point_a.array ().isNaN ().all ());
+  // Asked, 0.5 apart: the two sheets' nearest samples, a little under 0.5 + noise.
+  rq.distance = true;
+  ASSERT_TRUE (collide (a, b, far, rq, r)) << r.message;
+  EXPECT_TRUE (r.sample_distance);
+  EXPECT_NEAR (r.signed_distance, bruteNearest (ca, cb, far).distance, 1e-12);
+  EXPECT_NEAR (r.signed_distance, 0.5, 0.02);
+  EXPECT_NEAR (r.signed_distance_std, std::sqrt (2.0) * 0.002, 1e-6);
+  // Near contact the query reaches leaf pairs: the separators give no distance, and none is
+  // made up from the samples (interleaved samples of two crossing sheets are a spacing apart).
+  ASSERT_TRUE (collide (a, b, Eigen::Isometry3d::Identity (), rq, r)) << r.message;
+  EXPECT_FALSE (r.no_leaf_tested);
+  EXPECT_FALSE (r.sample_distance);
+  EXPECT_TRUE (std::isnan (r.signed_distance));
+}
+
+TEST (CollideDistance, FarFromTheOriginTheDistanceKeepsItsPrecision)
+{
+  const Eigen::Vector3d offset (1e5, 1e5, -1e5);
+  CollisionRequest rq;
+  rq.distance = true;
+  const CloudModel a0 (randomSheet (400, 0.2, 0.0, 0.002, 12));
+  const CloudModel b0 (randomSheet (400, 0.2, 0.03, 0.002, 13));
+  const CloudModel a1 (randomSheet (400, 0.2, 0.0, 0.002, 12, offset));
+  const CloudModel b1 (randomSheet (400, 0.2, 0.03, 0.002, 13, offset));
+  CollisionResult r0, r1;
+  ASSERT_TRUE (collide (a0, b0, Eigen::Isometry3d::Identity (), rq, r0)) << r0.message;
+  ASSERT_TRUE (collide (a1, b1, Eigen::Isometry3d::Identity (), rq, r1)) << r1.message;
+  ASSERT_TRUE (r0.sample_distance);
+  ASSERT_TRUE (r1.sample_distance);
+  EXPECT_NEAR (r0.signed_distance, r1.signed_distance, 1e-9);
+  EXPECT_LT ((r1.nearest_point_a - offset - r0.nearest_point_a).norm (), 1e-9);
+}
+
+TEST (CollideDistance, ProbabilisticCollisionGivesTheNearestPointsInTheTargetFrame)
+{
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  setPatches (pc);
+  CollisionRequest rq = pc.getRequest ();
+  rq.distance = true;
+  pc.setRequest (rq);
+  Eigen::Isometry3d T_target_input = Eigen::Isometry3d::Identity ();
+  T_target_input.translation () = Eigen::Vector3d (0.05, -0.02, 0.3);
+  T_target_input.rotate (Eigen::AngleAxisd (0.4, Eigen::Vector3d (1.0, 2.0, 0.5).normalized ()));
+  CollisionResult r;
+  ASSERT_TRUE (pc.compute (T_target_input, r)) << r.message;
+  ASSERT_TRUE (r.sample_distance);
+  EXPECT_NEAR ((r.nearest_point_a - r.nearest_point_b).norm (), r.signed_distance, 1e-12);
+  // B's point is a target sample as it lies (the target's frame is the query frame), A's one
+  // the input's sample moved by the pose: none nearer between the two models' samples.
+  const auto input = pc.getInputModel ();
+  const auto target = pc.getTargetModel ();
+  double nearest = std::numeric_limits<double>::infinity ();
+  double target_match = std::numeric_limits<double>::infinity ();
+  for (const Eigen::Vector3d& q : target->hierarchy ().means ())
+  {
+    const Eigen::Vector3d qt = q + target->origin ();
+    target_match = std::min (target_match, (qt - r.nearest_point_b).norm ());
+    for (const Eigen::Vector3d& p : input->hierarchy ().means ())
+      nearest = std::min (nearest, (T_target_input * (p + input->origin ()) - qt).norm ());
+  }
+  EXPECT_LT (target_match, 1e-9);
+  EXPECT_NEAR (r.signed_distance, nearest, 1e-9);
+}
+
 TEST (CollideReliability, CollideIsStableUnderATranslationBy1e5)
 {
   const Eigen::Vector3d offset (1e5, 1e5, -1e5);

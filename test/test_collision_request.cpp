@@ -40,6 +40,7 @@ TEST (CollisionRequest, DefaultsAreTheDocumentedOnes)
   EXPECT_EQ (r.seed, 1u);
   EXPECT_EQ (r.expanded_k_sigma, 3.0);
   EXPECT_FALSE (r.defer_kernel_fits);
+  EXPECT_FALSE (r.distance);  // no nearest-sample search unless asked
   // The leaf-pair classifier: Ladder, Robust, kappa = 0.9, C = 1000 (README, "Defaults").
   EXPECT_EQ (r.classifier.kernel, KernelMode::Ladder);
   EXPECT_EQ (r.classifier.training, TrainingMode::Robust);
@@ -158,6 +159,10 @@ TEST (CollisionRequest, EqualityComparesEveryMember)
       {"expanded_k_sigma", [] (CollisionRequest& r) { r.expanded_k_sigma = 2.0; }},
       {"defer_kernel_fits", [] (CollisionRequest& r) { r.defer_kernel_fits = true; }},
       {"max_leaf_fits", [] (CollisionRequest& r) { r.max_leaf_fits = 7; }},
+      {"surface", [] (CollisionRequest& r) { r.surface = true; }},
+      {"surface_pooled", [] (CollisionRequest& r) { r.surface_pooled = true; }},
+      {"surface_calibrated", [] (CollisionRequest& r) { r.surface_calibrated = true; }},
+      {"distance", [] (CollisionRequest& r) { r.distance = true; }},
       {"classifier.C", [] (CollisionRequest& r) { r.classifier.C = 10.0; }},
       {"classifier.kernel", [] (CollisionRequest& r) { r.classifier.kernel = KernelMode::Linear; }},
       {"classifier.loss", [] (CollisionRequest& r) { r.classifier.loss = Loss::Huber; }},

@@ -41,6 +41,12 @@ TEST (CollisionResult, DefaultIsNotOkAndHoldsNothingComputed)
     EXPECT_TRUE (std::isnan (r.witness_point[i])) << i;
     EXPECT_TRUE (std::isnan (r.witness_normal[i])) << i;
   }
+  // No distance, nor the nearest samples CollisionRequest::distance finds.
+  EXPECT_TRUE (std::isnan (r.signed_distance));
+  EXPECT_TRUE (std::isnan (r.signed_distance_std));
+  EXPECT_FALSE (r.sample_distance);
+  EXPECT_TRUE (r.nearest_point_a.array ().isNaN ().all ());
+  EXPECT_TRUE (r.nearest_point_b.array ().isNaN ().all ());
   EXPECT_EQ (r.points_a, 0u);
   EXPECT_EQ (r.points_b, 0u);
   EXPECT_EQ (r.points_skipped_nonfinite, 0u);

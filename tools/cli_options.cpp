@@ -42,7 +42,7 @@ const std::set<std::string> kValueFlags = {
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
   "-noise_stop", "-max_leaf_fits"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
-                                            "-measured", "-surface", "-surface_pooled", "-surface_calibrated", "-ignore_normals",
+                                            "-measured", "-surface", "-surface_pooled", "-surface_calibrated", "-distance", "-ignore_normals",
                                             "-v"};
 
 ParseResult
@@ -293,6 +293,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.surface = o.surface_pooled = true;
       else if (a == "-surface_calibrated")
         o.surface_calibrated = true;
+      else if (a == "-distance")
+        o.distance = true;
       else if (a == "-ignore_normals")
         o.ignore_normals = true;
       else if (a == "-json")
@@ -564,6 +566,9 @@ helpText ()
        "  -surface_calibrated  with -surface: P in [0.1, 0.9] through the calibration map fitted on\n"
        "                  the evaluation's procedural scenes (rankings and verdicts at 0.1,0.9\n"
        "                  unchanged; off by default: it does not carry over to other scenes)\n"
+       "  -distance       a distance at any separation: where the query reaches no leaf pair (the\n"
+       "                  objects beyond reach), d +- std is the distance between the two clouds'\n"
+       "                  nearest samples (\"nearest samples\"); near contact -surface's distance\n"
        "  -ignore_normals with -surface: orient clouds as if their files had no normal_x normal_y\n"
        "                  normal_z (by default a cloud's stored normals are its outward ones)\n"
        "  -nmax N         = "

@@ -48,6 +48,7 @@ struct Defaults
   static inline const bool surface = request.surface;
   static inline const bool surface_pooled = request.surface_pooled;
   static inline const bool surface_calibrated = request.surface_calibrated;
+  static inline const bool distance = request.distance;
   static inline const bool measured = !model.surface_projection;
   static inline const int n_max = model.hierarchy.n_max;
   static inline const int n_min = model.hierarchy.n_min;
@@ -111,6 +112,8 @@ struct Options
   bool surface_pooled = Defaults::surface_pooled;
   /** \brief -surface_calibrated: CollisionRequest::surface_calibrated. */
   bool surface_calibrated = Defaults::surface_calibrated;
+  /** \brief -distance: CollisionRequest::distance (the nearest samples' distance beyond reach). */
+  bool distance = Defaults::distance;
   /** \brief -ignore_normals: with -surface, a cloud file's normal_x normal_y normal_z are not
     * read (the cloud is oriented by its viewpoint or by propagation, as one without normals). */
   bool ignore_normals = false;

@@ -244,6 +244,7 @@ requestFor (const Options& o)
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
   r.surface_calibrated = o.surface_calibrated;
+  r.distance = o.distance;
   r.per_point = o.output.has_value ();
   r.enable_timings = true;
   r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
@@ -315,6 +316,18 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   // Always a boolean (false without -surface): the surface layer's answer rests on surface the
   // samples do not show (CollisionResult::unobserved).
   j.key ("unobserved").boolean (r.unobserved);
+  // Always a boolean (false without -distance): signed_distance is the nearest samples' distance,
+  // nearest_points the two samples (A's, B's; null otherwise).
+  j.key ("sample_distance").boolean (r.sample_distance);
+  if (r.sample_distance)
+  {
+    j.key ("nearest_points").beginArray ();
+    j.numbers ({r.nearest_point_a.x (), r.nearest_point_a.y (), r.nearest_point_a.z ()});
+    j.numbers ({r.nearest_point_b.x (), r.nearest_point_b.y (), r.nearest_point_b.z ()});
+    j.endArray ();
+  }
+  else
+    j.key ("nearest_points").null ();
   j.key ("lower_bound").boolean (r.lower_bound);
   j.key ("budget_exhausted").boolean (r.budget_exhausted);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
@@ -380,6 +393,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);
   j.key ("surface_calibrated").boolean (rq.surface_calibrated);
+  j.key ("distance").boolean (rq.distance);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);
@@ -409,7 +423,7 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
   char distance[128] = "";
   if (std::isfinite (r.signed_distance))
     std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", r.signed_distance, r.signed_distance_std,
-                   r.lower_bound ? " (first deciding point)" : "");
+                   r.lower_bound ? " (first deciding point)" : r.sample_distance ? " (nearest samples)" : "");
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";

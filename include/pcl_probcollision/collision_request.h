@@ -93,6 +93,15 @@ struct CollisionRequest
     * default is the model's raw P, P = Phi(-signed_distance / signed_distance_std). Per-point
     * values, signed_distance and its std are never mapped. */
   bool surface_calibrated = false;
+  /** \brief A distance at any separation, as FCL's distance request gives: where the query
+    * reached no leaf pair (CollisionResult::no_leaf_tested: the objects lie beyond the reach of
+    * either layer, and neither inside the other), signed_distance is the distance between the
+    * two clouds' nearest samples and its std their covariances' along the line between them
+    * (CollisionResult::sample_distance, nearest_point_a / nearest_point_b). Near contact the
+    * surface layer's signed distance stands (NaN there without it: the separators give none).
+    * An exact nearest-pair search over the two hierarchies; off by default, since a planner's
+    * free poses would pay for it (docs/PERFORMANCE.md). */
+  bool distance = false;
   /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
   ClassifierParams classifier;
 

@@ -48,6 +48,15 @@ struct CollisionResult
   /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
     * surfaces' own uncertainty and the discretisation between samples); NaN with it. */
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief True when signed_distance is the distance between the two clouds' nearest samples
+    * (CollisionRequest::distance, the objects beyond the query's reach): a clearance between
+    * samples, so between sparse samples a surface may pass up to about a spacing closer; its std
+    * is both samples' covariances (noise and discretisation) along the line between them. */
+  bool sample_distance = false;
+  /** \brief With sample_distance, the two nearest samples, A's (the input's for
+    * ProbabilisticCollision) and B's, in the query frame (as witness_point); NaN otherwise. */
+  Eigen::Vector3d nearest_point_a = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  Eigen::Vector3d nearest_point_b = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
     * InCollision and final, unless budget_exhausted). */
   bool lower_bound = false;

@@ -336,6 +336,30 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
     assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
 
 
+def test_distance_request_gives_the_nearest_samples_beyond_reach(sheets):
+    # CollisionRequest.distance: beyond reach, signed_distance is the distance between the two
+    # clouds' nearest samples (brute force here), nearest_point_a/_b those samples in A's frame.
+    a, b, A, B = sheets
+    T = translation(0.01, 0.02, 0.2)
+    plain = pc.collide(A, B, T)
+    assert plain.no_leaf_tested and np.isnan(plain.signed_distance) and not plain.sample_distance
+    for request in (pc.CollisionRequest(distance=True), pc.CollisionRequest(distance=True, surface=True)):
+        r = pc.collide(A, B, T, request)
+        assert r.ok and r.no_leaf_tested and r.sample_distance
+        moved = np.asarray(b, dtype=np.float64) + T[:3, 3]
+        gaps = np.linalg.norm(np.asarray(a, dtype=np.float64)[:, None, :] - moved[None, :, :], axis=2)
+        # The models hold the projected (denoised) samples: equal to the raw ones within the noise.
+        assert r.signed_distance == pytest.approx(gaps.min(), abs=2e-3)
+        assert np.linalg.norm(r.nearest_point_a - r.nearest_point_b) == pytest.approx(r.signed_distance, abs=1e-9)
+        assert r.signed_distance_std > 0
+        assert "sample_distance=True" in repr(r)
+    # Within reach the surface layer's distance stands.
+    near = pc.collide(A, B, translation(0.005, -0.003, -0.002), pc.CollisionRequest(distance=True, surface=True))
+    assert not near.sample_distance and np.isnan(near.nearest_point_a).all()
+    assert "distance=True" in repr(pc.CollisionRequest(distance=True))
+    assert pc.CollisionRequest(distance=True) != pc.CollisionRequest()
+
+
 def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
     # The sheets as scans, a seen from above and b from below (PCD VIEWPOINT; Auto orients them
     # toward it): load_model of the files and build_model of the same floats with the same

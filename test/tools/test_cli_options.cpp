@@ -69,6 +69,8 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.surface_pooled);
   EXPECT_FALSE (o.surface_calibrated);  // the model's raw P, unless -surface_calibrated
   EXPECT_TRUE (parse ({"-surface", "-surface_calibrated"}).options.surface_calibrated);
+  EXPECT_FALSE (o.distance);  // no distance beyond reach unless -distance
+  EXPECT_TRUE (parse ({"-distance"}).options.distance);
   EXPECT_FALSE (o.ignore_normals);
   EXPECT_FALSE (o.mesh_spacing);
   EXPECT_FALSE (o.output);

@@ -328,7 +328,8 @@ TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
   EXPECT_EQ (v[0]["witness"].type, Value::Type::Null);
 }
 
-// "unobserved" (CollisionResult::unobserved): always a boolean, right after the signed distance;
+// "unobserved" (CollisionResult::unobserved): always a boolean, right after the signed distance
+// (then -distance's sample_distance and nearest_points);
 // false without -surface. The human summary carries the marker exactly on the poses whose JSON
 // says true. Whether the surface layer sets it here is its own test's business: with -surface
 // only the member and the agreement of both outputs are asserted.
@@ -357,7 +358,8 @@ TEST_F (PcdCollisionTool, JsonUnobservedIsAlwaysABoolean)
       if (!surface)
       {
         EXPECT_FALSE (unobserved);
-        EXPECT_NE (out[i].find ("\"signed_distance_std\":null,\"unobserved\":false,\"lower_bound\":"),
+        EXPECT_NE (out[i].find ("\"signed_distance_std\":null,\"unobserved\":false,\"sample_distance\":false,"
+                                "\"nearest_points\":null,\"lower_bound\":"),
                    std::string::npos);
       }
       // Next to the signed distance, in the documented order.
@@ -437,6 +439,60 @@ TEST_F (PcdCollisionTool, AStoppedQueryNamesItsDistanceTheFirstDecidingPoint)
   ASSERT_EQ (full[2]["signed_distance"].type, Value::Type::Number);
   EXPECT_LT (full[2]["signed_distance"].number, stopped[2]["signed_distance"].number);
   EXPECT_NEAR (full[2]["signed_distance"].number, -0.02, 3.0 * full[2]["signed_distance_std"].number + 0.002);
+}
+
+// -distance: beyond the query's reach, the distance between the two inputs' nearest samples,
+// with both points in b's frame (JSON) and the marker "(nearest samples)" (human line); near
+// contact nothing changes. Without the flag, sample_distance is false and nearest_points null.
+TEST_F (PcdCollisionTool, DistanceGivesTheNearestSamplesBeyondReach)
+{
+  const std::string marker = " (nearest samples)";
+  std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses", kPoses.string ()};
+  const auto plain = runJson (args);
+  args.push_back ("-distance");
+  const auto v = runJson (args);
+  const ToolRun text = run (args);
+  ASSERT_EQ (text.status, 0) << text.err;
+  const auto human = lines (text.out);
+  ASSERT_EQ (plain.size (), 3u);
+  ASSERT_EQ (v.size (), 3u);
+  ASSERT_EQ (human.size (), 3u) << text.out;
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    SCOPED_TRACE ("pose " + std::to_string (i));
+    ASSERT_EQ (plain[i]["sample_distance"].type, Value::Type::Bool);
+    EXPECT_FALSE (plain[i]["sample_distance"].boolean);
+    EXPECT_EQ (plain[i]["nearest_points"].type, Value::Type::Null);
+    EXPECT_EQ (v[i]["parameters"]["distance"].type, Value::Type::Bool);
+    EXPECT_TRUE (v[i]["parameters"]["distance"].boolean);
+    EXPECT_EQ (v[i]["verdict"].text, plain[i]["verdict"].text);
+    EXPECT_EQ (v[i]["probability"].number, plain[i]["probability"].number);
+    EXPECT_EQ (human[i].find (marker) != std::string::npos, v[i]["sample_distance"].boolean) << human[i];
+  }
+  // The clear pose: fingertips 15 cm over the mug's rim, no leaf pair reached.
+  ASSERT_TRUE (v[0]["sample_distance"].boolean);
+  EXPECT_TRUE (v[0]["no_leaf_tested"].boolean);
+  EXPECT_EQ (plain[0]["signed_distance"].type, Value::Type::Null);
+  const double d = v[0]["signed_distance"].number;
+  EXPECT_GT (d, 0.14);
+  EXPECT_LT (d, 0.15);
+  EXPECT_GT (v[0]["signed_distance_std"].number, 0.0);
+  const Value& points = v[0]["nearest_points"];
+  ASSERT_EQ (points.array.size (), 2u);
+  ASSERT_EQ (points.array[0].array.size (), 3u);
+  ASSERT_EQ (points.array[1].array.size (), 3u);
+  double squared = 0.0;
+  for (std::size_t k = 0; k < 3; ++k)
+    squared += std::pow (points.array[0].array[k].number - points.array[1].array[k].number, 2);
+  EXPECT_NEAR (std::sqrt (squared), d, 1e-8);
+  // b's sample is the mug's rim or above it (b's frame: the mug stands at (0.10, 0) up to 0.10).
+  EXPECT_GT (points.array[1].array[2].number, 0.09);
+  // Touching and penetrating: within reach, so no sample distance (the separators give none).
+  for (std::size_t i = 1; i < 3; ++i)
+  {
+    EXPECT_FALSE (v[i]["sample_distance"].boolean);
+    EXPECT_EQ (v[i]["signed_distance"].type, Value::Type::Null);
+  }
 }
 
 // -max_leaf_fits N caps the fits of a query (budget_exhausted, P a lower bound: P >= in the human

@@ -190,6 +190,11 @@ ProbabilisticCollision<PointT>::finishResult (const Eigen::Isometry3d& T_target_
     result.witness_point = T_target_input * result.witness_point;
     result.witness_normal = T_target_input.linear () * result.witness_normal;
   }
+  if (result.sample_distance)
+  {
+    result.nearest_point_a = T_target_input * result.nearest_point_a;
+    result.nearest_point_b = T_target_input * result.nearest_point_b;
+  }
 }
 
 template <typename PointT>

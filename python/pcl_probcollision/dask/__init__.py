@@ -67,6 +67,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     # With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's
     # procedural scenes (pcd_collision's -surface_calibrated; off: the model's raw P).
     "surface_calibrated": _REQUEST.surface_calibrated,
+    # Beyond the query's reach, signed_distance is the distance between the two clouds' nearest
+    # samples (pcd_collision's -distance; CollisionRequest.distance).
+    "distance": _REQUEST.distance,
     # With surface: a cloud file's normal_x normal_y normal_z are not read (pcd_collision's
     # -ignore_normals); the cloud is oriented as one without them.
     "ignore_normals": False,
@@ -149,7 +152,8 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
         seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), defer_kernel_fits=bool(o["defer_kernel_fits"]),
         surface=bool(o["surface"]),
-        surface_pooled=bool(o["surface_pooled"]), surface_calibrated=bool(o["surface_calibrated"]))
+        surface_pooled=bool(o["surface_pooled"]), surface_calibrated=bool(o["surface_calibrated"]),
+        distance=bool(o["distance"]))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -318,6 +322,8 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         "signed_distance_std": np.array([r.signed_distance_std for r in results], dtype=np.float64),
         # The surface layer's answer rests on surface the samples do not show; False without surface.
         "unobserved": np.array([r.unobserved for r in results], dtype=bool),
+        # With distance: signed_distance is the nearest samples' (the objects beyond reach).
+        "sample_distance": np.array([r.sample_distance for r in results], dtype=bool),
         "witness_side": np.array([r.witness_side for r in results], dtype=np.int8),
         "query_ms": np.array([r.query_ms for r in results], dtype=np.float64),
     }
@@ -330,6 +336,9 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     R = T_b_a[:, :3, :3]
     out["witness_point"] = (R[:, :, 0] * wp[:, 0:1] + R[:, :, 1] * wp[:, 1:2] + R[:, :, 2] * wp[:, 2:3]) + T_b_a[:, :3, 3]
     out["witness_normal"] = R[:, :, 0] * wn[:, 0:1] + R[:, :, 1] * wn[:, 1:2] + R[:, :, 2] * wn[:, 2:3]
+    for side in ("a", "b"):  # the nearest samples, as the witness point (NaN without sample_distance)
+        p = np.array([getattr(r, "nearest_point_" + side) for r in results], dtype=np.float64).reshape(n, 3)
+        out["nearest_point_" + side] = (R[:, :, 0] * p[:, 0:1] + R[:, :, 1] * p[:, 1:2] + R[:, :, 2] * p[:, 2:3]) + T_b_a[:, :3, 3]
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
     out["pid"] = np.array([os.getpid()])
     return out
@@ -342,6 +351,8 @@ class BatchResults:
     """Answers in pose order, one numpy array per field: probability, verdict (int8 of Verdict),
     status, lower_bound, budget_exhausted, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
     unobserved (bool: with surface=True, the answer rests on surface the samples do not show; False otherwise),
+    sample_distance (bool: with distance=True, signed_distance is the nearest samples' distance) and
+    nearest_point_a/_b (those samples, b's frame; NaN otherwise),
     the counters (points_a, points_b, points_skipped_nonfinite, leaf_pairs_tested, bv_tests,
     kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
     witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; chunk_size
@@ -427,6 +438,8 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
         ignore_normals) and signed_distance / signed_distance_std are filled (NaN
         otherwise, and for poses where the surfaces never came within reach), and unobserved may
         be True (the answer rests on surface the samples do not show; always False otherwise).
+        distance=True is pcd_collision's -distance: beyond the query's reach signed_distance is
+        the distance between the two clouds' nearest samples (sample_distance True).
     Returns BatchResults in pose order, identical to the single-process answers."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)

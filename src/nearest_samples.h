@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The nearest pair of samples of two hierarchies (CollisionRequest::distance): the clearance
+// collide() reports where neither layer came within reach. Private to the library (src/).
+#pragma once
+
+#include <pcl_probcollision/probabilistic_bvh.h>
+
+#include <Eigen/Geometry>
+
+#include <cstddef>
+#include <limits>
+
+namespace pcl_probcollision
+{
+namespace detail
+{
+/** \brief The nearest pair of point means of two hierarchies. Frames: A's local frame. */
+struct NearestSamples
+{
+  double distance = std::numeric_limits<double>::infinity ();  ///< infinity when either is empty
+  int index_a = -1, index_b = -1;  ///< hierarchy indices
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero (), point_b = Eigen::Vector3d::Zero ();
+  std::size_t node_pairs = 0;      ///< node pairs taken from the queue and not pruned
+};
+
+/** \brief The nearest pair of samples (point means) of a and of b mapped into a's frame by
+  * T_a_b, exactly: a best-first descent of both hierarchies, node pairs ordered by a lower
+  * bound on the distance between their boxes (the norm of the gaps between their projections
+  * on one box's three axes, the larger of the two boxes'), stopped when the nearest pair
+  * found is no farther than the next bound. The descent's order is fixed by the hierarchies and
+  * the pose, so is the answer (ties keep the pair found first). */
+NearestSamples
+nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b);
+
+} // namespace detail
+} // namespace pcl_probcollision
