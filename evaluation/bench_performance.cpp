@@ -16,6 +16,9 @@
 //   BM_Covariances/N, BM_Hierarchy/N   the two parts alone
 //   BM_Query/near:0     per-pose times (median, p99) of ours, the octomap and exact FCL on the
 //   BM_Query/near:1     uniform (0) or near-contact (1) poses, with our accuracy on the same poses
+//   BM_Distance         CollisionRequest::distance on the uniform poses beyond reach: time
+//                       without and with it, and the nearest samples' distance error against
+//                       FCL's exact one (median, in mm, sigma_eff and relative; +-2 std coverage)
 //   BM_Batch/T          computeBatch() over all 2,700 poses on T threads: poses per second,
 //                       and how many answers equal the one-thread answer bit for bit
 //
@@ -26,6 +29,7 @@
 #include "metrics.h"
 #include "workloads.h"
 
+#include <pcl_probcollision/collision.h>
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/probabilistic_collision.h>
 
@@ -350,6 +354,74 @@ BM_Query (benchmark::State& state)
   state.counters["setup_s"] = w.setup_s;
 }
 BENCHMARK (BM_Query)->ArgName ("near")->Arg (0)->Arg (1)->Unit (benchmark::kMillisecond)->Iterations (1);
+
+// ---------------------------------------------------------------------------------------------
+/** \brief CollisionRequest::distance on the uniform poses that reach no leaf pair: each pose
+  * answered without and with it (collide() on the built models, interleaved), and the nearest
+  * samples' distance against the exact one (FCL on the meshes, PoseTruth::signed_distance). */
+void
+BM_Distance (benchmark::State& state)
+{
+  Workload& w = workload ();
+  const auto a = w.ours->getInputModel ();
+  const auto b = w.ours->getTargetModel ();
+  const CollisionRequest plain = w.ours->getRequest ();
+  CollisionRequest with = plain;
+  with.distance = true;
+  const RobustClassifier classifier (plain.classifier);
+  const double sigma_eff = std::sqrt (2.0) * w.sigma;
+  std::vector<double> without_us, with_us, signed_error, error, scaled_error, relative_error;
+  std::size_t covered = 0;
+  for (auto _ : state)
+  {
+    without_us.clear ();
+    with_us.clear ();
+    signed_error.clear ();
+    error.clear ();
+    scaled_error.clear ();
+    relative_error.clear ();
+    covered = 0;
+    for (const PoseTruth& pose : w.uniform)
+    {
+      // compute()'s pose maps the input into the target's frame; collide() takes the inverse.
+      const Eigen::Isometry3d T_a_b = pose.T.inverse ();
+      CollisionResult r0, r1;
+      auto t0 = Clock::now ();
+      const bool ok0 = collide (*a, *b, T_a_b, plain, r0, &classifier);
+      const double us0 = microsecondsSince (t0);
+      t0 = Clock::now ();
+      const bool ok1 = collide (*a, *b, T_a_b, with, r1, &classifier);
+      const double us1 = microsecondsSince (t0);
+      if (!ok0 || !ok1)
+      {
+        state.SkipWithError ((ok0 ? r1 : r0).message.c_str ());
+        return;
+      }
+      if (!r1.sample_distance)
+        continue;
+      without_us.push_back (us0);
+      with_us.push_back (us1);
+      const double e = r1.signed_distance - pose.signed_distance;
+      signed_error.push_back (e);
+      error.push_back (std::abs (e));
+      scaled_error.push_back (std::abs (e) / sigma_eff);
+      relative_error.push_back (std::abs (e) / pose.signed_distance);
+      covered += std::abs (e) <= 2.0 * r1.signed_distance_std;
+    }
+  }
+  const TimeSummary t0 = summarizeTimes (without_us), t1 = summarizeTimes (with_us);
+  state.counters["poses_beyond_reach"] = static_cast<double> (with_us.size ());
+  state.counters["without_median_us"] = t0.median;
+  state.counters["with_median_us"] = t1.median;
+  state.counters["with_p99_us"] = t1.p99;
+  state.counters["with_max_us"] = t1.max;
+  state.counters["error_median_mm"] = percentile (error, 50.0);
+  state.counters["signed_error_median_mm"] = percentile (signed_error, 50.0);
+  state.counters["error_median_sigma_eff"] = percentile (scaled_error, 50.0);
+  state.counters["error_median_relative"] = percentile (relative_error, 50.0);
+  state.counters["covered_2std"] = static_cast<double> (covered) / std::max<std::size_t> (1, with_us.size ());
+}
+BENCHMARK (BM_Distance)->Unit (benchmark::kMillisecond)->Iterations (1);
 
 // ---------------------------------------------------------------------------------------------
 /** \brief computeBatch() over all 2,700 poses on state.range (0) threads; compares every answer

@@ -854,7 +854,8 @@ PYBIND11_MODULE (_core, m)
                       "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.")
       .def_readwrite ("distance", &CollisionRequest::distance,
                       "Beyond the query's reach (no_leaf_tested), signed_distance is the nearest samples' distance,\n"
-                      "its std their covariances' along the line between them (result.sample_distance). Default False.")
+                      "its std their covariances' along the line between them with 0.29 of each one's spacing\n"
+                      "(result.sample_distance). Default False.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {

@@ -192,6 +192,12 @@ sampleDistance (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
     variance = a.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_a)].quadratic (u) +
                b.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_b)].quadratic (T_local.linear ().transpose () * u);
   }
+  // Where each surface passes between its samples: the discretisation term of the surface layer,
+  // 0.29 of the local spacing a side. Without it, +-2 std covered the exact (mesh) distance in
+  // 78 % of bench_performance's poses beyond reach (the samples' distance reads long by a median
+  // of 5 mm, 0.4 sigma_eff); with it 96 % (BM_Distance).
+  variance += std::pow (detail::kDiscretisationPerDistance * n.spacing_a, 2) +
+              std::pow (detail::kDiscretisationPerDistance * n.spacing_b, 2);
   result.signed_distance = length;
   result.signed_distance_std = std::sqrt (std::max (variance, 0.0));
   result.sample_distance = true;

@@ -116,6 +116,7 @@ nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eige
   thread_local std::vector<Entry> heap;
   heap.clear ();
   double best2 = std::numeric_limits<double>::infinity ();  // squared distance of the nearest pair so far
+  std::int32_t leaf_a = -1, leaf_b = -1;                    // the leaves that hold it
   auto push = [&] (std::int32_t ia, std::int32_t ib) {
     const BoxFrame& fa = frameA (ia);
     const BoxFrame& fb = frameB (ib);
@@ -161,6 +162,8 @@ nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eige
             best2 = d2;
             out.index_a = i;
             out.index_b = j;
+            leaf_a = e.a;
+            leaf_b = e.b;
           }
         }
       }
@@ -178,6 +181,20 @@ nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eige
   out.distance = std::sqrt (best2);
   if (out.index_a >= 0)
   {
+    // The spacing about a sample: its nearest distinct neighbour among its leaf's points.
+    auto spacing = [] (const ProbabilisticBVH& bvh, std::int32_t leaf, int index) {
+      const Eigen::Vector3d& p = bvh.means ()[static_cast<std::size_t> (index)];
+      double nearest2 = std::numeric_limits<double>::infinity ();
+      for (const int k : bvh.indices (bvh.node (leaf)))
+      {
+        const double d2 = (bvh.means ()[static_cast<std::size_t> (k)] - p).squaredNorm ();
+        if (d2 > 0.0)
+          nearest2 = std::min (nearest2, d2);
+      }
+      return std::isfinite (nearest2) ? std::sqrt (nearest2) : 0.0;
+    };
+    out.spacing_a = spacing (a, leaf_a, out.index_a);
+    out.spacing_b = spacing (b, leaf_b, out.index_b);
     out.point_a = a.means ()[static_cast<std::size_t> (out.index_a)];
     out.point_b = T_a_b * b.means ()[static_cast<std::size_t> (out.index_b)];
   }

@@ -21,6 +21,9 @@ struct NearestSamples
   int index_a = -1, index_b = -1;  ///< hierarchy indices
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero (), point_b = Eigen::Vector3d::Zero ();
   std::size_t node_pairs = 0;      ///< node pairs taken from the queue and not pruned
+  /** \brief The local sample spacing at each of the two: the distance from it to the nearest
+    * other sample of its leaf (0 when the leaf holds no other distinct sample). */
+  double spacing_a = 0.0, spacing_b = 0.0;
 };
 
 /** \brief The nearest pair of samples (point means) of a and of b mapped into a's frame by

@@ -22,10 +22,6 @@ namespace
 constexpr double kReachSigmas = 3.0;
 /** \brief Samples of the other surface that define its local implicit surface at a point. */
 constexpr int kSurfaceNeighbours = 8;
-/** \brief The spread of where a surface ends (or bends) between samples, per unit of distance
-  * from the nearest sample, up to one spacing: an edge anywhere within one spacing, uniformly,
-  * has a standard deviation of 1 / sqrt(12) = 0.29 spacing. Derived, not fitted. */
-constexpr double kDiscretisationPerDistance = 0.288675;
 /** \brief Holes are bridged up to this many sample spacings from the nearest sample (holes up
   * to twice as wide: an occlusion shadow) when samples lie on the far rim; farther, or with no
   * far rim, the surface has ended and the point is outside by its distance to an edge half a

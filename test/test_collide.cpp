@@ -257,6 +257,19 @@ bruteNearest (const UncertainCloud& a, const UncertainCloud& b, const Eigen::Iso
   }
   return best;
 }
+/** \brief The distance from point i of c to its nearest distinct other point. */
+double
+nearestNeighbour (const UncertainCloud& c, std::size_t i)
+{
+  double best = std::numeric_limits<double>::infinity ();
+  for (std::size_t k = 0; k < c.size (); ++k)
+  {
+    const double d = (c.means[k] - c.means[i]).norm ();
+    if (d > 0.0)
+      best = std::min (best, d);
+  }
+  return best;
+}
 } // namespace
 
 TEST (CollideDistance, BeyondReachTheNearestSamplesAreFoundExactlyWithTheirDeviation)
@@ -289,16 +302,38 @@ TEST (CollideDistance, BeyondReachTheNearestSamplesAreFoundExactlyWithTheirDevia
         EXPECT_NEAR (r.signed_distance, oracle.distance, 1e-12);
         EXPECT_LT ((r.nearest_point_a - ca.means[oracle.i]).norm (), 1e-12);
         EXPECT_LT ((r.nearest_point_b - T * cb.means[oracle.j]).norm (), 1e-12);
-        // Both samples' covariances along the line between them (stored in single precision).
+        // Both samples' covariances along the line between them (stored in single precision),
+        // plus 0.29 of each one's spacing, its nearest distinct neighbour in its leaf: at least
+        // its nearest neighbour in the whole cloud (exact on a grid: the next test).
         const Eigen::Vector3d u = (ca.means[oracle.i] - T * cb.means[oracle.j]).normalized ();
         const double variance = u.dot (ca.covariances[oracle.i] * u) +
                                 u.dot (T.linear () * cb.covariances[oracle.j] * T.linear ().transpose () * u);
-        EXPECT_NEAR (r.signed_distance_std, std::sqrt (variance), 1e-6 * std::sqrt (variance));
+        const double spacings = std::pow (nearestNeighbour (ca, oracle.i), 2) + std::pow (nearestNeighbour (cb, oracle.j), 2);
+        EXPECT_GE (r.signed_distance_std * r.signed_distance_std, (1.0 - 1e-6) * (variance + spacings / 12.0));
+        EXPECT_LT (r.signed_distance_std, 0.1);  // a spacing within a leaf of a unit-sized object
         EXPECT_EQ (r.verdict, Verdict::Free);
         ++checked;
       }
     }
   EXPECT_EQ (checked, 108);
+}
+
+TEST (CollideDistance, OnExactGridsTheDeviationIsTheDiscretisationTerm)
+{
+  // Two exact grids of spacing h, 0.3 apart: the distance is 0.3 and, with no noise, the
+  // deviation is the discretisation term alone, 1 / sqrt(12) of the spacing a side.
+  const double h = 0.01;
+  const UncertainCloud grid = jitteredGrid (20, h, 0.0, 1);
+  const CloudModel a (grid), b (grid);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
+  T.translation () = Eigen::Vector3d (0.003, -0.002, 0.3);
+  CollisionRequest rq;
+  rq.distance = true;
+  CollisionResult r;
+  ASSERT_TRUE (collide (a, b, T, rq, r)) << r.message;
+  ASSERT_TRUE (r.sample_distance);
+  EXPECT_NEAR (r.signed_distance, std::sqrt (0.3 * 0.3 + 0.003 * 0.003 + 0.002 * 0.002), 1e-12);
+  EXPECT_NEAR (r.signed_distance_std, std::sqrt (2.0 / 12.0) * h, 1e-6 * h);  // 0.288675, six digits
 }
 
 TEST (CollideDistance, OnlyBeyondReachAndOnlyWhenAsked)
@@ -322,7 +357,9 @@ TEST (CollideDistance, OnlyBeyondReachAndOnlyWhenAsked)
   EXPECT_TRUE (r.sample_distance);
   EXPECT_NEAR (r.signed_distance, bruteNearest (ca, cb, far).distance, 1e-12);
   EXPECT_NEAR (r.signed_distance, 0.5, 0.02);
-  EXPECT_NEAR (r.signed_distance_std, std::sqrt (2.0) * 0.002, 1e-6);
+  // The noise of both (2 mm each) and the sheets' spacing (400 samples on 0.2 x 0.2: about 10 mm).
+  EXPECT_GT (r.signed_distance_std, std::sqrt (2.0) * 0.002);
+  EXPECT_LT (r.signed_distance_std, std::sqrt (2.0) * std::hypot (0.002, 0.29 * 0.03));
   // Near contact the query reaches leaf pairs: the separators give no distance, and none is
   // made up from the samples (interleaved samples of two crossing sheets are a spacing apart).
   ASSERT_TRUE (collide (a, b, Eigen::Isometry3d::Identity (), rq, r)) << r.message;

@@ -96,7 +96,8 @@ struct CollisionRequest
   /** \brief A distance at any separation, as FCL's distance request gives: where the query
     * reached no leaf pair (CollisionResult::no_leaf_tested: the objects lie beyond the reach of
     * either layer, and neither inside the other), signed_distance is the distance between the
-    * two clouds' nearest samples and its std their covariances' along the line between them
+    * two clouds' nearest samples, and its std their covariances' along the line between them
+    * with 0.29 of each one's spacing for where the surfaces pass between samples
     * (CollisionResult::sample_distance, nearest_point_a / nearest_point_b). Near contact the
     * surface layer's signed distance stands (NaN there without it: the separators give none).
     * An exact nearest-pair search over the two hierarchies; off by default, since a planner's

@@ -50,8 +50,10 @@ struct CollisionResult
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
   /** \brief True when signed_distance is the distance between the two clouds' nearest samples
     * (CollisionRequest::distance, the objects beyond the query's reach): a clearance between
-    * samples, so between sparse samples a surface may pass up to about a spacing closer; its std
-    * is both samples' covariances (noise and discretisation) along the line between them. */
+    * samples, so between sparse samples a surface may pass up to about a spacing closer (it reads
+    * long on average); its std is both samples' covariances along the line between them and, for
+    * where each surface passes between its samples, 0.29 of each sample's spacing (its nearest
+    * distinct neighbour in its hierarchy leaf). */
   bool sample_distance = false;
   /** \brief With sample_distance, the two nearest samples, A's (the input's for
     * ProbabilisticCollision) and B's, in the query frame (as witness_point); NaN otherwise. */
