@@ -269,9 +269,10 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
     result.verdict = verdictFor (result.probability, request);
   }
 
-  // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
+  // Beyond reach, a distance when asked (CollisionRequest::distance).
   if (request.distance && result.no_leaf_tested && std::isnan (result.signed_distance))
     sampleDistance (a, b, T_local, result);
+  // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
   if (result.witness_side != 0)
   {
     result.witness_point += a.origin ();

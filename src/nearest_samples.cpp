@@ -178,7 +178,6 @@ nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eige
       for (int c = 0; c < nb.num_children; ++c)
         push (e.a, nb.first_child + c);
   }
-  out.distance = std::sqrt (best2);
   if (out.index_a >= 0)
   {
     // The spacing about a sample: its nearest distinct neighbour among its leaf's points.

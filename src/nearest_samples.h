@@ -8,7 +8,6 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
-#include <limits>
 
 namespace pcl_probcollision
 {
@@ -17,8 +16,7 @@ namespace detail
 /** \brief The nearest pair of point means of two hierarchies. Frames: A's local frame. */
 struct NearestSamples
 {
-  double distance = std::numeric_limits<double>::infinity ();  ///< infinity when either is empty
-  int index_a = -1, index_b = -1;  ///< hierarchy indices
+  int index_a = -1, index_b = -1;  ///< hierarchy indices; -1 when either hierarchy is empty
   Eigen::Vector3d point_a = Eigen::Vector3d::Zero (), point_b = Eigen::Vector3d::Zero ();
   std::size_t node_pairs = 0;      ///< node pairs taken from the queue and not pruned
   /** \brief The local sample spacing at each of the two: the distance from it to the nearest

@@ -329,16 +329,18 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     }
     for f in _INT_FIELDS:
         out[f] = np.array([getattr(r, f) for r in results], dtype=np.int64)
-    # collide() answers in A's frame; pcd_collision reports the witness in b's frame:
-    # p_b = T_b_a p_a, n_b = R_b_a n_a, summed in Eigen's order.
-    wp = np.array([r.witness_point for r in results], dtype=np.float64).reshape(n, 3)
-    wn = np.array([r.witness_normal for r in results], dtype=np.float64).reshape(n, 3)
+    # collide() answers in A's frame; pcd_collision reports the witness (and the nearest samples,
+    # NaN without sample_distance) in b's frame: p_b = T_b_a p_a, n_b = R_b_a n_a, summed in
+    # Eigen's order.
     R = T_b_a[:, :3, :3]
-    out["witness_point"] = (R[:, :, 0] * wp[:, 0:1] + R[:, :, 1] * wp[:, 1:2] + R[:, :, 2] * wp[:, 2:3]) + T_b_a[:, :3, 3]
-    out["witness_normal"] = R[:, :, 0] * wn[:, 0:1] + R[:, :, 1] * wn[:, 1:2] + R[:, :, 2] * wn[:, 2:3]
-    for side in ("a", "b"):  # the nearest samples, as the witness point (NaN without sample_distance)
-        p = np.array([getattr(r, "nearest_point_" + side) for r in results], dtype=np.float64).reshape(n, 3)
-        out["nearest_point_" + side] = (R[:, :, 0] * p[:, 0:1] + R[:, :, 1] * p[:, 1:2] + R[:, :, 2] * p[:, 2:3]) + T_b_a[:, :3, 3]
+
+    def rotated(field):
+        v = np.array([getattr(r, field) for r in results], dtype=np.float64).reshape(n, 3)
+        return R[:, :, 0] * v[:, 0:1] + R[:, :, 1] * v[:, 1:2] + R[:, :, 2] * v[:, 2:3]
+
+    for field in ("witness_point", "nearest_point_a", "nearest_point_b"):
+        out[field] = rotated(field) + T_b_a[:, :3, 3]
+    out["witness_normal"] = rotated("witness_normal")
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
     out["pid"] = np.array([os.getpid()])
     return out
