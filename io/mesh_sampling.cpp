@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "mesh_sampling.h"
 
+#include <pcl_probcollision/detail/sample_spacing.h>
 #include <pcl_probcollision/normal_distribution.h>
 
 #include <pcl/kdtree/kdtree_flann.h>
@@ -145,12 +146,9 @@ medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_quer
     return 0.0;
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud (finite);
-  const std::size_t stride = std::max<std::size_t> (1, (finite->size () + max_queries - 1) / max_queries);
-  std::vector<double> d;
   pcl::Indices idx;
   std::vector<float> sq;
-  for (std::size_t i = 0; i < finite->size (); i += stride)
-  {
+  return detail::medianNearestSpacing (finite->size (), max_queries, [&] (std::size_t i) {
     // The nearest other point at a positive distance: duplicates are skipped by asking for a
     // few more neighbours.
     for (int k = 2; k <= 16; k *= 2)
@@ -159,17 +157,11 @@ medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_quer
         break;
       const auto it = std::find_if (sq.begin (), sq.end (), [] (float v) { return v > 0.f; });
       if (it != sq.end ())
-      {
-        d.push_back (std::sqrt (static_cast<double> (*it)));
-        break;
-      }
+        return std::sqrt (static_cast<double> (*it));
       if (static_cast<std::size_t> (k) >= finite->size ())
         break;
     }
-  }
-  if (d.empty ())
     return 0.0;
-  std::nth_element (d.begin (), d.begin () + static_cast<std::ptrdiff_t> (d.size () / 2), d.end ());
-  return d[d.size () / 2];
+  });
 }
 } // namespace pcl_probcollision::io

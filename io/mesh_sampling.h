@@ -6,6 +6,8 @@
 
 #include "mesh_input.h"
 
+#include <pcl_probcollision/detail/sample_spacing.h>
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -35,7 +37,9 @@ double meshArea (const TriangleMesh& mesh);
 double meshDiagonal (const TriangleMesh& mesh);
 
 /** \brief Median over the finite points (at most max_queries of them, evenly strided) of the
-  * distance to the nearest other finite point; 0 when there are fewer than two points or
-  * they all coincide. */
-double medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_queries = 20000);
+  * distance to the nearest other finite point at a positive distance (within its 16 nearest);
+  * 0 when there are fewer than two points or they all coincide (detail::medianNearestSpacing).
+  * A built CloudModel gives the same number without a k-d tree of its own
+  * (CloudModel::medianNeighbourSpacing). */
+double medianSpacing (const pcl::PointCloud<pcl::PointXYZ>& cloud, std::size_t max_queries = detail::kSpacingQueries);
 } // namespace pcl_probcollision::io

@@ -964,6 +964,9 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("warning", &CloudModel::warning, "A precision warning about the input, '' when none.")
       .def_property_readonly ("build_ms", &CloudModel::buildMilliseconds, "Wall time of the build, ms.")
       .def_property_readonly ("bytes", &CloudModel::bytes, "Memory held, bytes.")
+      .def_property_readonly ("median_neighbour_spacing", &CloudModel::medianNeighbourSpacing,
+                              "median_spacing() of the points, read from the build's own neighbour search (the same number);\n"
+                              "NaN when the build did not search the whole cloud (covariances given, merged samples) or cannot tell.")
       .def_property_readonly ("precision_ratio", &CloudModel::precisionRatio)
       .def_property_readonly ("params", &CloudModel::params, "The CloudModelParams it was built with.")
       .def_property_readonly ("has_surface", [] (const CloudModel& c) { return !c.surface ().empty (); },

@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -646,11 +647,16 @@ run (int argc, char** argv)
     params.noise = SensorNoiseModel::fromName (sensor, sigma);
     return pcl_probcollision::buildCloudModel (*in.cloud, params, nullptr, nullptr, input ? "input" : "target");
   };
+  // A cloud against a mesh sampled at its spacing is built first (on its own thread beside the
+  // rest of the setup, or when the sampling asks for it with one thread): the build's neighbour
+  // search measures the spacing (CloudModel::medianNeighbourSpacing), so the sampling needs no
+  // k-d tree of its own over the cloud (0.85 s for 5,000,000 points).
   auto earlyBuild = [&] (const Input& cloud, const Input& other, const std::string& sensor, double sigma, bool input) {
-    std::future<pcl_probcollision::CloudModel::ConstPtr> model;
-    if (workers > 1 && cloud.kind == InputKind::Cloud && !cloud.oriented && other.kind == InputKind::Mesh &&
-        !o.mesh_spacing)
-      model = std::async (std::launch::async, buildCloud, std::cref (cloud), sensor, sigma, input);
+    std::shared_future<pcl_probcollision::CloudModel::ConstPtr> model;
+    if (cloud.kind == InputKind::Cloud && !cloud.oriented && other.kind == InputKind::Mesh && !o.mesh_spacing)
+      model = std::async (workers > 1 ? std::launch::async : std::launch::deferred, buildCloud, std::cref (cloud),
+                          sensor, sigma, input)
+                  .share ();
     return model;
   };
   auto early_a = earlyBuild (a, b, o.sensor_a, o.sigma_a, true);
@@ -665,7 +671,25 @@ run (int argc, char** argv)
     if (o.mesh_spacing)
       sampleInput (*m, *o.mesh_spacing, "-mesh_density", log);
     else if (other.kind == InputKind::Cloud)
-      sampleInput (*m, medianSpacing (*other.cloud), "median nearest-neighbour spacing of '" + other.path + "'", log);
+    {
+      // The other cloud's early build measured it; a build that failed is left to compute(),
+      // which reports its error, and the spacing is then measured here.
+      double spacing = std::numeric_limits<double>::quiet_NaN ();
+      const auto& early = (m == &a) ? early_b : early_a;
+      if (early.valid ())
+      {
+        try
+        {
+          spacing = early.get ()->medianNeighbourSpacing ();
+        }
+        catch (const pcl::PCLException&)
+        {
+        }
+      }
+      if (std::isnan (spacing))
+        spacing = medianSpacing (*other.cloud);
+      sampleInput (*m, spacing, "median nearest-neighbour spacing of '" + other.path + "'", log);
+    }
     else
       sampleInput (*m, Defaults::mesh_spacing_fraction * std::max (meshDiagonal (a.mesh), meshDiagonal (b.mesh)),
                    "both inputs are meshes: 1/100 of the larger bounding-box diagonal", log);
@@ -703,7 +727,7 @@ run (int argc, char** argv)
   // The other clouds' models are built here too (or taken from their early build), so that every
   // model gets its stage line (a 5,000,000-point cloud takes seconds); a build that fails is
   // left to compute(), which builds it again and reports the error as before.
-  auto cloudModel = [&] (const Input& in, std::future<pcl_probcollision::CloudModel::ConstPtr>& early,
+  auto cloudModel = [&] (const Input& in, const std::shared_future<pcl_probcollision::CloudModel::ConstPtr>& early,
                          const std::string& sensor, double sigma, bool input) {
     if (in.oriented)
       return;

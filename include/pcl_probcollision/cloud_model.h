@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -91,6 +92,13 @@ public:
   const CloudModelParams& params () const { return params_; }
   /** \brief Wall time of the build in milliseconds: covariance estimation and hierarchy. */
   double buildMilliseconds () const { return build_ms_; }
+  /** \brief The cloud's median nearest-neighbour spacing, as io::medianSpacing() measures it
+    * (detail::medianNearestSpacing), read from the covariance estimation's own neighbour search:
+    * what pcd_collision samples a mesh at, without a second k-d tree over a large cloud. NaN
+    * when the build did not search the whole cloud's neighbours (covariances given without the
+    * surface model, indices given, samples merged) or cannot tell (a sampled point with more
+    * than k coincident neighbours); the caller then measures it itself. */
+  double medianNeighbourSpacing () const { return neighbour_spacing_; }
   /** \brief The oriented surface (METHOD.md 10a), in the local frame; empty() when built
     * with CloudModelParams::surface off. */
   const SurfaceModel& surface () const { return surface_; }
@@ -160,6 +168,7 @@ private:
   std::vector<int> representatives_;
   CloudModelParams params_;
   double build_ms_ = 0.0;
+  double neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();
   double precision_ratio_ = 0.0;
   std::string warning_;
 };

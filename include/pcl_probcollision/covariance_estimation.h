@@ -79,6 +79,13 @@ public:
     * (NaN for non-finite points, 0 without neighbours), index-aligned with the output. The
     * hierarchy uses r_i^2 as the surface area a point stands for. */
   const std::vector<float>& getNeighbourRadii () const { return radii_; }
+  /** \brief After compute(): the squared distance of each output point to its nearest
+    * neighbour (in the search surface) at a positive distance, as the neighbour search returned
+    * it (coincident points are skipped); 0 when the search covered every finite point of the
+    * surface and found none; NaN when it is not known (a non-finite point, or all k + 1 found
+    * coincident while more points exist). What io::medianSpacing() measures, without a second
+    * search (CloudModel::medianNeighbourSpacing). */
+  const std::vector<float>& getNearestSquaredDistances () const { return nearest_sqr_; }
 
   /** \brief Locally denoised positions (default on, as CloudModelParams::surface_projection,
     * chosen by the evaluation; needs a sensor noise model: without one nothing moves).
@@ -146,6 +153,7 @@ private:
   SensorNoiseModel noise_;
   std::optional<SensorPose> sensor_pose_;
   std::vector<float> radii_;
+  std::vector<float> nearest_sqr_;
   bool project_ = true;  // CloudModelParams::surface_projection; test_cloud_model checks they agree
   std::vector<Eigen::Vector3d> displacements_;
   bool compute_surface_ = false;

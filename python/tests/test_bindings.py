@@ -217,6 +217,17 @@ def test_model_is_immutable_and_rebuilding_moved_points_changes_the_answer(table
     assert abs(far.probability - before.probability) < 0.05
 
 
+def test_a_built_model_gives_median_spacing_without_a_search_of_its_own(table_points):
+    pts = table_points.astype(np.float64)
+    pts[7, 0] = np.nan
+    model = pc.build_model(pts, params=NOISE)
+    assert model.median_neighbour_spacing == pc.median_spacing(pts)
+    assert model.median_neighbour_spacing > 0
+    # Covariances given: no neighbour search, so the model does not know it.
+    exact = pc.build_model(pts, np.zeros((len(pts), 3, 3)), params=NOISE)
+    assert np.isnan(exact.median_neighbour_spacing)
+
+
 def test_nan_rows_are_skipped_and_counted(table_points, gripper_patch):
     pts = table_points.astype(np.float64)
     pts[[5, 17], 1] = np.nan

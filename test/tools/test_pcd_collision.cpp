@@ -968,6 +968,13 @@ TEST_F (PcdCollisionTool, MeshFormatsAndDensity)
   EXPECT_EQ (d1[0]["points_a"].number, d2[0]["points_a"].number);
   EXPECT_GT (d1[0]["inputs"]["a"]["spacing"].number, 0.002);
   EXPECT_LT (d1[0]["inputs"]["a"]["spacing"].number, 0.006);
+  // On one thread the cloud is built before the sampling too (its neighbour search measures the
+  // spacing): the same spacing, samples and answer.
+  const auto d3 = runJson ({kGripper.string (), kScene.string (), "-threads", "1"});
+  ASSERT_EQ (d3.size (), 1u);
+  EXPECT_EQ (d3[0]["inputs"]["a"]["spacing"].number, d1[0]["inputs"]["a"]["spacing"].number);
+  EXPECT_EQ (d3[0]["points_a"].number, d1[0]["points_a"].number);
+  EXPECT_EQ (d3[0]["probability"].text, d1[0]["probability"].text);
   // Two meshes: 1/100 of the larger bounding-box diagonal.
   const auto mm = runJson ({kGripper.string (), (dir_ / "quad.ply").string (), "-pose", "0,0,0.5,0,0,0"});
   ASSERT_EQ (mm.size (), 1u);

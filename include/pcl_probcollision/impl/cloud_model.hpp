@@ -5,6 +5,7 @@
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/detail/input_checks.h>
 #include <pcl_probcollision/detail/parallel.h>
+#include <pcl_probcollision/detail/sample_spacing.h>
 #include <pcl_probcollision/impl/resolution.hpp>
 
 #include <pcl/common/point_tests.h>
@@ -86,6 +87,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       once.noise_resolution = 0.0;
       const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
       model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
+      model->neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();  // measured on the merged cloud
       model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
       return model;
     }
@@ -99,6 +101,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   std::vector<Eigen::Vector3d> displacements;
   std::vector<Eigen::Vector3f> normals;
   std::vector<int> neighbours;
+  double neighbour_spacing = std::numeric_limits<double>::quiet_NaN ();
   if (!covariances || params.surface)
   {
     // With covariances given, the estimation runs for the surface model alone (its normals,
@@ -131,6 +134,24 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     displacements = estimation.getSurfaceDisplacements ();
     normals = estimation.getNormals ();
     neighbours = estimation.getNeighbours ();
+    // medianNeighbourSpacing(): io::medianSpacing's rule on the estimation's own search, whose
+    // k-d tree holds the cloud's finite points in cloud order as medianSpacing's does, so that
+    // the squared distances, and the number, are the same.
+    const std::vector<float>& nearest_sqr = estimation.getNearestSquaredDistances ();
+    if (!indices && nearest_sqr.size () == n)
+    {
+      std::size_t finite = 0;
+      for (std::size_t j = 0; j < n; ++j)
+        finite += pcl::isXYZFinite (cloud[j]) ? 1 : 0;
+      std::size_t ordinal = 0, j = 0;  // the ordinal-th finite point is cloud[j]; asked in increasing order
+      neighbour_spacing = detail::medianNearestSpacing (finite, detail::kSpacingQueries, [&] (std::size_t i) {
+        for (; j < n; ++j)
+          if (pcl::isXYZFinite (cloud[j]) && ordinal++ == i)
+            break;
+        const float v = nearest_sqr[j++];
+        return std::isnan (v) ? std::numeric_limits<double>::quiet_NaN () : std::sqrt (static_cast<double> (v));
+      });
+    }
   }
 
   // The model's points: the finite ones with a finite covariance, in cloud order. Chunks count
@@ -241,6 +262,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   }
   model->params_ = params;
   model->skipped_ = skipped;
+  model->neighbour_spacing_ = neighbour_spacing;
   model->assessPrecision (max_abs, name);
   model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   if (!model->warning_.empty ())

@@ -337,6 +337,7 @@ bool
 CovarianceEstimation<PointInT, PointOutT>::initCompute ()
 {
   radii_.clear ();
+  nearest_sqr_.clear ();
   displacements_.clear ();
   if (this->search_radius_ != 0.0)
   {
@@ -442,6 +443,7 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
     finite_surface += pcl::isXYZFinite (p) ? 1 : 0;
 
   radii_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
+  nearest_sqr_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
   normals_.clear ();
   neighbours_.clear ();
   const bool fit_normals = compute_surface_ && compute_normals_;
@@ -513,6 +515,14 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
         r = std::max (r, std::sqrt (static_cast<double> (row_sqr_dists[j])));
       }
       radii_[out] = static_cast<float> (r);
+      // The nearest neighbour at a positive distance (the row is sorted; the point itself and
+      // its duplicates come back at 0): getNearestSquaredDistances().
+      const std::size_t found = static_cast<std::size_t> (std::max (block.found[b], 0));
+      const float* positive = std::find_if (row_sqr_dists, row_sqr_dists + found, [] (float v) { return v > 0.f; });
+      if (positive != row_sqr_dists + found)
+        nearest_sqr_[out] = *positive;
+      else if (found >= finite_surface)
+        nearest_sqr_[out] = 0.0f;
       if (compute_surface_)
         std::copy (nn_indices.begin (), nn_indices.begin () + static_cast<std::ptrdiff_t> (kept),
                    neighbours_.begin () + static_cast<std::ptrdiff_t> (out * static_cast<std::size_t> (this->k_)));

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// io/mesh_sampling's median spacing, against the number a built CloudModel reads from its own
+// neighbour search (CloudModel::medianNeighbourSpacing): pcd_collision samples a mesh at the
+// latter when it has it, so the two must agree bit for bit.
+
+#include "mesh_sampling.h"
+
+#include <pcl_probcollision/cloud_model.h>
+
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace
+{
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+pcl_probcollision::CloudModelParams
+noisyParams ()
+{
+  pcl_probcollision::CloudModelParams params;
+  params.noise = pcl_probcollision::SensorNoiseModel::isotropic (0.001);
+  return params;
+}
+
+/** \brief n points on a noisy wavy sheet, every 97th not finite, every 50th doubled. */
+Cloud
+sheet (std::size_t n, unsigned seed)
+{
+  std::mt19937 rng (seed);
+  std::uniform_real_distribution<float> u (0.0f, 1.0f);
+  std::normal_distribution<float> noise (0.0f, 0.001f);
+  Cloud cloud;
+  const float nan = std::numeric_limits<float>::quiet_NaN ();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const float x = u (rng), y = u (rng);
+    cloud.push_back (i % 97 == 5 ? pcl::PointXYZ (nan, 0.0f, 0.0f)
+                                 : pcl::PointXYZ (x, y, 0.05f * std::sin (6.0f * x) + noise (rng)));
+    if (i % 50 == 7)
+      cloud.push_back (cloud.back ());
+  }
+  return cloud;
+}
+} // namespace
+
+TEST (MedianSpacing, ABuiltModelReadsTheSameSpacingFromItsNeighbourSearch)
+{
+  // Above and below io's 20,000 queries (strided and not), a regular grid (ties everywhere) and
+  // a cloud with duplicates and non-finite points.
+  Cloud grid;
+  for (int i = 0; i < 120; ++i)
+    for (int j = 0; j < 110; ++j)
+      grid.push_back (pcl::PointXYZ (0.01f * i, 0.01f * j, 0.0f));
+  for (const Cloud& cloud : {sheet (30011, 1), sheet (5000, 2), grid})
+  {
+    const double io = pcl_probcollision::io::medianSpacing (cloud);
+    ASSERT_GT (io, 0.0);
+    for (const int threads : {1, 2})
+    {
+      pcl_probcollision::CloudModelParams params = noisyParams ();
+      params.threads = threads;
+      EXPECT_EQ (pcl_probcollision::buildCloudModel (cloud, params)->medianNeighbourSpacing (), io)
+          << cloud.size () << " points, " << threads << " threads";
+    }
+    pcl_probcollision::CloudModelParams surface = noisyParams ();
+    surface.surface = true;
+    EXPECT_EQ (pcl_probcollision::buildCloudModel (cloud, surface)->medianNeighbourSpacing (), io);
+  }
+}
+
+TEST (MedianSpacing, AModelThatCannotTellSaysSo)
+{
+  // A point with more coincident copies than the k + 1 = 11 neighbours the build searches:
+  // io looks further (16), the model cannot, and says NaN.
+  Cloud cloud = sheet (300, 3);
+  for (int c = 0; c < 12; ++c)
+    cloud.push_back (cloud[0]);
+  const double io = pcl_probcollision::io::medianSpacing (cloud);
+  EXPECT_GT (io, 0.0);
+  EXPECT_TRUE (std::isnan (pcl_probcollision::buildCloudModel (cloud, noisyParams ())->medianNeighbourSpacing ()));
+
+  // Not the whole cloud's search: indices, covariances given (no estimation), merged samples.
+  const Cloud plain = sheet (400, 4);
+  const pcl::Indices half = [] {
+    pcl::Indices idx;
+    for (int i = 0; i < 200; ++i)
+      idx.push_back (i);
+    return idx;
+  }();
+  EXPECT_TRUE (std::isnan (pcl_probcollision::buildCloudModel (plain, noisyParams (), &half)->medianNeighbourSpacing ()));
+  const pcl::PointCloud<pcl_probcollision::Covariance> exact (plain.width, plain.height);
+  EXPECT_TRUE (std::isnan (pcl_probcollision::buildCloudModel (plain, noisyParams (), nullptr, &exact)->medianNeighbourSpacing ()));
+  pcl_probcollision::CloudModelParams merged = noisyParams ();
+  merged.noise = pcl_probcollision::SensorNoiseModel::isotropic (0.05);  // far above the spacing: samples merge
+  merged.noise_resolution = 2.0;
+  const auto model = pcl_probcollision::buildCloudModel (plain, merged);
+  ASSERT_GT (model->mergedSamples (), 0u);
+  EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));
+}
