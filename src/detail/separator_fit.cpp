@@ -34,17 +34,18 @@ constexpr int kRffIterationFactor = 10;
 double
 effectiveGamma (const SeparatorProblem& p, const RungFit& fit, double gamma, double eta)
 {
-  const Eigen::ArrayXd norm = gradientNorms (fit, p.n);
-  const Eigen::ArrayXd s = quadraticForms (p, fit).sqrt ();
+  // Point by point, without temporary arrays (this runs for every leaf pair's fit).
+  const double plane_norm = fit.isPlane () ? fit.plane_gradient.norm () : 0.0;
   double t_hat = std::numeric_limits<double>::infinity ();
   bool any_direction = false;
   for (Eigen::Index i = 0; i < p.n; ++i)
   {
-    if (!(norm (i) >= kCollapse))
+    if (!((fit.isPlane () ? plane_norm : gradientNorm (fit, i)) >= kCollapse))
       continue;
     any_direction = true;
-    if (s (i) > 0.0)
-      t_hat = std::min (t_hat, p.label (i) * fit.f (i) / s (i));
+    const double s = std::sqrt (quadraticForm (p, fit, i));
+    if (s > 0.0)
+      t_hat = std::min (t_hat, p.label (i) * fit.f (i) / s);
   }
   if (!any_direction)
     return 0.0;

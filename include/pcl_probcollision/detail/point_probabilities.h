@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
+
 namespace pcl_probcollision
 {
 namespace detail
@@ -18,11 +20,26 @@ constexpr double kCollapse = 1e-8;
 /** \brief Standard deviation along the gradient below this counts as none (METHOD.md 6.1). */
 constexpr double kNoSpread = 1e-12;
 
-/** \brief g_i^T Sigma_i g_i (clamped at 0) for per-point gradients, or for one gradient w. */
-Eigen::ArrayXd quadraticForms (const SeparatorProblem& p, const RungFit& fit);
+/** \brief g_i^T Sigma_i g_i (clamped at 0) of point i: its own gradient, or a plane's w. */
+inline double
+quadraticForm (const SeparatorProblem& p, const RungFit& fit, Eigen::Index i)
+{
+  const bool plane = fit.isPlane ();
+  const double gx = plane ? fit.plane_gradient (0) : fit.gx (i);
+  const double gy = plane ? fit.plane_gradient (1) : fit.gy (i);
+  const double gz = plane ? fit.plane_gradient (2) : fit.gz (i);
+  const double q = gx * gx * p.sxx (i) + gy * gy * p.syy (i) + gz * gz * p.szz (i) +
+                   2.0 * (gx * gy * p.sxy (i) + gx * gz * p.sxz (i) + gy * gz * p.syz (i));
+  return q > 0.0 ? q : 0.0;
+}
 
-/** \brief |g_i| for each of the n points. */
-Eigen::ArrayXd gradientNorms (const RungFit& fit, Eigen::Index n);
+/** \brief |g_i| of point i for per-point gradients (a plane's is plane_gradient.norm(), the
+  * same for every point). */
+inline double
+gradientNorm (const RungFit& fit, Eigen::Index i)
+{
+  return std::sqrt (fit.gx (i) * fit.gx (i) + fit.gy (i) * fit.gy (i) + fit.gz (i) * fit.gz (i));
+}
 
 /** \brief METHOD.md 6.1 for every point, and the ladder's misclassification count: fills
   * fit.probability, fit.misclassified and fit.degenerate. With u_i = c_i f_i / |g_i| and
