@@ -80,6 +80,10 @@ checkSide (const PointSetView& side, const char* name, ClassifierResult& result)
   return true;
 }
 
+/** \brief Doubles of the per-thread problem kept between classify() calls: 512 KB, the eleven
+  * columns of about 5,900 points (leaf pairs hold tens). */
+constexpr std::size_t kProblemKeep = std::size_t (1) << 16;
+
 /** \brief The two-class problem of METHOD.md 5.1 in the unit cube: A's points (label +1) then
   * B's, mapped by to_cube, with class-balanced weights C_i = C n / (2 n_{c_i}).
   * \return false when some input mean or covariance entry is not finite (p is then unusable):
@@ -93,10 +97,8 @@ makeProblem (const PointSetView& a, const PointSetView& b, const UnitCubeTransfo
   // stays 0 unless an entry is inf or NaN (or a covariance's entries sum past the double range)
   double finite_check = 0.0;
   const std::size_t n = a.size + b.size;
-  p.n = static_cast<Eigen::Index> (n);
   p.n_a = static_cast<Eigen::Index> (a.size);
-  for (Eigen::ArrayXd* array : {&p.x, &p.y, &p.z, &p.sxx, &p.sxy, &p.sxz, &p.syy, &p.syz, &p.szz, &p.label, &p.weight})
-    array->resize (p.n);
+  p.resize (static_cast<Eigen::Index> (n));
   Eigen::Index k = 0;
   for (const PointSetView* side : {&a, &b})
   {
@@ -204,7 +206,15 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   // Uniform normalisation (METHOD.md 4); checkSide() names an offending point only when the
   // cheap checks fail
   const UnitCubeTransform to_cube = computeUnitCubeTransform ({a, b});
-  detail::SeparatorProblem p;
+  // One problem per thread, reused from call to call: its buffer is kept, so most calls
+  // allocate nothing for it (classify() is const and may run on several threads at once).
+  // Above kProblemKeep doubles it is freed on return: big problems are rare.
+  thread_local detail::SeparatorProblem p;
+  struct Release
+  {
+    detail::SeparatorProblem& problem;
+    ~Release () { problem.releaseAbove (kProblemKeep); }
+  } release {p};
   if (!makeProblem (a, b, to_cube, params_.C, p) || !to_cube.isFinite ())
   {
     if (checkSide (a, "A", result) && checkSide (b, "B", result))

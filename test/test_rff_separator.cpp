@@ -47,10 +47,8 @@ wavySheet (int n, int copies, double c)
     n_a += above;
   }
   SeparatorProblem p;
-  p.n = static_cast<Eigen::Index> (n) * copies;
+  p.resize (static_cast<Eigen::Index> (n) * copies);
   p.n_a = static_cast<Eigen::Index> (n_a) * copies;
-  for (Eigen::ArrayXd* a : {&p.x, &p.y, &p.z, &p.sxx, &p.sxy, &p.sxz, &p.syy, &p.syz, &p.szz, &p.label, &p.weight})
-    a->resize (p.n);
   Eigen::Index k = 0;
   for (const double side : {1.0, -1.0})  // points of A first
     for (int i = 0; i < n; ++i)

@@ -7,7 +7,10 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cstddef>
 #include <limits>
+#include <new>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -61,15 +64,62 @@ struct MarginLoss
   }
 };
 
-/** \brief The normalised problem, structure of arrays, points of A (label +1) first. */
+/** \brief The normalised problem, structure of arrays, points of A (label +1) first.
+  *
+  * Its columns are views of one buffer that resize() keeps when a problem is smaller than an
+  * earlier one, so that a problem reused from leaf pair to leaf pair allocates nothing (eleven
+  * arrays a fit otherwise). Each column starts on Eigen's largest alignment, as an
+  * Eigen::ArrayXd does, so that every expression and reduction over it is evaluated as over an
+  * ArrayXd (the same packets, the same order of sums). */
 struct SeparatorProblem
 {
+  /** \brief A column: n values, aligned as an Eigen::ArrayXd. */
+  using Column = Eigen::Map<Eigen::ArrayXd, Eigen::AlignedMax>;
+
   Eigen::Index n = 0;    ///< number of points
   Eigen::Index n_a = 0;  ///< points 0 .. n_a - 1 belong to A
-  Eigen::ArrayXd x, y, z;                       ///< unit-cube means
-  Eigen::ArrayXd sxx, sxy, sxz, syy, syz, szz;  ///< unit-cube covariances S Sigma_i S^T
-  Eigen::ArrayXd label;                         ///< c_i = +1 (A) or -1 (B)
-  Eigen::ArrayXd weight;                        ///< C_i = C n / (2 n_{c_i})
+  Column x {nullptr, 0}, y {nullptr, 0}, z {nullptr, 0};  ///< unit-cube means
+  Column sxx {nullptr, 0}, sxy {nullptr, 0}, sxz {nullptr, 0};  ///< unit-cube covariances S Sigma_i S^T
+  Column syy {nullptr, 0}, syz {nullptr, 0}, szz {nullptr, 0};
+  Column label {nullptr, 0};   ///< c_i = +1 (A) or -1 (B)
+  Column weight {nullptr, 0};  ///< C_i = C n / (2 n_{c_i})
+
+  SeparatorProblem () = default;
+  SeparatorProblem (const SeparatorProblem& other) : n (other.n), n_a (other.n_a), storage_ (other.storage_) { seat (); }
+  SeparatorProblem&
+  operator= (const SeparatorProblem& other)
+  {
+    if (this != &other)
+    {
+      n = other.n;
+      n_a = other.n_a;
+      storage_ = other.storage_;
+      seat ();
+    }
+    return *this;
+  }
+
+  /** \brief Sets n and points every column at count values (their contents undefined), reusing
+    * the buffer when it is large enough. */
+  void
+  resize (Eigen::Index count)
+  {
+    n = count;
+    const std::size_t need = static_cast<std::size_t> (kColumns * stride (count));
+    if (storage_.size () < need)
+      storage_.resize (need);
+    seat ();
+  }
+  /** \brief Frees the buffer (n becomes 0) when it holds more than keep doubles. */
+  void
+  releaseAbove (std::size_t keep)
+  {
+    if (storage_.capacity () <= keep)
+      return;
+    decltype (storage_) ().swap (storage_);
+    n = n_a = 0;
+    seat ();
+  }
 
   Eigen::Vector3d point (Eigen::Index i) const { return Eigen::Vector3d (x (i), y (i), z (i)); }
   Eigen::Matrix3d covariance (Eigen::Index i) const
@@ -85,6 +135,26 @@ struct SeparatorProblem
                      2.0 * (g (0) * g (1) * sxy (i) + g (0) * g (2) * sxz (i) + g (1) * g (2) * syz (i));
     return std::max (q, 0.0);
   }
+
+private:
+  static constexpr Eigen::Index kColumns = 11;
+  /** \brief Doubles from one column's start to the next: count rounded up to whole
+    * alignment units. */
+  static Eigen::Index
+  stride (Eigen::Index count)
+  {
+    constexpr Eigen::Index unit = std::max<Eigen::Index> (1, EIGEN_MAX_ALIGN_BYTES / static_cast<Eigen::Index> (sizeof (double)));
+    return (count + unit - 1) / unit * unit;
+  }
+  void
+  seat ()
+  {
+    Column* columns[kColumns] = {&x, &y, &z, &sxx, &sxy, &sxz, &syy, &syz, &szz, &label, &weight};
+    const Eigen::Index s = stride (n);
+    for (Eigen::Index k = 0; k < kColumns; ++k)
+      new (columns[k]) Column (n > 0 ? storage_.data () + k * s : nullptr, n);
+  }
+  std::vector<double, Eigen::aligned_allocator<double>> storage_;
 };
 
 /** \brief How one solve went. */
