@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <random>
 #include <vector>
@@ -146,4 +147,48 @@ TEST (RffSeparatorSolver, AStiffNewtonSolveStopsAtRounding)
   EXPECT_LE (stiff.standard_iterations, 30);
   EXPECT_GE (stiff.standard_objective, soft.standard_objective * (1.0 - 1e-9));
   EXPECT_LE (stiff.standard_objective, soft.standard_objective * 1.001);
+}
+
+// The leaf problem's columns (what every rung reads): n values each, aligned as an
+// Eigen::ArrayXd, apart from each other, the buffer kept when a problem shrinks (classify()
+// reuses one per thread) and freed by releaseAbove(); a copy owns its own values.
+TEST (SeparatorProblem, ColumnsFollowResizeWithoutReallocatingWhenSmaller)
+{
+  SeparatorProblem p;
+  const auto columns = [] (SeparatorProblem& q) {
+    return std::vector<SeparatorProblem::Column*> {&q.x, &q.y, &q.z, &q.sxx, &q.sxy, &q.sxz,
+                                                   &q.syy, &q.syz, &q.szz, &q.label, &q.weight};
+  };
+  const auto check = [&] (SeparatorProblem& q, Eigen::Index n) {
+    for (SeparatorProblem::Column* c : columns (q))
+    {
+      EXPECT_EQ (c->size (), n);
+      EXPECT_EQ (reinterpret_cast<std::uintptr_t> (c->data ()) % EIGEN_MAX_ALIGN_BYTES, 0u);
+    }
+    // Every column written with its own value, then read back: no two overlap.
+    double v = 1.0;
+    for (SeparatorProblem::Column* c : columns (q))
+      c->setConstant (v++);
+    v = 1.0;
+    for (SeparatorProblem::Column* c : columns (q))
+      EXPECT_TRUE ((*c == v++).all ());
+  };
+  p.resize (37);
+  check (p, 37);
+  const double* before = p.x.data ();
+  p.resize (5);
+  check (p, 5);
+  EXPECT_EQ (p.x.data (), before);  // the buffer was kept
+  const SeparatorProblem copy = p;
+  p.x.setConstant (-1.0);
+  EXPECT_EQ (copy.x.size (), 5);
+  EXPECT_TRUE ((copy.x == 1.0).all ());
+  EXPECT_NE (copy.x.data (), p.x.data ());
+  p.resize (40);
+  check (p, 40);
+  p.releaseAbove (1);
+  EXPECT_EQ (p.n, 0);
+  EXPECT_EQ (p.x.size (), 0);
+  p.resize (3);
+  check (p, 3);
 }

@@ -946,3 +946,41 @@ TEST (RobustClassifier, AKernelSolveStalledAtRoundingStops)
   // The P of the solve run to its cap (the stop changes theta only in its last bits).
   EXPECT_NEAR (r.probability, 1.84076e-09, 1e-14);
 }
+
+// classify() keeps one leaf problem per thread between calls (its buffer reused when a problem
+// is smaller, freed above 512 KB): a pair answered after larger and much larger ones, on the
+// same thread, gets the answer it gets on a fresh thread, bit for bit.
+TEST (RobustClassifier, AProblemReusedAfterLargerOnesGivesTheSameAnswer)
+{
+  Cloud small_a, small_b;
+  genericPatches (small_a, small_b);
+  const Cloud large_a = plane (0.0, 0.01), large_b = plane (0.02, 0.01);  // 441 points each
+  Cloud huge_a, huge_b;  // 6,000 points: above the kept buffer
+  bowl (3000, 0.01, huge_a, huge_b);
+  ASSERT_GT (huge_a.size () + huge_b.size (), 5900u);
+  const ClassifierParams params;  // the default Ladder
+  ClassifierParams plane_only;     // the huge pair with the plane rung alone (the buffer is the same)
+  plane_only.kernel = KernelMode::Linear;
+  const auto fresh = [&] {
+    ClassifierResult r;
+    std::thread ([&] { r = classify (params, small_a, small_b); }).join ();
+    return r;
+  };
+  const ClassifierResult first = fresh ();
+  ClassifierResult after_large, after_huge;
+  std::thread ([&] {
+    classify (params, large_a, large_b);
+    after_large = classify (params, small_a, small_b);
+    classify (plane_only, huge_a, huge_b);
+    after_huge = classify (params, small_a, small_b);
+  }).join ();
+  for (const ClassifierResult* r : {&after_large, &after_huge})
+  {
+    EXPECT_EQ (r->probability, first.probability);
+    EXPECT_EQ (r->probabilities_a, first.probabilities_a);
+    EXPECT_EQ (r->probabilities_b, first.probabilities_b);
+    EXPECT_EQ (r->rung, first.rung);
+    EXPECT_EQ (r->iterations, first.iterations);
+    EXPECT_EQ (r->witness_distance, first.witness_distance);
+  }
+}
