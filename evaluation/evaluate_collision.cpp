@@ -396,7 +396,8 @@ sharedBuild (bool surface_calibrated)
   b.model = OursSetting ().model;
   b.model.surface = true;
   for (const OursSetting& s : oursSettings (false))
-    if (s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled")
+    if (s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
+        s.name == "ladder")
     {
       pcl_probcollision::CloudModelParams m = s.model;
       m.surface = true;
@@ -1130,6 +1131,7 @@ issue16Targets (const Options& o, const std::vector<Summary>& summaries, const R
   {
     oursTargets ("surface");
     oursTargets ("pooled");
+    oursTargets ("ladder");
   }
   // The README demo through pcd_collision, without and with -surface. No comma in these rows:
   // scripts/evaluate.sh rewrites them with pcd_collision's answers.

@@ -50,6 +50,10 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   OursSetting pooled = surface;
   pooled.name = "pooled";
   pooled.request.surface_pooled = true;
+  // The ladder: the separators first, the surface layer where they leave the answer open.
+  OursSetting ladder = surface;
+  ladder.name = "ladder";
+  ladder.request.surface_ladder = true;
   OursSetting other = classifier;
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
@@ -57,6 +61,7 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (classifier);
   s.push_back (surface);
   s.push_back (pooled);
+  s.push_back (ladder);
   s.push_back (other);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
   // noise is at least the local sample spacing ("gate<c>"), or the hierarchy not split within

@@ -62,8 +62,10 @@ struct OursSetting
   * the surface layer on ("surface": both true), the paper's model ("max": measured positions,
   * separators alone), then one change at a time from the defaults. One of classifier and
   * surface answers as default does (the surface layer is off by default while experimental).
-  * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled).
-  * full = false keeps default, classifier, surface, pooled and max. Each c of merge adds "merge<c>"
+  * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled),
+  * "ladder" the separators first and the surface layer where they leave the answer open
+  * (CollisionRequest::surface_ladder). full = false keeps default, classifier, surface, pooled,
+  * ladder and max. Each c of merge adds "merge<c>"
   * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c;
   * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
   * (ResolutionGate::WhereNoiseExceedsSpacing); each c of stop "stop<c>" and "surface-stop<c>",

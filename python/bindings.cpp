@@ -799,6 +799,8 @@ PYBIND11_MODULE (_core, m)
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
       "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental);\n"
+      "surface_ladder: with surface, the separators first and the surface layer only where they leave the answer\n"
+      "open (experimental; excludes surface_pooled);\n"
       "surface_calibrated: with surface, P in [0.1, 0.9] through the calibration map fitted on the evaluation's\n"
       "procedural scenes (default False: the model's raw P);\n"
       "distance: beyond the query's reach, signed_distance is the distance between the nearest samples\n"
@@ -806,7 +808,7 @@ PYBIND11_MODULE (_core, m)
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
-                          bool surface_pooled, bool surface_calibrated, bool distance) {
+                          bool surface_pooled, bool surface_ladder, bool surface_calibrated, bool distance) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -821,6 +823,7 @@ PYBIND11_MODULE (_core, m)
               r.max_leaf_fits = max_leaf_fits;
               r.surface = surface;
               r.surface_pooled = surface_pooled;
+              r.surface_ladder = surface_ladder;
               r.surface_calibrated = surface_calibrated;
               r.distance = distance;
               return r;
@@ -831,6 +834,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
             py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
+            py::arg ("surface_ladder") = dr.surface_ladder,
             py::arg ("surface_calibrated") = dr.surface_calibrated, py::arg ("distance") = dr.distance,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
@@ -849,6 +853,10 @@ PYBIND11_MODULE (_core, m)
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
                       "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).")
+      .def_readwrite ("surface_ladder", &CollisionRequest::surface_ladder,
+                      "With surface: the separators first; the surface layer where they reached a leaf pair and found\n"
+                      "no sure collision, alone in the contact band, pooled with them where they read free\n"
+                      "(experimental, default False; excludes surface_pooled).")
       .def_readwrite ("surface_calibrated", &CollisionRequest::surface_calibrated,
                       "With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's "
                       "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.")
@@ -868,6 +876,7 @@ PYBIND11_MODULE (_core, m)
                ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
                ", surface=" + (r.surface ? "True" : "False") +
                ", surface_pooled=" + (r.surface_pooled ? "True" : "False") +
+               ", surface_ladder=" + (r.surface_ladder ? "True" : "False") +
                ", surface_calibrated=" + (r.surface_calibrated ? "True" : "False") +
                ", distance=" + (r.distance ? "True" : "False") + ")";
       });

@@ -74,12 +74,12 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
   "$out/summary.csv" >> "$out/summary.md"
 
 # Reliability tables per workload (W1 dense, W1-sparse, W2, W3) and noise level, ours default,
-# classifier, surface and pooled: the near band for W1 and W2, every query for W3 (against "listed as not
+# classifier, surface, pooled and ladder: the near band for W1 and W2, every query for W3 (against "listed as not
 # free").
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
                    print "| workload | noise | setting | band | bin | mean P | observed | count | tolerance | check |";
                    print "|---|---|---|---|---|---|---|---|---|---|"; next }
-         $c["method"] == "ours" && ($c["setting"] == "default" || $c["setting"] == "classifier" || $c["setting"] == "surface" || $c["setting"] == "pooled") && $c["count"] > 0 &&
+         $c["method"] == "ours" && ($c["setting"] == "default" || $c["setting"] == "classifier" || $c["setting"] == "surface" || $c["setting"] == "pooled" || $c["setting"] == "ladder") && $c["count"] > 0 &&
          ($c["band"] == "near_sigma" || ($c["workload"] == "W3" && $c["band"] == "all")) {
            check = $c["judged"] == 1 ? ($c["within"] == 1 ? "within" : "**outside**") : "-"
            printf "| %s | %s | %s | %s | [%s, %s) | %.3f | %.3f | %s | %.3f | %s |\n", $c["workload"], $c["noise_pct"],

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace pcl_probcollision
@@ -144,15 +145,11 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   result.verdict = verdictFor (result.probability, request);
   return true;
 }
-/** \brief The surface layer's answer (into) pooled with the separators' on the same pair
-  * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
-  * reached it (else the one that did); the surface layer's distance and witness (the
-  * separators' when the surface layer reached nothing); the work of both counted. */
+/** \brief The separators' share of a combined answer: their work counted in into, their
+  * witness where the surface layer has none. */
 void
-pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request)
+addSeparators (CollisionResult& into, const CollisionResult& separators)
 {
-  into.probability = 0.5 * (into.probability + separators.probability);
-  into.lower_bound = into.lower_bound || separators.lower_bound;
   into.budget_exhausted = into.budget_exhausted || separators.budget_exhausted;
   into.no_leaf_tested = into.no_leaf_tested && separators.no_leaf_tested;
   if (into.witness_side == 0 && separators.witness_side != 0)
@@ -167,6 +164,18 @@ pool (CollisionResult& into, const CollisionResult& separators, const CollisionR
   into.kernel_leaf_pairs = separators.kernel_leaf_pairs;
   into.degenerate_leaf_pairs = separators.degenerate_leaf_pairs;
   into.classifier_iterations = separators.classifier_iterations;
+}
+
+/** \brief The surface layer's answer (into) pooled with the separators' on the same pair
+  * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
+  * reached it (else the one that did); the surface layer's distance and witness (the
+  * separators' when the surface layer reached nothing); the work of both counted. */
+void
+pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request)
+{
+  into.probability = 0.5 * (into.probability + separators.probability);
+  into.lower_bound = into.lower_bound || separators.lower_bound;
+  addSeparators (into, separators);
   auto mean = [] (std::vector<float>& values, const std::vector<float>& other) {
     for (std::size_t i = 0; i < values.size () && i < other.size (); ++i)
       values[i] = std::isnan (values[i]) ? other[i] : std::isnan (other[i]) ? values[i] : 0.5f * (values[i] + other[i]);
@@ -248,24 +257,52 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   // The surface layer answers when both models carry a surface; otherwise (or with
   // request.surface off) the separators do, as in the paper.
   const bool surface = request.surface && !a.surface ().empty () && !b.surface ().empty ();
-  if (surface ? !collideSurface (a, b, T_local, request, result)
-              : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
-    return false;
-  if (surface && request.surface_pooled)
+  // Whose answer stands: the surface layer's (alone or pooled) or the separators'.
+  bool from_surface = surface, pooled = surface && request.surface_pooled;
+  if (surface && request.surface_ladder)
   {
+    // The ladder (CollisionRequest::surface_ladder): the separators first; the surface layer
+    // where they reached a leaf pair and found no sure collision.
     CollisionResult separators;
     if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, separators, classifier))
     {
       result = separators;
       return false;
     }
-    pool (result, separators, request);
+    from_surface = !separators.no_leaf_tested && !(separators.probability > request.collision_above);
+    if (!from_surface)
+      result = std::move (separators);
+    else
+    {
+      if (!collideSurface (a, b, T_local, request, result))
+        return false;
+      pooled = separators.probability < request.free_below;
+      if (pooled)
+        pool (result, separators, request);
+      else
+        addSeparators (result, separators);
+    }
   }
-  if (surface && request.surface_calibrated)
+  else
+  {
+    if (surface ? !collideSurface (a, b, T_local, request, result)
+                : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
+      return false;
+    if (pooled)
+    {
+      CollisionResult separators;
+      if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, separators, classifier))
+      {
+        result = separators;
+        return false;
+      }
+      pool (result, separators, request);
+    }
+  }
+  if (from_surface && request.surface_calibrated)
   {
     result.probability = detail::calibratedSurfaceProbability (
-        result.probability, request.surface_pooled ? detail::SurfaceCalibration::Pooled
-                                                   : detail::SurfaceCalibration::SurfaceLayer);
+        result.probability, pooled ? detail::SurfaceCalibration::Pooled : detail::SurfaceCalibration::SurfaceLayer);
     result.verdict = verdictFor (result.probability, request);
   }
 

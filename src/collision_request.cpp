@@ -25,6 +25,10 @@ CollisionRequest::validate () const
   if (traversal != TraversalMode::ExpectedWeight && traversal != TraversalMode::Stochastic &&
       traversal != TraversalMode::ExpandedBV)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "traversal mode " << static_cast<int> (traversal) << " is unknown");
+  if (surface_pooled && surface_ladder)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         where << "surface_pooled and surface_ladder exclude each other: pick one way to combine the "
+                                  "surface layer with the separators");
   classifier.validate ();
 }
 
@@ -35,7 +39,8 @@ CollisionRequest::operator== (const CollisionRequest& o) const
          per_point == o.per_point && enable_timings == o.enable_timings && traversal == o.traversal &&
          rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && classifier == o.classifier &&
          defer_kernel_fits == o.defer_kernel_fits && max_leaf_fits == o.max_leaf_fits && surface == o.surface &&
-         surface_pooled == o.surface_pooled && surface_calibrated == o.surface_calibrated && distance == o.distance;
+         surface_pooled == o.surface_pooled &&
+         surface_ladder == o.surface_ladder && surface_calibrated == o.surface_calibrated && distance == o.distance;
 }
 
 const char*

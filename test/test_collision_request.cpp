@@ -85,6 +85,28 @@ TEST (CollisionRequest, ValidateNamesTheMemberOutOfRangeAndItsValue)
   }
 }
 
+// The two ways of combining the surface layer with the separators exclude each other; either
+// alone is accepted.
+TEST (CollisionRequest, ValidateRefusesPooledWithLadder)
+{
+  CollisionRequest r;
+  r.surface = r.surface_pooled = r.surface_ladder = true;
+  try
+  {
+    r.validate ();
+    FAIL () << "surface_pooled with surface_ladder did not throw";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("surface_pooled and surface_ladder"), std::string::npos) << e.what ();
+  }
+  r.surface_pooled = false;
+  EXPECT_NO_THROW (r.validate ());
+  r.surface_pooled = true;
+  r.surface_ladder = false;
+  EXPECT_NO_THROW (r.validate ());
+}
+
 TEST (CollisionRequest, ValidateMessageCarriesTheMethodPrefix)
 {
   CollisionRequest r;
@@ -161,6 +183,7 @@ TEST (CollisionRequest, EqualityComparesEveryMember)
       {"max_leaf_fits", [] (CollisionRequest& r) { r.max_leaf_fits = 7; }},
       {"surface", [] (CollisionRequest& r) { r.surface = true; }},
       {"surface_pooled", [] (CollisionRequest& r) { r.surface_pooled = true; }},
+      {"surface_ladder", [] (CollisionRequest& r) { r.surface_ladder = true; }},
       {"surface_calibrated", [] (CollisionRequest& r) { r.surface_calibrated = true; }},
       {"distance", [] (CollisionRequest& r) { r.distance = true; }},
       {"classifier.C", [] (CollisionRequest& r) { r.classifier.C = 10.0; }},

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <random>
 
 using namespace pcl_probcollision;
@@ -515,6 +516,83 @@ TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
         EXPECT_FLOAT_EQ (rp.probabilities_a[i], expected) << "point " << i << " at z = " << z;
     }
   }
+}
+
+// The ladder (CollisionRequest::surface_ladder) answers as one of its rungs: the separators'
+// answer where they reached no leaf pair or read collision; otherwise the surface layer's, alone
+// where the separators read contact and pooled with theirs where they read free. A plate over,
+// touching and under a scanned table (the space under a scanned sheet is occupied), and upright
+// through it, in decision mode as a planner asks.
+TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  std::vector<Eigen::Isometry3d> poses;
+  for (double z = -0.01; z <= 0.0301; z += 0.001)
+    poses.push_back (shift (0.0, 0.0, z));
+  Eigen::Isometry3d upright = shift (0.0, 0.0, 0.0);
+  upright.rotate (Eigen::AngleAxisd (0.5 * M_PI, Eigen::Vector3d::UnitX ()));
+  poses.push_back (upright);
+  int far = 0, sure = 0, contact = 0, free = 0;
+  for (const Eigen::Isometry3d& T : poses)
+  {
+    SCOPED_TRACE ("pose z = " + std::to_string (T.translation ().z ()));
+    CollisionRequest surface = surfaceRequest ();
+    surface.exhaustive = false;
+    surface.per_point = true;
+    CollisionRequest separators = surface;
+    separators.surface = false;
+    CollisionRequest pooled = surface;
+    pooled.surface_pooled = true;
+    CollisionRequest ladder = surface;
+    ladder.surface_ladder = true;
+    CollisionResult rs, rc, rp, rl;
+    ASSERT_TRUE (collide (*plate, *table, T, surface, rs));
+    ASSERT_TRUE (collide (*plate, *table, T, separators, rc));
+    ASSERT_TRUE (collide (*plate, *table, T, pooled, rp));
+    ASSERT_TRUE (collide (*plate, *table, T, ladder, rl));
+    const CollisionResult* expected = nullptr;
+    if (rc.no_leaf_tested || rc.probability > ladder.collision_above)
+    {
+      (rc.no_leaf_tested ? far : sure) += 1;
+      expected = &rc;
+      EXPECT_TRUE (std::isnan (rl.signed_distance));
+    }
+    else if (rc.probability >= ladder.free_below)
+    {
+      ++contact;
+      expected = &rs;
+    }
+    else
+    {
+      ++free;
+      expected = &rp;
+    }
+    EXPECT_DOUBLE_EQ (rl.probability, expected->probability);
+    EXPECT_EQ (rl.verdict, expected->verdict);
+    if (!std::isnan (expected->signed_distance))
+    {
+      EXPECT_EQ (rl.signed_distance, expected->signed_distance);
+    }
+    ASSERT_EQ (rl.probabilities_a.size (), expected->probabilities_a.size ());
+    for (std::size_t i = 0; i < rl.probabilities_a.size (); ++i)
+    {
+      if (std::isnan (expected->probabilities_a[i]))
+      {
+        EXPECT_TRUE (std::isnan (rl.probabilities_a[i])) << "point " << i;
+      }
+      else
+      {
+        EXPECT_FLOAT_EQ (rl.probabilities_a[i], expected->probabilities_a[i]) << "point " << i;
+      }
+    }
+    // The work of every rung it ran is counted.
+    EXPECT_GE (rl.bv_tests, rc.bv_tests);
+  }
+  std::cout << "[ ladder ] rungs: far " << far << ", separators sure " << sure << ", contact band " << contact
+            << ", free after a fit " << free << "\n";
+  EXPECT_GT (far, 0);
+  EXPECT_GT (contact, 0);
 }
 
 // The calibration map (CollisionRequest::surface_calibrated) moves the pair's P inside the

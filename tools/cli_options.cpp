@@ -42,7 +42,7 @@ const std::set<std::string> kValueFlags = {
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
   "-noise_stop", "-max_leaf_fits"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
-                                            "-measured", "-surface", "-surface_pooled", "-surface_calibrated", "-distance", "-ignore_normals",
+                                            "-measured", "-surface", "-surface_pooled", "-surface_ladder", "-surface_calibrated", "-distance", "-ignore_normals",
                                             "-v"};
 
 ParseResult
@@ -291,6 +291,8 @@ parseCommandLine (const std::vector<std::string>& args)
         o.surface = true;
       else if (a == "-surface_pooled")
         o.surface = o.surface_pooled = true;
+      else if (a == "-surface_ladder")
+        o.surface = o.surface_ladder = true;
       else if (a == "-surface_calibrated")
         o.surface_calibrated = true;
       else if (a == "-distance")
@@ -465,6 +467,8 @@ parseCommandLine (const std::vector<std::string>& args)
     return usage ("option -o writes one query's result and cannot be combined with -poses");
   if (deterministic && o.stochastic)
     return usage ("options -deterministic and -stochastic cannot be combined");
+  if (o.surface_pooled && o.surface_ladder)
+    return usage ("options -surface_pooled and -surface_ladder cannot be combined");
   // -sensor sets both inputs, -sensor_a / -sensor_b one each whatever the order; likewise the
   // sigmas, which only an isotropic input uses.
   o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
@@ -563,6 +567,9 @@ helpText ()
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
        "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"
+       "  -surface_ladder -surface only where the separators leave it open: their answer where they\n"
+       "                  reach nothing or read collision, else the surface layer's (pooled with\n"
+       "                  theirs where they read free); experimental\n"
        "  -surface_calibrated  with -surface: P in [0.1, 0.9] through the calibration map fitted on\n"
        "                  the evaluation's procedural scenes (rankings and verdicts at 0.1,0.9\n"
        "                  unchanged; off by default: it does not carry over to other scenes)\n"

@@ -47,6 +47,7 @@ struct Defaults
   static inline const int n_noise_max = model.hierarchy.n_noise_max;
   static inline const bool surface = request.surface;
   static inline const bool surface_pooled = request.surface_pooled;
+  static inline const bool surface_ladder = request.surface_ladder;
   static inline const bool surface_calibrated = request.surface_calibrated;
   static inline const bool distance = request.distance;
   static inline const bool measured = !model.surface_projection;
@@ -110,6 +111,8 @@ struct Options
   bool surface = Defaults::surface;
   /** \brief -surface_pooled: the surface layer pooled with the separators (implies -surface). */
   bool surface_pooled = Defaults::surface_pooled;
+  /** \brief -surface_ladder: CollisionRequest::surface_ladder (implies -surface). */
+  bool surface_ladder = Defaults::surface_ladder;
   /** \brief -surface_calibrated: CollisionRequest::surface_calibrated. */
   bool surface_calibrated = Defaults::surface_calibrated;
   /** \brief -distance: CollisionRequest::distance (the nearest samples' distance beyond reach). */

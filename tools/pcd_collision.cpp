@@ -244,6 +244,7 @@ requestFor (const Options& o)
   r.defer_kernel_fits = o.defer_kernel_fits;
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
+  r.surface_ladder = o.surface_ladder;
   r.surface_calibrated = o.surface_calibrated;
   r.distance = o.distance;
   r.per_point = o.output.has_value ();
@@ -393,6 +394,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("noise_stop").number (o.noise_stop);
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);
+  j.key ("surface_ladder").boolean (rq.surface_ladder);
   j.key ("surface_calibrated").boolean (rq.surface_calibrated);
   j.key ("distance").boolean (rq.distance);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;

@@ -83,6 +83,17 @@ struct CollisionRequest
     * stays the surface layer's. Experimental, off by default; the rule was chosen on evaluation
     * runs with seeds other than the reported one (docs/SURFACE.md). */
   bool surface_pooled = false;
+  /** \brief With surface on: a ladder, the separators first and the surface layer only where they
+    * leave the answer open. The separators' answer stands where they reached no leaf pair (the
+    * objects apart) or found P above collision_above (they see two sheets crossing, which the
+    * surface layer cannot where the noise is as thick as the parts). Otherwise the surface
+    * layer runs too, and answers alone where the separators' P lies in the contact band (they
+    * cannot tell a touch from a part through a single scanned sheet: the README demo's 2 cm
+    * penetration), or pooled with them as surface_pooled does where they answered free (between
+    * sparse samples a part can pass unseen by the separators). Most free poses then cost the
+    * separators alone. The rule was chosen on evaluation runs with seeds other than the reported
+    * one (docs/SURFACE.md, "The ladder"); experimental, off by default. Excludes surface_pooled. */
+  bool surface_ladder = false;
   /** \brief With surface on: P (the surface layer's, or the pool's) goes through a calibration
     * map inside the default contact band [0.1, 0.9]: strictly increasing, onto the band, the
     * identity outside it, so rankings and the default thresholds' verdicts are kept. The maps

@@ -82,12 +82,15 @@ class CollisionRequest:
     max_leaf_fits: int
     surface: bool
     surface_pooled: bool
+    surface_ladder: bool
     surface_calibrated: bool
+    distance: bool
     def __init__(self, *, free_below: float = ..., collision_above: float = ..., exhaustive: bool = ...,
                  per_point: bool = ..., enable_timings: bool = ..., traversal: TraversalMode = ...,
                  rho_min: float = ..., seed: int = ..., expanded_k_sigma: float = ...,
                  defer_kernel_fits: bool = ..., max_leaf_fits: int = ..., surface: bool = False,
-                 surface_pooled: bool = False, surface_calibrated: bool = False) -> None: ...
+                 surface_pooled: bool = False, surface_ladder: bool = False,
+                 surface_calibrated: bool = False, distance: bool = False) -> None: ...
     def validate(self) -> None: ...
 
 class CollisionResult:

@@ -347,6 +347,33 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
     assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
 
 
+def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):
+    # CollisionRequest.surface_ladder: the separators' answer where they reached nothing or read
+    # collision, else the surface layer's, alone in the contact band and pooled where they read
+    # free. Over a sweep through contact at least two of the rungs answer.
+    _, _, A, B = sheets
+    rungs = set()
+    for z in np.linspace(-0.004, 0.03, 18):
+        T = translation(0.005, -0.003, z)
+        separators = pc.collide(A, B, T)
+        surface = pc.collide(A, B, T, pc.CollisionRequest(surface=True))
+        pooled = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_pooled=True))
+        ladder = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_ladder=True))
+        if separators.no_leaf_tested or separators.probability > 0.9:
+            expected, rung = separators, "separators"
+        elif separators.probability >= 0.1:
+            expected, rung = surface, "surface"
+        else:
+            expected, rung = pooled, "pooled"
+        rungs.add(rung)
+        assert ladder.probability == expected.probability, (z, rung)
+        assert ladder.verdict == expected.verdict
+    assert len(rungs) >= 2, rungs
+    assert "surface_ladder=True" in repr(pc.CollisionRequest(surface=True, surface_ladder=True))
+    with pytest.raises(ValueError, match="surface_pooled and surface_ladder"):
+        pc.CollisionRequest(surface=True, surface_pooled=True, surface_ladder=True).validate()
+
+
 def test_distance_request_gives_the_nearest_samples_beyond_reach(sheets):
     # CollisionRequest.distance: beyond reach, signed_distance is the distance between the two
     # clouds' nearest samples (brute force here), nearest_point_a/_b those samples in A's frame.

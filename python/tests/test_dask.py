@@ -197,6 +197,7 @@ def cli_inputs(tmp_path_factory, table_points):
     ["-sensor_b", "kinect", "-k", "12", "-thresholds=0.2,0.8", "-exhaustive", "-nmax", "16", "-split", "octree"],
     ["-sigma", "0.0015", "-surface"],
     ["-sigma", "0.0015", "-surface_pooled"],
+    ["-sigma", "0.0015", "-surface_ladder"],
     ["-sigma", "0.0015", "-surface", "-surface_calibrated"],
     ["-sigma", "0.0015", "-distance"],
 ])
@@ -217,12 +218,19 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     assert all(isinstance(a["unobserved"], bool) for a in answers)  # never null
     assert all(a["parameters"]["surface_pooled"] == ("-surface_pooled" in flags) for a in answers)
     assert all(a["parameters"]["surface_calibrated"] == ("-surface_calibrated" in flags) for a in answers)
+    assert all(a["parameters"]["surface_ladder"] == ("-surface_ladder" in flags) for a in answers)
     assert all(a["parameters"]["distance"] == ("-distance" in flags) for a in answers)
     # -distance: the nearest samples' distance exactly where the query reached nothing.
     assert [a["sample_distance"] for a in answers] == [
         "-distance" in flags and a["no_leaf_tested"] and a["signed_distance"] is not None for a in answers]
     assert ("-distance" in flags) == any(a["sample_distance"] for a in answers)
-    if "-surface" in flags or "-surface_pooled" in flags:
+    if "-surface_ladder" in flags:
+        # The separators' answer stands where they reached nothing (no distance there); the
+        # surface layer's distance where they reached a leaf pair and found no sure collision.
+        assert all(a["parameters"]["surface"] for a in answers)
+        assert all(a["signed_distance"] is None for a in answers if a["no_leaf_tested"])
+        assert any(d is not None for d in distances)
+    elif "-surface" in flags or "-surface_pooled" in flags:
         assert all(a["parameters"]["surface"] for a in answers)
         assert sum(d is not None for d in distances) >= 10
         assert any(d is not None and d < 0 for d in distances)

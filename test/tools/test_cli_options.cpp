@@ -126,6 +126,19 @@ TEST (CliOptions, SurfacePooledImpliesSurface)
   expectUsageError ({"-ignore_normals=1"}, "-ignore_normals");
 }
 
+// -surface_ladder implies -surface and cannot be combined with -surface_pooled.
+TEST (CliOptions, SurfaceLadderImpliesSurfaceAndExcludesPooled)
+{
+  EXPECT_FALSE (parse ({}).options.surface_ladder);
+  const ParseResult ladder = parse ({"-surface_ladder"});
+  ASSERT_EQ (ladder.kind, Kind::Run) << ladder.error;
+  EXPECT_TRUE (ladder.options.surface);
+  EXPECT_TRUE (ladder.options.surface_ladder);
+  EXPECT_FALSE (ladder.options.surface_pooled);
+  expectUsageError ({"-surface_pooled", "-surface_ladder"}, "-surface_pooled and -surface_ladder");
+  expectUsageError ({"-surface_ladder=1"}, "-surface_ladder");
+}
+
 TEST (CliOptions, Help)
 {
   EXPECT_EQ (parse ({"-h"}, false).kind, Kind::Help);

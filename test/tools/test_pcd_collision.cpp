@@ -441,6 +441,38 @@ TEST_F (PcdCollisionTool, AStoppedQueryNamesItsDistanceTheFirstDecidingPoint)
   EXPECT_NEAR (full[2]["signed_distance"].number, -0.02, 3.0 * full[2]["signed_distance_std"].number + 0.002);
 }
 
+// -surface_ladder on the README demo: the clear pose is the separators' alone (no leaf pair
+// reached, no distance), the touching and the penetrating poses, which the separators leave in
+// the contact band, go to the surface layer, and the 2 cm penetration reads collision; the
+// parameters say which combination ran.
+TEST_F (PcdCollisionTool, SurfaceLadderAnswersTheDemoPenetrationAsCollision)
+{
+  const auto plain = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string ()});
+  const auto ladder = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface_ladder"});
+  const auto surface = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface"});
+  ASSERT_EQ (plain.size (), 3u);
+  ASSERT_EQ (ladder.size (), 3u);
+  ASSERT_EQ (surface.size (), 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    SCOPED_TRACE ("pose " + std::to_string (i));
+    EXPECT_TRUE (ladder[i]["parameters"]["surface"].boolean);
+    EXPECT_TRUE (ladder[i]["parameters"]["surface_ladder"].boolean);
+    EXPECT_FALSE (ladder[i]["parameters"]["surface_pooled"].boolean);
+    EXPECT_FALSE (plain[i]["parameters"]["surface_ladder"].boolean);
+  }
+  EXPECT_EQ (ladder[0]["verdict"].text, "free");
+  EXPECT_EQ (ladder[0]["probability"].number, plain[0]["probability"].number);
+  EXPECT_EQ (ladder[0]["signed_distance"].type, Value::Type::Null);
+  // The separators leave the penetration in the contact band; the ladder hands it on.
+  EXPECT_EQ (plain[2]["verdict"].text, "contact");
+  EXPECT_EQ (ladder[2]["verdict"].text, "collision");
+  EXPECT_EQ (ladder[2]["probability"].number, surface[2]["probability"].number);
+  ASSERT_EQ (ladder[2]["signed_distance"].type, Value::Type::Number);
+  EXPECT_LT (ladder[2]["signed_distance"].number, 0.0);
+  EXPECT_GE (ladder[2]["leaf_pairs"].number, plain[2]["leaf_pairs"].number);
+}
+
 // -distance: beyond the query's reach, the distance between the two inputs' nearest samples,
 // with both points in b's frame (JSON) and the marker "(nearest samples)" (human line); near
 // contact nothing changes. Without the flag, sample_distance is false and nearest_points null.

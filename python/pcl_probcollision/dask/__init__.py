@@ -64,6 +64,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "surface": _REQUEST.surface,
     # The surface layer pooled with the separators (the mean of the two P); implies surface.
     "surface_pooled": _REQUEST.surface_pooled,
+    # The separators first, the surface layer only where they leave the answer open
+    # (pcd_collision's -surface_ladder); implies surface, excludes surface_pooled.
+    "surface_ladder": _REQUEST.surface_ladder,
     # With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's
     # procedural scenes (pcd_collision's -surface_calibrated; off: the model's raw P).
     "surface_calibrated": _REQUEST.surface_calibrated,
@@ -97,7 +100,9 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
         raise TypeError(f"unknown option(s) {', '.join(unknown)}; expected some of {', '.join(OPTION_NAMES)}")
     o = dict(DEFAULT_OPTIONS)
     o.update({k: v for k, v in options.items()})
-    o["surface"] = bool(o["surface"] or o["surface_pooled"])
+    o["surface"] = bool(o["surface"] or o["surface_pooled"] or o["surface_ladder"])
+    if o["surface_pooled"] and o["surface_ladder"]:
+        raise ValueError("options surface_pooled and surface_ladder cannot be combined")
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
@@ -152,7 +157,8 @@ def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
         traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
         seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), defer_kernel_fits=bool(o["defer_kernel_fits"]),
         surface=bool(o["surface"]),
-        surface_pooled=bool(o["surface_pooled"]), surface_calibrated=bool(o["surface_calibrated"]),
+        surface_pooled=bool(o["surface_pooled"]), surface_ladder=bool(o["surface_ladder"]),
+        surface_calibrated=bool(o["surface_calibrated"]),
         distance=bool(o["distance"]))
 
 
