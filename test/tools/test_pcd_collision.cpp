@@ -12,6 +12,8 @@
 
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <pty.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -1052,6 +1054,64 @@ TEST_F (PcdCollisionTool, NormalRunsPrintOnlyStageLinesOnStderr)
       EXPECT_EQ (lowercase (l).find ("warn"), std::string::npos) << l;
     }
   }
+}
+
+// On a terminal a build that takes a while shows "Building <file> ... N s" on stderr, erased
+// before the build's stage line; through a pipe nothing but the stage lines (docs/CLI.md).
+TEST_F (PcdCollisionTool, OnATerminalALongBuildShowsItsElapsedTime)
+{
+  // 250,000 points on one thread: a build of one to two seconds (the line appears at 0.2 s).
+  const fs::path plane = dir_ / "plane.pcd";
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (int i = 0; i < 500; ++i)
+    for (int j = 0; j < 500; ++j)
+      cloud.push_back (pcl::PointXYZ (0.002f * static_cast<float> (i), 0.002f * static_cast<float> (j),
+                                      0.0015f * std::sin (0.7f * static_cast<float> (i)) * std::cos (1.3f * static_cast<float> (j))));
+  ASSERT_EQ (pcl::io::savePCDFileBinary (plane.string (), cloud), 0);
+  const std::vector<std::string> args = {kGripper.string (), plane.string (), "-pose", "0.5,0.5,0.3,0,0,0", "-threads", "1"};
+
+  int terminal = -1;
+  const pid_t pid = ::forkpty (&terminal, nullptr, nullptr, nullptr);
+  ASSERT_GE (pid, 0) << std::strerror (errno);
+  if (pid == 0)
+  {
+    std::vector<std::string> words = args;
+    words.insert (words.begin (), kExe);
+    std::vector<char*> argv;
+    for (std::string& w : words)
+      argv.push_back (w.data ());
+    argv.push_back (nullptr);
+    ::execv (kExe.c_str (), argv.data ());
+    ::_exit (127);
+  }
+  std::string shown;
+  char buffer[4096];
+  for (ssize_t got; (got = ::read (terminal, buffer, sizeof buffer)) > 0;)
+    shown.append (buffer, static_cast<std::size_t> (got));
+  int w = 0;
+  ASSERT_EQ (::waitpid (pid, &w, 0), pid);
+  ::close (terminal);
+  ASSERT_TRUE (WIFEXITED (w));
+  EXPECT_EQ (WEXITSTATUS (w), 0) << shown;
+  const std::string line = "\rBuilding " + plane.string () + " ... ";
+  const std::size_t at = shown.find (line);
+  ASSERT_NE (at, std::string::npos) << shown;
+  std::size_t end = at + line.size ();
+  while (end < shown.size () && std::isdigit (static_cast<unsigned char> (shown[end])))
+    ++end;
+  EXPECT_GT (end, at + line.size ()) << shown;  // the seconds
+  EXPECT_EQ (shown.compare (end, 2, " s"), 0) << shown;
+  const std::size_t erased = shown.find ("\r\033[K", at);
+  const std::size_t done = shown.find ("Building " + plane.string () + " [done, ");
+  ASSERT_NE (erased, std::string::npos) << shown;
+  ASSERT_NE (done, std::string::npos) << shown;
+  EXPECT_LT (erased, done) << shown;
+
+  // Through a pipe the same run prints its stage lines alone.
+  const ToolRun r = run (args);
+  ASSERT_EQ (r.status, 0) << r.err;
+  EXPECT_EQ (r.err.find ('\r'), std::string::npos) << r.err;
+  EXPECT_NE (r.err.find ("Building " + plane.string () + " [done, "), std::string::npos) << r.err;
 }
 
 // -sensor_a / -sensor_b give each cloud its own noise model; -sensor sets both.
