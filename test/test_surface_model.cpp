@@ -101,6 +101,26 @@ surfaceRequest ()
   return r;
 }
 
+/** \brief The same query as each way of answering it: the surface layer (per point, exhaustive
+  * or not), the separators, both pooled, and the ladder. */
+struct Answerers
+{
+  CollisionRequest surface, separators, pooled, ladder;
+  explicit Answerers (bool exhaustive)
+  {
+    surface = surfaceRequest ();
+    surface.exhaustive = exhaustive;
+    surface.per_point = true;
+    surface.surface_calibrated = false;
+    separators = surface;
+    separators.surface = false;
+    pooled = surface;
+    pooled.surface_pooled = true;
+    ladder = surface;
+    ladder.surface_ladder = true;
+  }
+};
+
 Eigen::Isometry3d
 shift (double x, double y, double z)
 {
@@ -490,21 +510,14 @@ TEST (SurfaceLayer, PooledIsTheMeanOfBothAnswers)
   const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
   for (const double z : {0.0005, 0.002, -0.002})
   {
-    CollisionRequest surface = surfaceRequest ();
-    surface.exhaustive = true;
-    surface.per_point = true;
-    surface.surface_calibrated = false;
-    CollisionRequest separators = surface;
-    separators.surface = false;
-    CollisionRequest pooled = surface;
-    pooled.surface_pooled = true;
+    const Answerers q (true);
     CollisionResult rs, rc, rp;
-    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), surface, rs));
-    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), separators, rc));
-    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), pooled, rp));
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), q.surface, rs));
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), q.separators, rc));
+    ASSERT_TRUE (collide (*plate, *table, shift (0, 0, z), q.pooled, rp));
     EXPECT_DOUBLE_EQ (rp.probability, 0.5 * (rs.probability + rc.probability)) << "z = " << z;
     EXPECT_EQ (rp.signed_distance, rs.signed_distance);
-    EXPECT_EQ (rp.verdict, verdictFor (rp.probability, pooled));
+    EXPECT_EQ (rp.verdict, verdictFor (rp.probability, q.pooled));
     ASSERT_EQ (rp.probabilities_a.size (), rs.probabilities_a.size ());
     for (std::size_t i = 0; i < rp.probabilities_a.size (); ++i)
     {
@@ -537,28 +550,20 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
   for (const Eigen::Isometry3d& T : poses)
   {
     SCOPED_TRACE ("pose z = " + std::to_string (T.translation ().z ()));
-    CollisionRequest surface = surfaceRequest ();
-    surface.exhaustive = false;
-    surface.per_point = true;
-    CollisionRequest separators = surface;
-    separators.surface = false;
-    CollisionRequest pooled = surface;
-    pooled.surface_pooled = true;
-    CollisionRequest ladder = surface;
-    ladder.surface_ladder = true;
+    const Answerers q (false);
     CollisionResult rs, rc, rp, rl;
-    ASSERT_TRUE (collide (*plate, *table, T, surface, rs));
-    ASSERT_TRUE (collide (*plate, *table, T, separators, rc));
-    ASSERT_TRUE (collide (*plate, *table, T, pooled, rp));
-    ASSERT_TRUE (collide (*plate, *table, T, ladder, rl));
+    ASSERT_TRUE (collide (*plate, *table, T, q.surface, rs));
+    ASSERT_TRUE (collide (*plate, *table, T, q.separators, rc));
+    ASSERT_TRUE (collide (*plate, *table, T, q.pooled, rp));
+    ASSERT_TRUE (collide (*plate, *table, T, q.ladder, rl));
     const CollisionResult* expected = nullptr;
-    if (rc.no_leaf_tested || rc.probability > ladder.collision_above)
+    if (rc.no_leaf_tested || rc.probability > q.ladder.collision_above)
     {
       (rc.no_leaf_tested ? far : sure) += 1;
       expected = &rc;
       EXPECT_TRUE (std::isnan (rl.signed_distance));
     }
-    else if (rc.probability >= ladder.free_below)
+    else if (rc.probability >= q.ladder.free_below)
     {
       ++contact;
       expected = &rs;
@@ -631,16 +636,24 @@ TEST (SurfaceLayer, CalibrationMovesOnlyTheContactBand)
       EXPECT_EQ (r1.signed_distance_std, r0.signed_distance_std);
       ASSERT_EQ (r1.probabilities_a.size (), r0.probabilities_a.size ());
       for (std::size_t i = 0; i < r0.probabilities_a.size (); ++i)
+      {
         if (!std::isnan (r0.probabilities_a[i]))
+        {
           EXPECT_EQ (r1.probabilities_a[i], r0.probabilities_a[i]);
+        }
+      }
       raw_and_mapped.emplace_back (p0, p1);
     }
     // Strictly increasing: a higher raw P never maps lower, a different one never to the same.
     std::sort (raw_and_mapped.begin (), raw_and_mapped.end ());
     for (std::size_t i = 1; i < raw_and_mapped.size (); ++i)
+    {
       if (raw_and_mapped[i].first > raw_and_mapped[i - 1].first + 1e-9)
+      {
         EXPECT_GT (raw_and_mapped[i].second, raw_and_mapped[i - 1].second)
             << "pooled " << pooled << ": raw " << raw_and_mapped[i - 1].first << " and " << raw_and_mapped[i].first;
+      }
+    }
     // The sweep crosses the band: some answers inside it were moved.
     EXPECT_GE (moved, 1u) << "pooled " << pooled;
   }
