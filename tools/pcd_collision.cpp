@@ -545,6 +545,12 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
                 why.c_str ());
 }
 
+/** \brief Terminal progress lines (Progress, BuildTicker) appear only after this long: short runs
+  * show nothing. */
+constexpr std::chrono::milliseconds kProgressDelay (200);
+/** \brief Returns to the start of the line and erases it: a progress line leaves nothing behind. */
+constexpr const char* kEraseLine = "\r\033[K";
+
 /** \brief "\r[12/300 poses]" on stderr when it is a terminal, at most every 0.2 s, first after
   * 0.2 s (short runs show nothing); erased at the end and before summary lines that share the
   * terminal. */
@@ -558,7 +564,7 @@ public:
     if (!enabled_ || done >= total_)
       return;
     const auto now = std::chrono::steady_clock::now ();
-    if (now - last_ < std::chrono::milliseconds (200))
+    if (now - last_ < kProgressDelay)
       return;
     last_ = now;
     std::fprintf (stderr, "\r[%zu/%zu poses]", done, total_);
@@ -569,7 +575,7 @@ public:
   {
     if (!shown_)
       return;
-    std::fprintf (stderr, "\r\033[K");
+    std::fputs (kEraseLine, stderr);
     std::fflush (stderr);
     shown_ = false;
   }
@@ -610,7 +616,7 @@ public:
     stopping_ = false;
     thread_ = std::thread ([this, label, start = std::chrono::steady_clock::now ()] {
       std::unique_lock<std::mutex> lock (mutex_);
-      if (wake_.wait_for (lock, std::chrono::milliseconds (200), [this] { return stopping_; }))
+      if (wake_.wait_for (lock, kProgressDelay, [this] { return stopping_; }))
         return;
       do
       {
@@ -618,7 +624,7 @@ public:
         std::fprintf (stderr, "\r%s ... %.0f s", label.c_str (), seconds);
         std::fflush (stderr);
       } while (!wake_.wait_for (lock, std::chrono::seconds (1), [this] { return stopping_; }));
-      std::fprintf (stderr, "\r\033[K");
+      std::fputs (kEraseLine, stderr);
       std::fflush (stderr);
     });
     return Guard{this};
