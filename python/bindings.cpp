@@ -416,6 +416,19 @@ verdictEnumName (Verdict v)
 }
 
 const char*
+answeredByEnumName (AnsweredBy a)
+{
+  switch (a)
+  {
+    case AnsweredBy::Unknown: return "Unknown";
+    case AnsweredBy::Separators: return "Separators";
+    case AnsweredBy::SurfaceLayer: return "SurfaceLayer";
+    case AnsweredBy::Pooled: return "Pooled";
+  }
+  return "?";
+}
+
+const char*
 traversalName (TraversalMode t)
 {
   switch (t)
@@ -660,6 +673,14 @@ PYBIND11_MODULE (_core, m)
       .value ("InContact", Verdict::InContact)
       .value ("InCollision", Verdict::InCollision);
 
+  py::enum_<AnsweredBy> (m, "AnsweredBy", "Whose answer a result's probability is: Separators (the paper's leaf-pair "
+                                          "classifiers), SurfaceLayer, or Pooled (the mean of both); with "
+                                          "request.surface_ladder it varies from pose to pose. Unknown when the query failed.")
+      .value ("Unknown", AnsweredBy::Unknown)
+      .value ("Separators", AnsweredBy::Separators)
+      .value ("SurfaceLayer", AnsweredBy::SurfaceLayer)
+      .value ("Pooled", AnsweredBy::Pooled);
+
   py::enum_<TraversalMode> (m, "TraversalMode", "How the traversal treats node pairs whose boxes are disjoint.")
       .value ("ExpectedWeight", TraversalMode::ExpectedWeight)
       .value ("Stochastic", TraversalMode::Stochastic)
@@ -894,6 +915,9 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("message", &CollisionResult::message)
       .def_readonly ("verdict", &CollisionResult::verdict)
       .def_readonly ("probability", &CollisionResult::probability)
+      .def_readonly ("answered_by", &CollisionResult::answered_by,
+                     "Whose answer probability is (AnsweredBy): Separators also when request.surface is set but a\n"
+                     "model was built without CloudModelParams.surface; with request.surface_ladder, the rung reached.")
       .def_readonly ("signed_distance", &CollisionResult::signed_distance,
                      "Signed distance between the two surfaces in data units (the surface layer, METHOD.md 10a):\n"
                      "> 0 the gap, < 0 minus the penetration depth. NaN when not computed: request.surface off, a\n"
@@ -938,6 +962,8 @@ PYBIND11_MODULE (_core, m)
       .def ("__repr__", [] (const CollisionResult& r) {
         std::string s = std::string ("CollisionResult(status=") + statusName (r.status) + ", verdict=Verdict." +
                         verdictEnumName (r.verdict) + ", probability=" + num (r.probability);
+        if (r.answered_by == AnsweredBy::SurfaceLayer || r.answered_by == AnsweredBy::Pooled)  // shown only for the surface
+          s += std::string (", answered_by=AnsweredBy.") + answeredByEnumName (r.answered_by);
         if (!std::isnan (r.signed_distance))
           s += ", signed_distance=" + num (r.signed_distance);
         if (!std::isnan (r.signed_distance_std))

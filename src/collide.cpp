@@ -299,6 +299,7 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
       pool (result, separators, request);
     }
   }
+  result.answered_by = !from_surface ? AnsweredBy::Separators : pooled ? AnsweredBy::Pooled : AnsweredBy::SurfaceLayer;
   if (from_surface && request.surface_calibrated)
   {
     result.probability = detail::calibratedSurfaceProbability (

@@ -55,4 +55,17 @@ verdictName (Verdict verdict)
   }
   return "unknown";
 }
+
+const char*
+answeredByName (AnsweredBy answered_by)
+{
+  switch (answered_by)
+  {
+    case AnsweredBy::Separators: return "separators";
+    case AnsweredBy::SurfaceLayer: return "surface";
+    case AnsweredBy::Pooled: return "pooled";
+    case AnsweredBy::Unknown: break;
+  }
+  return "unknown";
+}
 } // namespace pcl_probcollision

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <random>
 
 using namespace pcl_probcollision;
@@ -556,6 +557,10 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
     ASSERT_TRUE (collide (*plate, *table, T, q.separators, rc));
     ASSERT_TRUE (collide (*plate, *table, T, q.pooled, rp));
     ASSERT_TRUE (collide (*plate, *table, T, q.ladder, rl));
+    // Each setting names itself as the answerer; the ladder names the rung it reached.
+    EXPECT_EQ (rs.answered_by, AnsweredBy::SurfaceLayer);
+    EXPECT_EQ (rc.answered_by, AnsweredBy::Separators);
+    EXPECT_EQ (rp.answered_by, AnsweredBy::Pooled);
     const CollisionResult* expected = nullptr;
     if (rc.no_leaf_tested || rc.probability > q.ladder.collision_above)
     {
@@ -573,6 +578,7 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
       ++free;
       expected = &rp;
     }
+    EXPECT_EQ (rl.answered_by, expected->answered_by);
     EXPECT_DOUBLE_EQ (rl.probability, expected->probability);
     EXPECT_EQ (rl.verdict, expected->verdict);
     if (!std::isnan (expected->signed_distance))
@@ -598,6 +604,35 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
             << ", free after a fit " << free << "\n";
   EXPECT_GT (far, 0);
   EXPECT_GT (contact, 0);
+}
+
+// A surface request on models built without the surface model (CloudModelParams::surface off)
+// falls back to the separators, and the result says so rather than passing their answer off as
+// the surface layer's; a failed query names no answerer.
+TEST (SurfaceLayer, WithoutASurfaceModelTheResultNamesTheSeparators)
+{
+  CloudModelParams plain;
+  plain.noise = SensorNoiseModel::isotropic (0.001);
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), plain);
+  const auto surfaced = buildCloudModel (sheet (0.1, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  ASSERT_TRUE (table->surface ().empty ());
+  ASSERT_FALSE (surfaced->surface ().empty ());
+  const Answerers q (false);
+  for (const CollisionRequest* request : {&q.surface, &q.pooled, &q.ladder})
+  {
+    CollisionResult r, separators;
+    ASSERT_TRUE (collide (*surfaced, *table, shift (0, 0, 0.0005), *request, r));
+    ASSERT_TRUE (collide (*surfaced, *table, shift (0, 0, 0.0005), q.separators, separators));
+    EXPECT_EQ (r.answered_by, AnsweredBy::Separators);
+    EXPECT_EQ (r.probability, separators.probability);
+    EXPECT_FALSE (separators.no_leaf_tested);  // the pose reaches a leaf pair: a real answer
+    EXPECT_TRUE (std::isnan (r.signed_distance));
+    EXPECT_STREQ (answeredByName (r.answered_by), "separators");
+  }
+  CollisionResult failed;
+  EXPECT_FALSE (collide (*surfaced, *table, shift (0, 0, std::numeric_limits<double>::quiet_NaN ()), q.surface, failed));
+  EXPECT_EQ (failed.answered_by, AnsweredBy::Unknown);
+  EXPECT_STREQ (answeredByName (failed.answered_by), "unknown");
 }
 
 // The calibration map (CollisionRequest::surface_calibrated) moves the pair's P inside the

@@ -313,6 +313,9 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("pose").numbers ({pose[0], pose[1], pose[2], pose[3], pose[4], pose[5]});
   j.key ("verdict").string (pcl_probcollision::verdictName (r.verdict));
   j.key ("probability").number (r.probability);
+  // Whose answer P is (CollisionResult::answered_by): "separators", "surface" or "pooled"; with
+  // -surface_ladder it varies from pose to pose.
+  j.key ("answered_by").string (pcl_probcollision::answeredByName (r.answered_by));
   j.key ("signed_distance").number (r.signed_distance);
   j.key ("signed_distance_std").number (r.signed_distance_std);
   // Always a boolean (false without -surface): the surface layer's answer rests on surface the
@@ -416,7 +419,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
 }
 
 std::string
-humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
+humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bool ladder)
 {
   char buf[512];
   const std::string prefix = pose_index >= 0 ? "pose " + std::to_string (pose_index) + ": " : std::string ();
@@ -430,11 +433,18 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index)
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";
+  // With -surface_ladder, the rung that answered (CollisionResult::answered_by); the other
+  // settings have one answerer, which the command line names.
+  const char* rung = !ladder ? ""
+                     : r.answered_by == pcl_probcollision::AnsweredBy::Separators   ? "  (ladder: separators)"
+                     : r.answered_by == pcl_probcollision::AnsweredBy::SurfaceLayer ? "  (ladder: surface layer)"
+                     : r.answered_by == pcl_probcollision::AnsweredBy::Pooled       ? "  (ladder: pooled)"
+                                                                                    : "";
   std::snprintf (buf, sizeof (buf),
-                 "%s%-9s P %s %.6f%s%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "%s%-9s P %s %.6f%s%s%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
                  "query %.1f ms]",
                  prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
-                 r.probability, distance, unobserved, capped, r.points_a, r.points_b, r.points_skipped_nonfinite,
+                 r.probability, distance, unobserved, rung, capped, r.points_a, r.points_b, r.points_skipped_nonfinite,
                  r.leaf_pairs_tested,
                  std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
   return buf;
@@ -908,7 +918,7 @@ run (int argc, char** argv)
     }
     else
     {
-      std::fprintf (human, "%s\n", humanLine (result, index).c_str ());
+      std::fprintf (human, "%s\n", humanLine (result, index, o.surface_ladder).c_str ());
       if (!batch)
         std::fprintf (human, "%s\n", witnessLine (result).c_str ());
       std::fflush (human);

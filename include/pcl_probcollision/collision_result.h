@@ -22,6 +22,19 @@ enum class Verdict
 /** \brief "free", "contact", "collision" or "unknown". */
 const char* verdictName (Verdict verdict);
 
+/** \brief Whose probability a result reports (CollisionRequest::surface, surface_pooled,
+  * surface_ladder): with the ladder it differs from pose to pose. */
+enum class AnsweredBy
+{
+  Unknown,       ///< not computed (the query failed)
+  Separators,    ///< the leaf-pair classifiers of the paper (the default)
+  SurfaceLayer,  ///< the surface layer alone (METHOD.md 10a)
+  Pooled         ///< the mean of both (surface_pooled, or the ladder after a "free" fit)
+};
+
+/** \brief "separators", "surface", "pooled" or "unknown". */
+const char* answeredByName (AnsweredBy answered_by);
+
 /** \brief Outcome of a query. Anything not computed is NaN (numbers) or Unknown. */
 struct CollisionResult
 {
@@ -35,6 +48,10 @@ struct CollisionResult
   std::string message;
 
   Verdict verdict = Verdict::Unknown;
+  /** \brief Whose answer P is. Separators also when CollisionRequest::surface is set but a model
+    * carries no surface model (CloudModelParams::surface off): the request then falls back to the
+    * paper's method, and this says so. */
+  AnsweredBy answered_by = AnsweredBy::Unknown;
   /** \brief P(A, B) in [0, 1]: the largest reach-weighted leaf-pair probability. */
   double probability = std::numeric_limits<double>::quiet_NaN ();
   /** \brief Signed distance between the two surfaces in data units (METHOD.md 10a, the

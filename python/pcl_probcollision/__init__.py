@@ -12,6 +12,7 @@ The compiled core is pcl_probcollision._core; everything public is re-exported h
 Pose batches over Dask workers: pcl_probcollision.dask (needs python3-distributed).
 """
 from ._core import (  # noqa: F401
+    AnsweredBy,
     CloudModel,
     CloudModelParams,
     CollisionRequest,
@@ -37,6 +38,7 @@ from ._core import (  # noqa: F401
 )
 
 __all__ = [
+    "AnsweredBy",
     "CloudModel",
     "CloudModelParams",
     "CollisionRequest",

@@ -16,6 +16,12 @@ class Verdict(enum.IntEnum):
     InContact: int
     InCollision: int
 
+class AnsweredBy(enum.IntEnum):
+    Unknown: int
+    Separators: int
+    SurfaceLayer: int
+    Pooled: int
+
 class TraversalMode(enum.IntEnum):
     ExpectedWeight: int
     Stochastic: int
@@ -107,6 +113,9 @@ class CollisionResult:
     def verdict(self) -> Verdict: ...
     @property
     def probability(self) -> float: ...
+    @property
+    def answered_by(self) -> AnsweredBy:
+        """Whose answer probability is: Separators, SurfaceLayer or Pooled (the ladder's rung)."""
     @property
     def signed_distance(self) -> float:
         """Signed distance between the surfaces (> 0 gap, < 0 minus the penetration depth); NaN when not computed."""

@@ -22,7 +22,7 @@ def same_result(r, s):
     assert r.probability == s.probability  # exact, not approx
     # The surface layer's distance: exact too, NaN (not computed) on both sides alike.
     np.testing.assert_array_equal([r.signed_distance, r.signed_distance_std], [s.signed_distance, s.signed_distance_std])
-    for f in ("lower_bound", "budget_exhausted", "no_leaf_tested", "unobserved", "witness_side", "witness_index", "points_a", "points_b",
+    for f in ("answered_by", "lower_bound", "budget_exhausted", "no_leaf_tested", "unobserved", "witness_side", "witness_index", "points_a", "points_b",
               "points_skipped_nonfinite", "bv_tests", "leaf_pairs_tested", "kernel_leaf_pairs",
               "degenerate_leaf_pairs", "classifier_iterations"):
         assert getattr(r, f) == getattr(s, f), f
@@ -368,7 +368,14 @@ def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):
         rungs.add(rung)
         assert ladder.probability == expected.probability, (z, rung)
         assert ladder.verdict == expected.verdict
+        # answered_by names each setting, and the ladder's rung.
+        assert separators.answered_by == pc.AnsweredBy.Separators
+        assert surface.answered_by == pc.AnsweredBy.SurfaceLayer
+        assert pooled.answered_by == pc.AnsweredBy.Pooled
+        assert ladder.answered_by == expected.answered_by, (z, rung)
+        assert ("answered_by=AnsweredBy." in repr(ladder)) == (rung != "separators")
     assert len(rungs) >= 2, rungs
+    assert pc.CollisionResult().answered_by == pc.AnsweredBy.Unknown
     assert "surface_ladder=True" in repr(pc.CollisionRequest(surface=True, surface_ladder=True))
     with pytest.raises(ValueError, match="surface_pooled and surface_ladder"):
         pc.CollisionRequest(surface=True, surface_pooled=True, surface_ladder=True).validate()

@@ -224,17 +224,23 @@ def test_cli_writes_pcd_collision_json_lines(cli_inputs, flags):
     assert [a["sample_distance"] for a in answers] == [
         "-distance" in flags and a["no_leaf_tested"] and a["signed_distance"] is not None for a in answers]
     assert ("-distance" in flags) == any(a["sample_distance"] for a in answers)
+    # answered_by (equal to pcd_collision's above): the setting's own answerer, the ladder's rung.
+    answerers = {a["answered_by"] for a in answers}
     if "-surface_ladder" in flags:
         # The separators' answer stands where they reached nothing (no distance there); the
         # surface layer's distance where they reached a leaf pair and found no sure collision.
         assert all(a["parameters"]["surface"] for a in answers)
         assert all(a["signed_distance"] is None for a in answers if a["no_leaf_tested"])
         assert any(d is not None for d in distances)
+        assert all(a["answered_by"] == "separators" for a in answers if a["no_leaf_tested"])
+        assert "separators" in answerers and answerers - {"separators"}, answerers
     elif "-surface" in flags or "-surface_pooled" in flags:
+        assert answerers == {"pooled" if "-surface_pooled" in flags else "surface"}
         assert all(a["parameters"]["surface"] for a in answers)
         assert sum(d is not None for d in distances) >= 10
         assert any(d is not None and d < 0 for d in distances)
     else:
+        assert answerers == {"separators"}
         assert [d is not None for d in distances] == [a["sample_distance"] for a in answers]
         assert not any(a["unobserved"] for a in answers)  # only the surface layer sets it
 
@@ -316,6 +322,8 @@ def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     np.testing.assert_array_equal(r.probability, [x.probability for x in ref])
     assert r.unobserved.dtype == bool
     np.testing.assert_array_equal(r.unobserved, [x.unobserved for x in ref])
+    np.testing.assert_array_equal(r.answered_by, [int(x.answered_by) for x in ref])
+    assert (r.answered_by == int(pc.AnsweredBy.SurfaceLayer)).all()
     assert np.isfinite(r.signed_distance[:4]).all() and np.isnan(r.signed_distance[4])
     # Sheets oriented by propagation have no known outside: only |d| is meaningful here; the
     # sign is asserted with oriented sheets in test_bindings.py and with the mesh above.
@@ -323,6 +331,7 @@ def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     off = pcd.collide_poses(a, b, P, sigma=0.001)
     assert np.isnan(off.signed_distance).all() and np.isnan(off.signed_distance_std).all()
     assert off.unobserved.dtype == bool and not off.unobserved.any()
+    assert (off.answered_by == int(pc.AnsweredBy.Separators)).all()
 
 
 def test_cli_errors_match_pcd_collision(tmp_path):

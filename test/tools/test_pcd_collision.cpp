@@ -473,6 +473,30 @@ TEST_F (PcdCollisionTool, SurfaceLadderAnswersTheDemoPenetrationAsCollision)
   ASSERT_EQ (ladder[2]["signed_distance"].type, Value::Type::Number);
   EXPECT_LT (ladder[2]["signed_distance"].number, 0.0);
   EXPECT_GE (ladder[2]["leaf_pairs"].number, plain[2]["leaf_pairs"].number);
+  // "answered_by" names the rung: the separators' answer stands on pose 0, the surface layer's on
+  // pose 2; the other settings name themselves on every pose. The human line says the same, and
+  // only with -surface_ladder.
+  const ToolRun text = run ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface_ladder"});
+  const ToolRun plain_text = run ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface"});
+  ASSERT_EQ (text.status, 0) << text.err;
+  ASSERT_EQ (plain_text.status, 0) << plain_text.err;
+  const auto human = lines (text.out), plain_human = lines (plain_text.out);
+  ASSERT_EQ (human.size (), 3u) << text.out;
+  ASSERT_EQ (plain_human.size (), 3u) << plain_text.out;
+  EXPECT_EQ (ladder[0]["answered_by"].text, "separators");
+  EXPECT_EQ (ladder[2]["answered_by"].text, "surface");
+  EXPECT_NE (human[0].find ("  (ladder: separators)   [points "), std::string::npos) << human[0];
+  EXPECT_NE (human[2].find ("  (ladder: surface layer)   [points "), std::string::npos) << human[2];
+  for (std::size_t i = 0; i < 3; ++i)
+  {
+    SCOPED_TRACE ("pose " + std::to_string (i));
+    ASSERT_EQ (plain[i]["answered_by"].type, Value::Type::String);
+    EXPECT_EQ (plain[i]["answered_by"].text, "separators");
+    EXPECT_EQ (surface[i]["answered_by"].text, "surface");
+    EXPECT_EQ (plain_human[i].find ("(ladder:"), std::string::npos) << plain_human[i];
+    const std::string rung = ladder[i]["answered_by"].text;
+    EXPECT_TRUE (rung == "separators" || rung == "surface" || rung == "pooled") << rung;
+  }
 }
 
 // -distance: beyond the query's reach, the distance between the two inputs' nearest samples,

@@ -319,6 +319,8 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         "index": np.arange(start, start + n, dtype=np.int64),
         "probability": np.array([r.probability for r in results], dtype=np.float64),
         "verdict": np.array([int(r.verdict) for r in results], dtype=np.int8),
+        # Whose answer P is (int8 of AnsweredBy): with surface_ladder it varies from pose to pose.
+        "answered_by": np.array([int(r.answered_by) for r in results], dtype=np.int8),
         "status": np.array([int(r.status) for r in results], dtype=np.int8),
         "lower_bound": np.array([r.lower_bound for r in results], dtype=bool),
         "budget_exhausted": np.array([r.budget_exhausted for r in results], dtype=bool),
@@ -357,7 +359,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
 
 class BatchResults:
     """Answers in pose order, one numpy array per field: probability, verdict (int8 of Verdict),
-    status, lower_bound, budget_exhausted, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
+    answered_by (int8 of AnsweredBy: separators, surface layer or pooled, the ladder's rung), status, lower_bound, budget_exhausted, no_leaf_tested, signed_distance(_std) (with surface=True; NaN otherwise),
     unobserved (bool: with surface=True, the answer rests on surface the samples do not show; False otherwise),
     sample_distance (bool: with distance=True, signed_distance is the nearest samples' distance) and
     nearest_point_a/_b (those samples, b's frame; NaN otherwise),

@@ -201,6 +201,7 @@ def _input_json(spec):
 
 
 _VERDICTS = {0: "unknown", 1: "free", 2: "contact", 3: "collision"}
+_ANSWERED_BY = {0: "unknown", 1: "separators", 2: "surface", 3: "pooled"}  # answeredByName()
 
 
 def json_lines(r, pose_rows, o, a, b):
@@ -240,7 +241,8 @@ def json_lines(r, pose_rows, o, a, b):
             witness = (f'{{"point":{_nums(r.witness_point[i])},"side":"{"a" if r.witness_side[i] > 0 else "b"}",'
                        f'"index":{int(r.witness_index[i])},"normal":{_nums(r.witness_normal[i])}}}')
         yield (f'{{"pose_index":{i},"pose":{_nums(pose_rows[i])},"verdict":"{_VERDICTS[int(r.verdict[i])]}",'
-               f'"probability":{_num(r.probability[i])},{surface(i)}"lower_bound":{_bool(r.lower_bound[i])},'
+               f'"probability":{_num(r.probability[i])},"answered_by":"{_ANSWERED_BY[int(r.answered_by[i])]}",'
+               f'{surface(i)}"lower_bound":{_bool(r.lower_bound[i])},'
                f'"budget_exhausted":{_bool(r.budget_exhausted[i])},'
                f'"no_leaf_tested":{_bool(r.no_leaf_tested[i])},"points_a":{int(r.points_a[i])},'
                f'"points_b":{int(r.points_b[i])},"points_skipped_nonfinite":{int(r.points_skipped_nonfinite[i])},'
