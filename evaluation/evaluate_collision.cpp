@@ -5,9 +5,11 @@
 // nominal spacing sqrt(area / N) of at least 10 sigma at 0.5 % noise) and, in the full run, at
 // 0.25, 0.5, 1, 2 and 4 % noise, with poses aimed at issue 16's near band |d| <= 2.8 sigma_eff.
 // Writes into the output directory:
-//   queries.csv      every answer (signed_distance and its std empty when not computed)
+//   queries.csv      every answer (signed_distance and its std empty when not computed;
+//                    answered_by: ours' CollisionResult::answered_by, empty for baselines)
 //   summary.csv      per (workload, noise, method, setting): accuracy, AUC, Brier, hidden
-//                    collisions, re-noise and re-scan stability, signed-distance errors, times
+//                    collisions, re-noise and re-scan stability, signed-distance errors, times,
+//                    the share of ours' answers the surface layer gave (surface_answered_share)
 //   reliability.csv  reliability bins per band (near_sigma, near_contact, all) with the
 //                    per-bin check of issue 16 (bins of >= 30 queries)
 //   flips.csv        stability: kind renoise (same samples, new noise; issue 6) and rescan
@@ -221,6 +223,7 @@ runQueries (Results& results, const QueryRow& prototype, const CellPoses& cell, 
     row.verdict = a.verdict;
     row.signed_distance = a.signed_distance;
     row.signed_distance_std = a.signed_distance_std;
+    row.answered_by = a.answered_by;
     results.queries.push_back (row);
   }
 }
@@ -748,6 +751,7 @@ evaluatePrimitives (const Options& o, Results& results)
         row.verdict = a.verdict;
         row.signed_distance = a.signed_distance;
         row.signed_distance_std = a.signed_distance_std;
+        row.answered_by = a.answered_by;
         row.query_us = us;
         results.queries.push_back (row);
       };
@@ -875,6 +879,9 @@ struct Summary
   std::vector<BandReliability> reliability;
   TimeSummary t;
   double build_ms = NAN, memory = NAN;
+  /** \brief Ours: the share of queries the surface layer answered, alone or pooled (with the
+    * ladder, how often it climbed past the separators); NaN for the baselines. */
+  double surface_answered = NAN;
 };
 
 Summary
@@ -888,8 +895,10 @@ summarize (const CellKey& k, const std::vector<const QueryRow*>& rows)
   std::vector<double> scores, times, near_scores, ns_scores;
   std::vector<bool> outcomes, near_outcomes, ns_outcomes, free_all, free_ns, ns_collide;
   std::vector<double> sd, sd_std, truth, scale, ns_sd, ns_sd_std, ns_truth, ns_scale;
+  std::size_t surface_answered = 0;
   for (const QueryRow* r : rows)
   {
+    surface_answered += r->answered_by == "surface" || r->answered_by == "pooled";
     scores.push_back (r->score);
     outcomes.push_back (r->exact_collision);
     times.push_back (r->query_us);
@@ -926,6 +935,8 @@ summarize (const CellKey& k, const std::vector<const QueryRow*>& rows)
     }
   }
   s.easy_accuracy = s.easy ? static_cast<double> (s.easy_right) / s.easy : NAN;
+  if (ours && !rows.empty ())
+    s.surface_answered = static_cast<double> (surface_answered) / static_cast<double> (rows.size ());
   s.auc = rocAuc (scores, outcomes);
   s.auc_near_sigma = rocAuc (ns_scores, ns_outcomes);
   s.hidden_all = hiddenCollisions (free_all, outcomes);
@@ -1209,13 +1220,13 @@ writeOutputs (const Options& o, const Results& results)
 {
   std::ostringstream q;
   q << "workload,noise_pct,sigma_eff,query,exact_distance,exact_collision,near_contact,easy,method,setting,score,"
-       "verdict,query_us,near_sigma,pose_set,signed_distance,signed_distance_std\n";
+       "verdict,query_us,near_sigma,pose_set,signed_distance,signed_distance_std,answered_by\n";
   for (const auto& r : results.queries)
     q << r.workload << ',' << fmt (r.noise_pct) << ',' << fmt (r.sigma_eff) << ',' << r.query << ','
       << fmt (r.exact_distance) << ',' << r.exact_collision << ',' << r.near_contact << ',' << isEasy (r) << ','
       << r.method << ',' << r.setting << ',' << fmt (r.score) << ',' << r.verdict << ',' << fmt (r.query_us) << ','
       << r.near_sigma << ',' << r.pose_set << ',' << fmtOrEmpty (r.signed_distance) << ','
-      << fmtOrEmpty (r.signed_distance_std) << '\n';
+      << fmtOrEmpty (r.signed_distance_std) << ',' << r.answered_by << '\n';
   writeFile (o.out_dir + "/queries.csv", q.str ());
 
   // Group rows per (workload, noise, method, setting), in first-seen order.
@@ -1295,7 +1306,8 @@ writeOutputs (const Options& o, const Results& results)
          "near_sigma_queries,near_sigma_colliding,brier_near_sigma,auc_near_sigma,free_near_sigma,hidden_near_sigma,"
          "hidden_rate_near_sigma,missed_near_sigma,free_all,hidden_all,hidden_rate_all,rescan_poses,rescans,"
          "rescan_any_flip,rescan_flip_rate,rescan_p_std,sd_count_near_sigma,sd_median_abs_err_near_sigma,"
-         "sd_coverage_near_sigma,sd_count_all,sd_median_abs_err_all,sd_coverage_all,rel_bins_judged,rel_bins_outside\n";
+         "sd_coverage_near_sigma,sd_count_all,sd_median_abs_err_all,sd_coverage_all,rel_bins_judged,rel_bins_outside,"
+         "surface_answered_share\n";
   std::ostringstream flips;
   flips << "workload,noise_pct,method,setting,kind,poses,draws,flip_rate,any_flip_rate,p_std\n";
   for (std::size_t i = 0; i < summaries.size (); ++i)
@@ -1323,7 +1335,7 @@ writeOutputs (const Options& o, const Results& results)
         << fmt (s.rescan_p_std) << ',' << s.sd_near_sigma.count << ',' << fmt (s.sd_near_sigma.median_abs_error) << ','
         << fmt (s.sd_near_sigma.coverage) << ',' << s.sd_all.count << ',' << fmt (s.sd_all.median_abs_error) << ','
         << fmt (s.sd_all.coverage) << ',' << (have_band ? std::to_string (judged) : "nan") << ','
-        << (have_band ? std::to_string (outside) : "nan") << '\n';
+        << (have_band ? std::to_string (outside) : "nan") << ',' << fmt (s.surface_answered) << '\n';
     const auto f = results.renoise.find (s.key);
     if (f != results.renoise.end ())
       flips << head << ",renoise," << f->second.is_free.size () << ','

@@ -70,6 +70,7 @@ evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& r
       row.verdict = verdictName (r.verdict);
       row.signed_distance = r.signed_distance;
       row.signed_distance_std = r.signed_distance_std;
+      row.answered_by = answeredByName (r.answered_by);
       row.query_us = std::chrono::duration<double, std::micro> (std::chrono::steady_clock::now () - start).count ();
       rows.push_back (row);
       // Resting objects may read contact or collision, never free; lifted ones must read free.

@@ -197,6 +197,7 @@ oursQuery (const OursModels& models, const CollisionRequest& request,
     answer.signed_distance = result.signed_distance;
     answer.signed_distance_std = result.signed_distance_std;
     answer.surface = request.surface;
+    answer.answered_by = answeredByName (result.answered_by);
     if (on_query)
     {
       const double linear = static_cast<double> (result.leaf_pairs_tested - result.kernel_leaf_pairs);

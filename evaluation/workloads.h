@@ -34,6 +34,8 @@ struct QueryRow
   /** \brief Ours: CollisionResult::signed_distance and its std (NaN when not computed). */
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief Ours: CollisionResult::answered_by's name (the ladder's rung); empty for baselines. */
+  std::string answered_by;
 };
 
 /** \brief Build cost and model size of one method on one workload cell. */
@@ -89,6 +91,7 @@ struct Answer
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
   bool surface = false;
+  std::string answered_by {};  ///< ours: answeredByName (); empty for baselines
 };
 /** \brief One method on one cloud pair, prebuilt: answers a pose. */
 using PoseQuery = std::function<Answer (const Eigen::Isometry3d& T)>;

@@ -63,15 +63,27 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
 # Issue 16's measures of ours and the 2-sigma collision map (columns found by header name).
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
                    print "";
-                   print "| workload | noise | method | setting | near-band queries | Brier (near band) | free answers | hidden collisions | hidden rate | re-scan any-flip | re-scan P std | re-noise flip | distance error (sigma_eff, median) | +-2 std coverage | reliability bins outside / judged |";
-                   print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
+                   print "| workload | noise | method | setting | near-band queries | Brier (near band) | free answers | hidden collisions | hidden rate | re-scan any-flip | re-scan P std | re-noise flip | distance error (sigma_eff, median) | +-2 std coverage | reliability bins outside / judged | answered by the surface layer |";
+                   print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"; next }
          $c["workload"] != "W3" && ($c["method"] == "ours" || $c["method"] == "octomap_2x") {
-           printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s / %s |\n",
+           printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s / %s | %s |\n",
                   $c["workload"], $c["noise_pct"], $c["method"], $c["setting"], $c["near_sigma_queries"],
                   $c["brier_near_sigma"], $c["free_near_sigma"], $c["hidden_near_sigma"], $c["hidden_rate_near_sigma"],
                   $c["rescan_any_flip"], $c["rescan_p_std"], $c["renoise_flip_rate"], $c["sd_median_abs_err_near_sigma"],
-                  $c["sd_coverage_near_sigma"], $c["rel_bins_outside"], $c["rel_bins_judged"] }' \
+                  $c["sd_coverage_near_sigma"], $c["rel_bins_outside"], $c["rel_bins_judged"], $c["surface_answered_share"] }' \
   "$out/summary.csv" >> "$out/summary.md"
+
+# Who answered (CollisionResult::answered_by, summed as surface_answered_share): the separators'
+# settings never the surface layer, the surface layer's and the pool's always, the ladder's
+# between. A result that names the wrong answerer fails the run.
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+         $c["method"] == "ours" {
+           s = $c["setting"]; v = $c["surface_answered_share"] + 0
+           if ((s == "default" || s == "classifier") && v != 0) bad = bad " " $c["workload"] "/" s "=" v
+           if ((s == "surface" || s == "pooled") && v != 1) bad = bad " " $c["workload"] "/" s "=" v
+           if (s == "ladder" && (v < 0 || v > 1)) bad = bad " " $c["workload"] "/" s "=" v }
+         END { if (bad != "") { print "evaluate.sh: wrong surface_answered_share:" bad > "/dev/stderr"; exit 1 } }' \
+  "$out/summary.csv"
 
 # Reliability tables per workload (W1 dense, W1-sparse, W2, W3) and noise level, ours default,
 # classifier, surface, pooled and ladder: the near band for W1 and W2, every query for W3 (against "listed as not
