@@ -324,6 +324,7 @@ def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     np.testing.assert_array_equal(r.unobserved, [x.unobserved for x in ref])
     np.testing.assert_array_equal(r.answered_by, [int(x.answered_by) for x in ref])
     assert (r.answered_by == int(pc.AnsweredBy.SurfaceLayer)).all()
+    assert "answered_by={'SurfaceLayer': 5}" in repr(r)
     assert np.isfinite(r.signed_distance[:4]).all() and np.isnan(r.signed_distance[4])
     # Sheets oriented by propagation have no known outside: only |d| is meaningful here; the
     # sign is asserted with oriented sheets in test_bindings.py and with the mesh above.
@@ -332,6 +333,7 @@ def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     assert np.isnan(off.signed_distance).all() and np.isnan(off.signed_distance_std).all()
     assert off.unobserved.dtype == bool and not off.unobserved.any()
     assert (off.answered_by == int(pc.AnsweredBy.Separators)).all()
+    assert "answered_by" not in repr(off)
 
 
 def test_cli_errors_match_pcd_collision(tmp_path):

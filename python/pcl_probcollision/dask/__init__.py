@@ -385,7 +385,11 @@ class BatchResults:
 
     def __repr__(self) -> str:
         counts = collections.Counter(core.Verdict(int(v)).name for v in self.verdict)
-        return f"BatchResults({len(self)} poses, {dict(counts)}, chunk_size={self.chunk_size}, chunks={self.chunks})"
+        # Who answered, shown when the surface layer answered any pose (surface, pooled, ladder).
+        answered = collections.Counter(core.AnsweredBy(int(v)).name for v in self.answered_by)
+        by = "" if set(answered) <= {"Separators"} else f", answered_by={dict(sorted(answered.items()))}"
+        return (f"BatchResults({len(self)} poses, {dict(counts)}{by}, chunk_size={self.chunk_size}, "
+                f"chunks={self.chunks})")
 
 
 def as_pose_matrices(poses) -> np.ndarray:
