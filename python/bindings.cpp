@@ -390,67 +390,13 @@ num (double v)
   return py::repr (py::float_ (v));  // Python's shortest round-trip form
 }
 
-const char*
-statusName (CollisionResult::Status s)
+/** \brief A bound enum value's Python name ("Free", "SurfaceLayer"): the py::enum_ registrations
+  * below own those names, the reprs read them from there. */
+template <typename E>
+std::string
+enumName (E value)
 {
-  switch (s)
-  {
-    case CollisionResult::Status::Ok: return "Ok";
-    case CollisionResult::Status::InvalidInput: return "InvalidInput";
-    case CollisionResult::Status::NumericalFailure: return "NumericalFailure";
-  }
-  return "?";
-}
-
-const char*
-verdictEnumName (Verdict v)
-{
-  switch (v)
-  {
-    case Verdict::Unknown: return "Unknown";
-    case Verdict::Free: return "Free";
-    case Verdict::InContact: return "InContact";
-    case Verdict::InCollision: return "InCollision";
-  }
-  return "?";
-}
-
-const char*
-answeredByEnumName (AnsweredBy a)
-{
-  switch (a)
-  {
-    case AnsweredBy::Unknown: return "Unknown";
-    case AnsweredBy::Separators: return "Separators";
-    case AnsweredBy::SurfaceLayer: return "SurfaceLayer";
-    case AnsweredBy::Pooled: return "Pooled";
-  }
-  return "?";
-}
-
-const char*
-traversalName (TraversalMode t)
-{
-  switch (t)
-  {
-    case TraversalMode::ExpectedWeight: return "ExpectedWeight";
-    case TraversalMode::Stochastic: return "Stochastic";
-    case TraversalMode::ExpandedBV: return "ExpandedBV";
-  }
-  return "?";
-}
-
-const char*
-orientationEnumName (NormalOrientation o)
-{
-  switch (o)
-  {
-    case NormalOrientation::Auto: return "Auto";
-    case NormalOrientation::PointNormals: return "PointNormals";
-    case NormalOrientation::Viewpoint: return "Viewpoint";
-    case NormalOrientation::Propagate: return "Propagate";
-  }
-  return "?";
+  return py::cast (value).attr ("name").template cast<std::string> ();
 }
 
 const char*
@@ -805,7 +751,7 @@ PYBIND11_MODULE (_core, m)
                ", n_max=" + std::to_string (p.hierarchy.n_max) + ", n_min=" + std::to_string (p.hierarchy.n_min) +
                ", sigma_max=" + num (p.hierarchy.sigma_max) + ", epsilon=" + num (p.hierarchy.epsilon) +
                ", k_sigma=" + num (p.hierarchy.k_sigma) + ", surface=" + (p.surface ? "True" : "False") +
-               ", orientation=NormalOrientation." + orientationEnumName (p.orientation) + ")";
+               ", orientation=NormalOrientation." + enumName (p.orientation) + ")";
       });
 
   // --- CollisionRequest ---------------------------------------------------------------------------
@@ -891,7 +837,7 @@ PYBIND11_MODULE (_core, m)
         return "CollisionRequest(free_below=" + num (r.free_below) + ", collision_above=" + num (r.collision_above) +
                ", exhaustive=" + (r.exhaustive ? "True" : "False") + ", per_point=" + (r.per_point ? "True" : "False") +
                ", enable_timings=" + (r.enable_timings ? "True" : "False") + ", traversal=TraversalMode." +
-               traversalName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
+               enumName (r.traversal) + ", rho_min=" + num (r.rho_min) + ", seed=" + std::to_string (r.seed) +
                ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
                ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
                ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
@@ -960,10 +906,10 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("probabilities_b", [] (const CollisionResult& r) { return floats (r.probabilities_b); })
       .def_property_readonly ("ok", &CollisionResult::ok)
       .def ("__repr__", [] (const CollisionResult& r) {
-        std::string s = std::string ("CollisionResult(status=") + statusName (r.status) + ", verdict=Verdict." +
-                        verdictEnumName (r.verdict) + ", probability=" + num (r.probability);
+        std::string s = std::string ("CollisionResult(status=") + enumName (r.status) + ", verdict=Verdict." +
+                        enumName (r.verdict) + ", probability=" + num (r.probability);
         if (r.answered_by == AnsweredBy::SurfaceLayer || r.answered_by == AnsweredBy::Pooled)  // shown only for the surface
-          s += std::string (", answered_by=AnsweredBy.") + answeredByEnumName (r.answered_by);
+          s += ", answered_by=AnsweredBy." + enumName (r.answered_by);
         if (!std::isnan (r.signed_distance))
           s += ", signed_distance=" + num (r.signed_distance);
         if (!std::isnan (r.signed_distance_std))
