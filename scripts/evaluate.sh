@@ -40,14 +40,16 @@ demo() {
 }
 demo_verdict=$(demo)
 demo_surface=$(demo -surface)
-awk -F, -v OFS=, -v v="$demo_verdict" -v s="$demo_surface" '
+demo_ladder=$(demo -surface_ladder)
+awk -F, -v OFS=, -v v="$demo_verdict" -v s="$demo_surface" -v l="$demo_ladder" '
   index($0, "the demo'"'"'s pose 2 reads collision,") == 1 {
-    surf = ($2 ~ /with -surface$/); a = surf ? s : v
+    flag = ($2 ~ /with -surface$/) ? " -surface" : ($2 ~ /with -surface_ladder$/) ? " -surface_ladder" : ""
+    a = flag == " -surface" ? s : flag == " -surface_ladder" ? l : v
     if (a != "") {
       print $1, $2, a, "collision", (a == "collision") ? "met" : "missed",
-            "pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt" (surf ? " -surface" : ""); next }
+            "pcd_collision data/gripper.obj data/table_mug.pcd -poses data/demo_poses.txt" flag; next }
   } { print }' "$out/targets.csv" > "$out/targets.csv.tmp" && mv "$out/targets.csv.tmp" "$out/targets.csv"
-echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)}, with -surface ${demo_surface:-nothing} (issue 16 target: collision)"
+echo "evaluate.sh: demo pose 2 reads ${demo_verdict:-nothing (pcd_collision failed)}, with -surface ${demo_surface:-nothing}, with -surface_ladder ${demo_ladder:-nothing} (issue 16 target: collision)"
 
 # The summary table as markdown (docs/RESULTS.md quotes it).
 awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i;
