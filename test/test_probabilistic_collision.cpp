@@ -141,6 +141,55 @@ TEST (ProbabilisticCollision, SeparatedTouchingAndCrossingPlanesGetTheirVerdicts
   EXPECT_LT (std::abs (crossing.witness_point.z ()), 0.02);  // the witness lies at the crossing
 }
 
+// CollisionRequest::surface through the filter: the next query builds both clouds' surface
+// model, once, and the surface layer answers (named by answered_by, with a signed distance) as
+// collide() does on models built with CloudModelParams::surface; the separators' answer on the
+// rebuilt models is the one before.
+TEST (ProbabilisticCollision, ASurfaceRequestBuildsTheSurfaceModelsOnce)
+{
+  const SensorNoiseModel noise = SensorNoiseModel::isotropic (0.002);
+  const auto a = organizedPatch (0.2, 0.01, 0.0, 0.0, 1);
+  const auto b = organizedPatch (0.2, 0.01, 0.0, 0.0, 2);
+  const Eigen::Isometry3d pose (Eigen::Translation3d (0.0, 0.0, 0.003));
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (a);
+  pc.setTargetCloud (b);
+  pc.setInputNoise (noise);
+  pc.setTargetNoise (noise);
+  CollisionRequest request;
+  request.enable_timings = true;
+  pc.setRequest (request);
+  CollisionResult plain, surface, again, separators;
+  ASSERT_TRUE (pc.compute (pose, plain)) << plain.message;
+  EXPECT_EQ (plain.answered_by, AnsweredBy::Separators);
+  EXPECT_TRUE (std::isnan (plain.signed_distance));
+
+  request.surface = true;
+  pc.setRequest (request);
+  ASSERT_TRUE (pc.compute (pose, surface)) << surface.message;
+  EXPECT_EQ (surface.answered_by, AnsweredBy::SurfaceLayer);
+  EXPECT_TRUE (std::isfinite (surface.signed_distance));
+  EXPECT_GT (surface.build_ms, 0.0);  // built for this query
+  ASSERT_TRUE (pc.compute (pose, again)) << again.message;
+  EXPECT_EQ (again.build_ms, 0.0);  // and kept
+  EXPECT_EQ (again.probability, surface.probability);
+
+  CloudModelParams params;
+  params.noise = noise;
+  params.surface = true;
+  CollisionResult direct;
+  ASSERT_TRUE (collide (*buildCloudModel (*a, params), *buildCloudModel (*b, params), pose.inverse (), request, direct));
+  EXPECT_EQ (surface.probability, direct.probability);
+  EXPECT_EQ (surface.signed_distance, direct.signed_distance);
+
+  request.surface = false;
+  pc.setRequest (request);
+  ASSERT_TRUE (pc.compute (pose, separators)) << separators.message;
+  EXPECT_EQ (separators.build_ms, 0.0);  // the surface models serve the separators too
+  EXPECT_EQ (separators.answered_by, AnsweredBy::Separators);
+  EXPECT_EQ (separators.probability, plain.probability);
+}
+
 TEST (ProbabilisticCollision, ProbabilityFallsWithTheGapAndStaysNearTheFlatAnswer)
 {
   // Clean parallel patches with isotropic sigma: the single-classifier (flat) answer is

@@ -72,7 +72,8 @@ struct CollisionRequest
   /** \brief The surface layer (METHOD.md 10a), experimental: instead of the separators, test
     * each object's points against the other's oriented surface (a local signed distance near
     * contact, a winding-number inside test when out of reach) and fill signed_distance. Needs
-    * both models built with CloudModelParams::surface; otherwise the separators answer.
+    * both models built with CloudModelParams::surface (ProbabilisticCollision builds them so when
+    * its request asks); otherwise the separators answer, and CollisionResult::answered_by says so.
     * Default off: on the evaluation's noisy piano-in-room clouds, whose normals are oriented by
     * propagation, it is not yet as accurate as the separators (docs/RESULTS.md, issue #16). */
   bool surface = false;

@@ -124,7 +124,10 @@ public:
     * without being set again. Prebuilt models are kept. */
   void markForRebuild () { markInput (); markTarget (); }
 
-  /** \brief Every query parameter at once; validated (throws pcl::BadArgumentException). */
+  /** \brief Every query parameter at once; validated (throws pcl::BadArgumentException). With
+    * request.surface on, the next query builds both clouds' surface model
+    * (CloudModelParams::surface) if they lack it; a model set by setInputModel() or setTargetModel()
+    * is used as given. */
   void setRequest (const CollisionRequest& request);
   const CollisionRequest& getRequest () const { return request_; }
   /** \brief Verdict thresholds on P: Free below free_below, InCollision above collision_above. */

@@ -136,10 +136,15 @@ ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
 {
   const auto start = std::chrono::steady_clock::now ();
   bool built = false;
+  // A surface request (CollisionRequest::surface) needs both models' surface model: a model this
+  // filter built without one is rebuilt with it, once. The separators answer alike either way
+  // (the surface model adds to the hierarchy, it changes none of it); a prebuilt model is the
+  // caller's (CollisionResult::answered_by then says who answered).
   auto build = [&] (const PointCloudConstPtr& cloud, const pcl::IndicesConstPtr& indices,
-                    const CovarianceCloudConstPtr& covariances, const CloudModelParams& params, const char* which,
+                    const CovarianceCloudConstPtr& covariances, CloudModelParams params, const char* which,
                     CloudModel::ConstPtr& model, bool& dirty) {
-    if (!dirty && model)
+    params.surface = params.surface || request_.surface;
+    if (!dirty && model && (!params.surface || model->params ().surface))
       return true;
     model.reset ();
     if (!cloud)
