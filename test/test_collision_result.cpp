@@ -23,6 +23,16 @@ TEST (Verdict, AValueOutsideTheEnumIsNamedUnknown)
   EXPECT_STREQ (verdictName (static_cast<Verdict> (42)), "unknown");
 }
 
+TEST (AnsweredBy, NamesAreTheDocumentedWords)
+{
+  // The words of pcd_collision's JSON member answered_by (docs/CLI.md).
+  EXPECT_STREQ (answeredByName (AnsweredBy::Separators), "separators");
+  EXPECT_STREQ (answeredByName (AnsweredBy::SurfaceLayer), "surface");
+  EXPECT_STREQ (answeredByName (AnsweredBy::Pooled), "pooled");
+  EXPECT_STREQ (answeredByName (AnsweredBy::Unknown), "unknown");
+  EXPECT_STREQ (answeredByName (static_cast<AnsweredBy> (42)), "unknown");
+}
+
 TEST (CollisionResult, DefaultIsNotOkAndHoldsNothingComputed)
 {
   const CollisionResult r;
@@ -30,6 +40,7 @@ TEST (CollisionResult, DefaultIsNotOkAndHoldsNothingComputed)
   EXPECT_EQ (r.status, CollisionResult::Status::InvalidInput);
   EXPECT_TRUE (r.message.empty ());
   EXPECT_EQ (r.verdict, Verdict::Unknown);
+  EXPECT_EQ (r.answered_by, AnsweredBy::Unknown);
   EXPECT_TRUE (std::isnan (r.probability)) << r.probability;
   EXPECT_FALSE (r.lower_bound);
   EXPECT_FALSE (r.no_leaf_tested);
