@@ -1112,8 +1112,9 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   answer.leaf_pairs = pairs.size ();
   double best_z = std::numeric_limits<double>::infinity ();
   // Decision mode: once a point's P_in exceeds collision_above the verdict is final (the
-  // distance is then a bound: the deepest point may not have been reached).
-  const bool may_stop = !request.exhaustive && !per_point_a && !per_point_b;
+  // distance is then a bound: the deepest point may not have been reached). A requested
+  // distance (CollisionRequest::distance) is an estimate, never such a bound.
+  const bool may_stop = !request.exhaustive && !request.distance && !per_point_a && !per_point_b;
   const double stop_z = may_stop ? -normalQuantile (request.collision_above) : -std::numeric_limits<double>::infinity ();
   if (!pairs.empty ())
   {

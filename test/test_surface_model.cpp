@@ -322,6 +322,37 @@ TEST (SurfaceLayer, SignedDistanceOfASlabOverATable)
   EXPECT_TRUE (std::isnan (r.signed_distance));
 }
 
+// A distance asked for (CollisionRequest::distance) is an estimate, never the decision mode's
+// bound: the slab tilted 1 cm into the table (its bottom 2.5-17.5 mm deep) stops at the first
+// point that decides the collision without it, and is answered as exhaustively with it.
+TEST (SurfaceLayer, AnAskedDistanceIsNeverTheFirstDecidingPoint)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto block = buildCloudModel (slab (0.1, 0.05, 0.01), withSurface ());
+  const Eigen::Isometry3d T = shift (0, 0, 0.01) * Eigen::AngleAxisd (0.15, Eigen::Vector3d::UnitY ());
+  CollisionRequest decision = surfaceRequest ();
+  decision.exhaustive = false;
+  CollisionRequest exhaustive = surfaceRequest ();
+  CollisionRequest asked = decision;
+  asked.distance = true;
+  CollisionResult first, all, with_distance;
+  ASSERT_TRUE (collide (*block, *table, T, decision, first)) << first.message;
+  ASSERT_TRUE (collide (*block, *table, T, exhaustive, all)) << all.message;
+  ASSERT_TRUE (collide (*block, *table, T, asked, with_distance)) << with_distance.message;
+  ASSERT_TRUE (first.lower_bound);  // the pose exercises the early stop
+  EXPECT_EQ (first.verdict, Verdict::InCollision);
+  EXPECT_FALSE (with_distance.lower_bound);
+  EXPECT_FALSE (with_distance.sample_distance);
+  EXPECT_EQ (with_distance.verdict, Verdict::InCollision);
+  EXPECT_EQ (with_distance.probability, all.probability);
+  EXPECT_EQ (with_distance.signed_distance, all.signed_distance);
+  EXPECT_EQ (with_distance.signed_distance_std, all.signed_distance_std);
+  // The most significant point, at least as deep in deviations as the first deciding one.
+  EXPECT_LE (with_distance.signed_distance / with_distance.signed_distance_std,
+             first.signed_distance / first.signed_distance_std);
+  EXPECT_LT (with_distance.signed_distance, -0.005);
+}
+
 // A table without a viewpoint (its sensor origin within it) is oriented by propagation, which
 // cannot say which side is solid: a ball 10 mm above it and one 10 mm below read free alike.
 // Through its middle, the ball reads collision (its points on both sides of the table).

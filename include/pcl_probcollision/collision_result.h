@@ -60,7 +60,8 @@ struct CollisionResult
     * both surfaces (no_leaf_tested without a far-field inside answer). The distance at the
     * query's most significant point (lowest d / std); when the query stopped early at a
     * collision (lower_bound), at the first point that decided it: the deepest may lie elsewhere
-    * (CollisionRequest::exhaustive visits every pair). */
+    * (CollisionRequest::exhaustive visits every pair; so does CollisionRequest::distance, whose
+    * distance is never such a bound). */
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
     * surfaces' own uncertainty and the discretisation between samples); NaN with it. */
