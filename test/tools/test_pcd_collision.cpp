@@ -411,7 +411,7 @@ TEST_F (PcdCollisionTool, DemoPosesVerdicts)
 // With -surface the penetrating demo pose stops at the first point that decides the collision
 // (P >=): its distance is that point's, and the human line says so; -exhaustive visits every
 // pair and reports the most significant point, here the fingers' full 2 cm (a deeper distance
-// than the stopped query's), without the marker.
+// than the stopped query's), without the marker; so does -distance.
 TEST_F (PcdCollisionTool, AStoppedQueryNamesItsDistanceTheFirstDecidingPoint)
 {
   const std::string marker = " (first deciding point)";
@@ -441,6 +441,18 @@ TEST_F (PcdCollisionTool, AStoppedQueryNamesItsDistanceTheFirstDecidingPoint)
   ASSERT_EQ (full[2]["signed_distance"].type, Value::Type::Number);
   EXPECT_LT (full[2]["signed_distance"].number, stopped[2]["signed_distance"].number);
   EXPECT_NEAR (full[2]["signed_distance"].number, -0.02, 3.0 * full[2]["signed_distance_std"].number + 0.002);
+  // -distance asks for an estimate: near contact the same answer as -exhaustive, never a bound.
+  args.pop_back ();
+  args.push_back ("-distance");
+  const auto asked = runJson (args);
+  ASSERT_EQ (asked.size (), 3u);
+  for (std::size_t i = 1; i < 3; ++i)
+  {
+    SCOPED_TRACE ("pose " + std::to_string (i) + " with -distance");
+    EXPECT_FALSE (asked[i]["lower_bound"].boolean);
+    EXPECT_EQ (asked[i]["probability"].number, full[i]["probability"].number);
+    EXPECT_EQ (asked[i]["signed_distance"].number, full[i]["signed_distance"].number);
+  }
 }
 
 // -surface_ladder on the README demo: the clear pose is the separators' alone (no leaf pair
