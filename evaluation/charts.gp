@@ -6,7 +6,7 @@
 # reads  dir/{summary,queries,flips,model_size,reliability}.csv   (comma separated, header line)
 # writes out/accuracy_vs_time.png, free_probability_vs_distance.png, flip_rate_vs_noise.png,
 #        model_size_vs_accuracy.png, reliability.png, rescan_flips.png,
-#        reliability_grid.png                                        (out defaults to dir)
+#        reliability_grid.png, signed_distance_vs_exact.png          (out defaults to dir)
 #
 # Optional variables, given with -e before the script, e.g. -e "dir='x'; noise=1":
 #   out       directory of the PNGs (default: dir)
@@ -21,6 +21,8 @@
 #   noiseunit what noise_pct measures, for axis labels (default "% of the piano's bounding-box diagonal")
 #   relband   band of chart 5: 'near_sigma' (|d| <= 2.8 sigma_eff, default), 'near_contact' or 'all'
 #   gridwl    workloads of chart 7, one row each (default 'W1 W1-sparse W2 W3')
+#   dwl, dlevels, dsetting  rows (default 'W1 W1-sparse'), noise levels (default: those up to 1 %
+#             with a distance) and setting of ours (default 'surface') of chart 8
 # Columns are found by header name, so the order of the columns does not matter. A chart whose
 # file is missing or whose selection is empty is skipped with a message.
 
@@ -456,6 +458,72 @@ if (!readable("reliability.csv")) {
         } else {
           set multiplot next
         }
+      }
+    }
+    unset multiplot
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (8) The surface layer's signed distance against the exact one, both in σ_eff, for the poses
+# within 5 σ_eff of contact: one panel per room (rows, dwl) and noise level (columns, dlevels),
+# error bars ±2 std; blue: the interval covers the exact distance, red: it misses (issue 16's
+# coverage target counts the near band, between the dotted lines). Colliding poses answered in
+# decision mode report the first deciding point's distance (docs/SURFACE.md, step 5).
+
+if (!exists("dwl")) dwl = "W1 W1-sparse"
+if (!exists("dsetting")) dsetting = "surface"
+# The levels of the coverage target (0.25-1 %) at which the setting gave a distance.
+if (!exists("dlevels") && readable("queries.csv")) {
+  dlevels = system(select("queries.csv", noise, sprintf("%s == \"ours\" && %s == \"%s\" && %s ~ /^W1/ && num(%s) && %s > 0 && %s <= 1 { print %s }", \
+                   col("method"), col("setting"), dsetting, col("workload"), col("signed_distance"), col("noise_pct"), \
+                   col("noise_pct"), col("noise_pct"))) \
+                   . " | sort -gu | tr '\\n' ' '")
+}
+dist_prog(w, lv, covered) = sprintf("$c[\"workload\"] == \"%s\" && ($c[\"noise_pct\"] - %s) * ($c[\"noise_pct\"] - %s) < 1e-12 && %s == \"ours\" && %s == \"%s\" && num(%s) && num(%s) && %s > 0 { s = %s; e = %s / s; d = %s / s; u = %s / s; if (e < -5 || e > 5) next; ok = (d - e <= 2 * u && e - d <= 2 * u); if (ok == %d) print e, d, 2 * u }", \
+  w, lv, lv, col("method"), col("setting"), dsetting, col("signed_distance"), col("signed_distance_std"), col("sigma_eff"), \
+  col("sigma_eff"), col("exact_distance"), col("signed_distance"), col("signed_distance_std"), covered)
+cmd8(w, lv, covered) = select("queries.csv", noise, dist_prog(w, lv, covered))
+
+if (!readable("queries.csv")) {
+  print skip("signed_distance_vs_exact.png", "no queries.csv")
+} else {
+  drows = ""
+  do for [w in dwl] {
+    n8 = 0
+    do for [lv in dlevels] { n8 = n8 + count(cmd8(w, lv, 1)) + count(cmd8(w, lv, 0)) }
+    if (n8 > 0) { drows = drows . " " . w }
+  }
+  if (words(drows) == 0) {
+    print skip("signed_distance_vs_exact.png", sprintf("no signed distances of ours/%s", dsetting))
+  } else {
+    reset
+    nc8 = words(dlevels)
+    if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
+      set terminal pngcairo size 420 * nc8 + 60, 400 * words(drows) + 60 noenhanced font "DejaVu Sans,9"
+    } else {
+      set terminal png size 420 * nc8 + 60, 400 * words(drows) + 60 noenhanced
+    }
+    set output png("signed_distance_vs_exact.png")
+    set multiplot layout words(drows), nc8 title sprintf("ours/%s: signed distance ±2 std against the exact one, in σ_eff (blue: covers it, red: misses)", dsetting)
+    set xrange [-5:5]
+    set yrange [-8:8]
+    set grid
+    set xlabel "exact signed distance / σ_eff"
+    set ylabel "estimated / σ_eff"
+    unset key
+    set arrow 1 from first -2.8, graph 0 to first -2.8, graph 1 nohead dt 3 lc rgb "#999999"
+    set arrow 2 from first 2.8, graph 0 to first 2.8, graph 1 nohead dt 3 lc rgb "#999999"
+    do for [w in drows] {
+      do for [lv in dlevels] {
+        n_in = count(cmd8(w, lv, 1))
+        n_out = count(cmd8(w, lv, 0))
+        set title sprintf("%s, noise %s %%: %d poses within 5 σ_eff, %.0f %% covered", w, lv, n_in + n_out, \
+                          n_in + n_out > 0 ? 100.0 * n_in / (n_in + n_out) : 0)
+        plot x with lines dt 2 lc rgb "#777777", \
+             "< " . cmd8(w, lv, 1) using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb "#a01f77b4", \
+             "< " . cmd8(w, lv, 0) using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb "#d62728"
       }
     }
     unset multiplot
