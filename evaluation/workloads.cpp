@@ -54,6 +54,12 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   OursSetting ladder = surface;
   ladder.name = "ladder";
   ladder.request.surface_ladder = true;
+  // The surface layer on models of 20 neighbours instead of 10 (covariances, projected
+  // positions and normals): surer near contact, on the chart, not the default (docs/SURFACE.md,
+  // "Twenty neighbours").
+  OursSetting surface_k20 = surface;
+  surface_k20.name = "surface-k20";
+  surface_k20.model.k = 20;
   OursSetting other = classifier;
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
@@ -62,6 +68,7 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (surface);
   s.push_back (pooled);
   s.push_back (ladder);
+  s.push_back (surface_k20);
   s.push_back (other);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
   // noise is at least the local sample spacing ("gate<c>"), or the hierarchy not split within
