@@ -55,8 +55,8 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   ladder.name = "ladder";
   ladder.request.surface_ladder = true;
   // The surface layer on models of 20 neighbours instead of 10 (covariances, projected
-  // positions and normals): surer near contact, on the chart, not the default (docs/SURFACE.md,
-  // "Twenty neighbours").
+  // positions and normals): surer near contact in the dense room, not in the sparse one; on the
+  // chart, not the default (docs/SURFACE.md, "Twenty neighbours").
   OursSetting surface_k20 = surface;
   surface_k20.name = "surface-k20";
   surface_k20.model.k = 20;
