@@ -483,6 +483,7 @@ if (!exists("dlevels") && readable("queries.csv")) {
                    . " | sort -gu | tr '\\n' ' '")
 }
 near8 = 2.8  # the near band, |d| <= 2.8 σ_eff (evaluate_collision's kNearSigma)
+shown8 = 5   # the poses plotted, |d| <= 5 σ_eff
 dist_prog(w, lv, covered, reach) = sprintf("$c[\"workload\"] == \"%s\" && ($c[\"noise_pct\"] - %s) * ($c[\"noise_pct\"] - %s) < 1e-12 && %s == \"ours\" && %s == \"%s\" && num(%s) && num(%s) && %s > 0 { s = %s; e = %s / s; d = %s / s; u = %s / s; if (e < -%g || e > %g) next; ok = (d - e <= 2 * u && e - d <= 2 * u); if (ok == %d) print e, d, 2 * u }", \
   w, lv, lv, col("method"), col("setting"), dsetting, col("signed_distance"), col("signed_distance_std"), col("sigma_eff"), \
   col("sigma_eff"), col("exact_distance"), col("signed_distance"), col("signed_distance_std"), reach, reach, covered)
@@ -494,7 +495,7 @@ if (!readable("queries.csv")) {
   drows = ""
   do for [w in dwl] {
     n8 = 0
-    do for [lv in dlevels] { n8 = n8 + count(cmd8(w, lv, 1, 5)) + count(cmd8(w, lv, 0, 5)) }
+    do for [lv in dlevels] { n8 = n8 + count(cmd8(w, lv, 1, shown8)) + count(cmd8(w, lv, 0, shown8)) }
     if (n8 > 0) { drows = drows . " " . w }
   }
   if (words(drows) == 0) {
@@ -509,7 +510,7 @@ if (!readable("queries.csv")) {
     }
     set output png("signed_distance_vs_exact.png")
     set multiplot layout words(drows), nc8 title sprintf("ours/%s: signed distance ±2 std against the exact one, in σ_eff (blue: covers it, red: misses)", dsetting)
-    set xrange [-5:5]
+    set xrange [-shown8:shown8]
     set yrange [-8:8]
     set grid
     set xlabel "exact signed distance / σ_eff"
@@ -524,8 +525,8 @@ if (!readable("queries.csv")) {
         set title sprintf("%s, noise %s %%: %.3f of %d near-band poses covered", w, lv, \
                           n_in + n_out > 0 ? 1.0 * n_in / (n_in + n_out) : 0, n_in + n_out)
         plot x with lines dt 2 lc rgb "#777777", \
-             "< " . cmd8(w, lv, 1, 5) using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb "#a01f77b4", \
-             "< " . cmd8(w, lv, 0, 5) using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb "#d62728"
+             "< " . cmd8(w, lv, 1, shown8) using 1:2:3 with yerrorbars pt 7 ps 0.4 lc rgb "#a01f77b4", \
+             "< " . cmd8(w, lv, 0, shown8) using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb "#d62728"
       }
     }
     unset multiplot
