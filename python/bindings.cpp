@@ -676,15 +676,18 @@ PYBIND11_MODULE (_core, m)
       "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma: the hierarchy;\n"
       "surface: also build the oriented surface model (METHOD.md 10a) that CollisionRequest.surface queries\n"
       "(experimental, issue #16; costs a normal fit and an orientation pass per point); orientation: how its\n"
-      "normals are oriented (NormalOrientation, default Auto).")
+      "normals are oriented (NormalOrientation, default Auto); closed_objects: the cloud samples closed solids,\n"
+      "so a propagated orientation, once checked by the winding number, says where the inside is.")
       .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, int n_min,
-                          double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation) {
+                          double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation,
+                          bool closed_objects) {
               CloudModelParams p;
               p.k = k;
               p.noise = noise;
               p.surface_projection = surface_projection;
               p.surface = surface;
               p.orientation = orientation;
+              p.closed_objects = closed_objects;
               p.hierarchy.n_max = n_max;
               p.hierarchy.n_min = n_min;
               p.hierarchy.sigma_max = sigma_max;
@@ -697,6 +700,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("n_min") = dp.hierarchy.n_min, py::arg ("sigma_max") = dp.hierarchy.sigma_max,
             py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
             py::arg ("surface") = dp.surface, py::arg ("orientation") = dp.orientation,
+            py::arg ("closed_objects") = dp.closed_objects,
             "Every argument defaults to the C++ CloudModelParams default.")
       .def_readwrite ("k", &CloudModelParams::k)
       .def_readwrite ("noise", &CloudModelParams::noise)
@@ -705,6 +709,11 @@ PYBIND11_MODULE (_core, m)
                       "Build the surface model CollisionRequest.surface queries (default False).")
       .def_readwrite ("orientation", &CloudModelParams::orientation,
                       "How the surface model's normals are oriented (NormalOrientation, default Auto).")
+      .def_readwrite ("closed_objects", &CloudModelParams::closed_objects,
+                      "The cloud samples closed solids (not an open sheet, one scan's view or a room seen from\n"
+                      "within): a propagated orientation is checked by the winding number and, where it checks out,\n"
+                      "says where the inside is (CloudModel.surface_inside_known). Default False: a propagated surface\n"
+                      "is two-sided.")
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
                       "Merge samples closer than this many sensor-noise sigmas into one (issue #17; default 0: off).")
       .def_property ("noise_resolution_gated",
@@ -751,7 +760,8 @@ PYBIND11_MODULE (_core, m)
                ", n_max=" + std::to_string (p.hierarchy.n_max) + ", n_min=" + std::to_string (p.hierarchy.n_min) +
                ", sigma_max=" + num (p.hierarchy.sigma_max) + ", epsilon=" + num (p.hierarchy.epsilon) +
                ", k_sigma=" + num (p.hierarchy.k_sigma) + ", surface=" + (p.surface ? "True" : "False") +
-               ", orientation=NormalOrientation." + enumName (p.orientation) + ")";
+               ", orientation=NormalOrientation." + enumName (p.orientation) +
+               ", closed_objects=" + (p.closed_objects ? "True" : "False") + ")";
       });
 
   // --- CollisionRequest ---------------------------------------------------------------------------
@@ -961,6 +971,22 @@ PYBIND11_MODULE (_core, m)
                                 return py::cast (c.surface ().orientation ());
                               },
                               "The NormalOrientation the surface model used (Auto resolved), None without a surface.")
+      .def_property_readonly ("surface_inside_known",
+                              [] (const CloudModel& c) -> py::object {
+                                if (c.surface ().empty ())
+                                  return py::none ();
+                                return py::cast (c.surface ().insideKnown ());
+                              },
+                              "Whether the surface model's orientation says where the inside is (given normals, a viewpoint,\n"
+                              "or a propagated one checked closed with CloudModelParams.closed_objects); False: two-sided.\n"
+                              "None without a surface.")
+      .def_property_readonly ("surface_closed_share",
+                              [] (const CloudModel& c) {
+                                return c.surface ().empty () ? std::numeric_limits<double>::quiet_NaN ()
+                                                             : c.surface ().closedShare ();
+                              },
+                              "With closed_objects and a propagated orientation, the share of probed samples in front of\n"
+                              "which the surface reads outside (SurfaceModel::closedShare); NaN where not checked.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +

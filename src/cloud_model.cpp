@@ -64,6 +64,7 @@ CloudModel::buildSurfaceFromPoints (NormalOrientation orientation, int k)
   in.normals = estimation.getNormals ();
   in.radii = estimation.getNeighbourRadii ();
   in.neighbours = estimation.getNeighbours ();
+  in.closed_objects = params_.closed_objects;
   surface_.build (bvh_, std::move (in), orientation);
 }
 

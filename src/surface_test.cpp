@@ -765,13 +765,14 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
   scratch.earlier_leaves.push_back (leaf);
 }
 
-/** \brief Whether the surface's orientation says where its inside is: the points' own normals
-  * or a viewpoint. A propagated one does not: an open sheet's side is a coin toss, and a room
-  * seen from within is oriented inside out (its free space read as inside the walls). */
+/** \brief Whether the surface's orientation says where its inside is (SurfaceModel::insideKnown):
+  * the points' own normals, a viewpoint, or a propagated one checked closed for a cloud declared
+  * closed objects. A propagated one otherwise does not: an open sheet's side is a coin toss, and
+  * a room seen from within is oriented inside out (its free space read as inside the walls). */
 bool
 trustedOrientation (const SurfaceModel& s)
 {
-  return s.orientation () != NormalOrientation::Propagate;
+  return s.insideKnown ();
 }
 
 /** \brief True when the surface's area-weighted normals cancel to within kClosedFlux of its

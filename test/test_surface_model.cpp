@@ -517,6 +517,116 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   EXPECT_TRUE (outside.no_leaf_tested);
 }
 
+namespace
+{
+/** \brief The surface of the box of half extents h about c, sampled on a grid of about spacing
+  * `step` on each face, every coordinate moved by N(0, sigma^2) (seeded): a solid's samples
+  * without normals. */
+pcl::PointCloud<pcl::PointXYZ>
+boxSurface (const Eigen::Vector3d& c, const Eigen::Vector3d& h, double step, double sigma, unsigned seed)
+{
+  std::mt19937 rng (seed);
+  std::normal_distribution<double> noise (0.0, sigma);
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double side : {-1.0, 1.0})
+    {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const int nu = static_cast<int> (std::ceil (2.0 * h (u) / step)), nv = static_cast<int> (std::ceil (2.0 * h (v) / step));
+      for (int i = 0; i <= nu; ++i)
+        for (int j = 0; j <= nv; ++j)
+        {
+          Eigen::Vector3d p;
+          p (axis) = side * h (axis);
+          p (u) = -h (u) + 2.0 * h (u) * i / nu;
+          p (v) = -h (v) + 2.0 * h (v) * j / nv;
+          p += c + Eigen::Vector3d (noise (rng), noise (rng), noise (rng));
+          cloud.push_back (pcl::PointXYZ (static_cast<float> (p.x ()), static_cast<float> (p.y ()), static_cast<float> (p.z ())));
+        }
+    }
+  return cloud;
+}
+
+CloudModelParams
+closedObjects (CloudModelParams p)
+{
+  p.closed_objects = true;
+  return p;
+}
+} // namespace
+
+// Declared closed objects (CloudModelParams::closed_objects), a propagated orientation is checked
+// by the winding number in front of and behind its samples: a sphere and a noisy box check out
+// and are trusted (the box's edge samples' probes behind come out of it: fewer read inside); an
+// open sheet does not (about 1/2 on either side), nor does a plate thinner than the probes'
+// offset (every probe behind it comes out beyond its other face). Undeclared, nothing is
+// checked and the propagated surface stays two-sided.
+TEST (SurfaceModel, ClosedObjectsCheckTheirPropagatedOrientation)
+{
+  const auto ball = buildCloudModel (xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3))), closedObjects (withSurface ()));
+  ASSERT_EQ (ball->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_GE (ball->surface ().closedShare (), 0.95);
+  EXPECT_GE (ball->surface ().solidShare (), 0.95);
+  EXPECT_TRUE (ball->surface ().insideKnown ());
+  const auto box = buildCloudModel (boxSurface (Eigen::Vector3d (1, 2, 3), Eigen::Vector3d (0.1, 0.08, 0.06), 0.006, 0.001, 7),
+                                    closedObjects (noisy (0.001)));
+  ASSERT_EQ (box->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_GE (box->surface ().closedShare (), 0.95);
+  EXPECT_GT (box->surface ().solidShare (), 0.7);  // 0.89
+  EXPECT_LT (box->surface ().solidShare (), box->surface ().closedShare ());
+  EXPECT_TRUE (box->surface ().insideKnown ());
+  const auto undeclared = buildCloudModel (xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3))), withSurface ());
+  EXPECT_TRUE (std::isnan (undeclared->surface ().closedShare ()));
+  EXPECT_FALSE (undeclared->surface ().insideKnown ());
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f::Zero ()), closedObjects (noisy (0.001)));
+  ASSERT_EQ (table->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_LT (table->surface ().closedShare (), 0.1);  // 0.04
+  EXPECT_FALSE (table->surface ().insideKnown ());
+  CloudModelParams propagated = closedObjects (noisy (0.0005));
+  propagated.orientation = NormalOrientation::Propagate;  // PCL's default origin would be its viewpoint
+  const auto plate = buildCloudModel (boxSurface (Eigen::Vector3d (1, 2, 3), Eigen::Vector3d (0.1, 0.1, 0.001), 0.004, 0.0005, 8),
+                                      propagated);
+  ASSERT_EQ (plate->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_LT (plate->surface ().solidShare (), 0.1);
+  EXPECT_FALSE (plate->surface ().insideKnown ());
+  // Given normals and a viewpoint are trusted anyway, and not checked.
+  const auto given = buildCloudModel (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3)), closedObjects (withSurface ()));
+  EXPECT_EQ (given->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_TRUE (std::isnan (given->surface ().closedShare ()));
+  EXPECT_TRUE (given->surface ().insideKnown ());
+}
+
+// A small box wholly inside a big noisy box sampled without normals, deeper than any point's
+// reach of its surface: declared closed objects, the winding number finds it (collision, about
+// as deep as it lies); undeclared, the propagated surface is two-sided and says nothing about an
+// inside, so the query reads free, as the separators do. Outside, both read free.
+TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
+{
+  const auto solid = boxSurface (Eigen::Vector3d::Zero (), Eigen::Vector3d (0.3, 0.25, 0.2), 0.01, 0.002, 11);
+  const auto declared = buildCloudModel (solid, closedObjects (noisy (0.002)));
+  const auto undeclared = buildCloudModel (solid, noisy (0.002));
+  ASSERT_TRUE (declared->surface ().insideKnown ()) << declared->surface ().closedShare ();
+  ASSERT_FALSE (undeclared->surface ().insideKnown ());
+  const auto small = buildCloudModel (boxSurface (Eigen::Vector3d::Zero (), Eigen::Vector3d::Constant (0.03), 0.01, 0.0, 12),
+                                      withSurface ());
+  CollisionResult inside, outside, two_sided;
+  ASSERT_TRUE (collide (*small, *declared, shift (0.05, -0.02, 0.01), surfaceRequest (), inside));
+  EXPECT_EQ (inside.verdict, Verdict::InCollision) << "P " << inside.probability;
+  EXPECT_LT (inside.signed_distance, -0.1) << inside.signed_distance;  // the nearest face is 0.16 away
+  EXPECT_FALSE (inside.unobserved);
+  ASSERT_TRUE (collide (*small, *undeclared, shift (0.05, -0.02, 0.01), surfaceRequest (), two_sided));
+  EXPECT_EQ (two_sided.verdict, Verdict::Free) << "P " << two_sided.probability;
+  ASSERT_TRUE (collide (*small, *declared, shift (0.5, 0.0, 0.0), surfaceRequest (), outside));
+  EXPECT_EQ (outside.verdict, Verdict::Free) << "P " << outside.probability;
+  // A small box half way through a face: both read collision (its points on both sides).
+  for (const auto* model : {&declared, &undeclared})
+  {
+    CollisionResult through;
+    ASSERT_TRUE (collide (*small, **model, shift (0.3, 0.0, 0.0), surfaceRequest (), through));
+    EXPECT_EQ (through.verdict, Verdict::InCollision) << "P " << through.probability;
+  }
+}
+
 // A small ball half inside a big closed surface: its far side lies deeper than any point's
 // reach of the big surface, and only the winding number of the nodes out of reach sees it.
 TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)

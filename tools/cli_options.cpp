@@ -43,7 +43,7 @@ const std::set<std::string> kValueFlags = {
   "-noise_stop", "-max_leaf_fits"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-surface_ladder", "-surface_calibrated", "-distance", "-ignore_normals",
-                                            "-v"};
+                                            "-closed", "-closed_a", "-closed_b", "-v"};
 
 ParseResult
 usage (const std::string& message)
@@ -299,6 +299,12 @@ parseCommandLine (const std::vector<std::string>& args)
         o.distance = true;
       else if (a == "-ignore_normals")
         o.ignore_normals = true;
+      else if (a == "-closed")
+        o.closed_a = o.closed_b = true;
+      else if (a == "-closed_a")
+        o.closed_a = true;
+      else if (a == "-closed_b")
+        o.closed_b = true;
       else if (a == "-json")
         o.json = true;
       else if (a == "-v")
@@ -469,6 +475,9 @@ parseCommandLine (const std::vector<std::string>& args)
     return usage ("options -deterministic and -stochastic cannot be combined");
   if (o.surface_pooled && o.surface_ladder)
     return usage ("options -surface_pooled and -surface_ladder cannot be combined");
+  if ((o.closed_a || o.closed_b) && !o.surface)
+    return usage ("options -closed, -closed_a and -closed_b need -surface (or -surface_pooled, -surface_ladder): they "
+                  "say where the surface layer's inside is");
   // -sensor sets both inputs, -sensor_a / -sensor_b one each whatever the order; likewise the
   // sigmas, which only an isotropic input uses.
   o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
@@ -579,6 +588,10 @@ helpText ()
        "                  gives a distance\n"
        "  -ignore_normals with -surface: orient clouds as if their files had no normal_x normal_y\n"
        "                  normal_z (by default a cloud's stored normals are its outward ones)\n"
+       "  -closed         with -surface: both inputs sample closed solids (not an open sheet, one\n"
+       "                  scan's view or a room seen from within): a cloud oriented by propagation\n"
+       "                  is checked by the winding number and, where it checks out, has an inside\n"
+       "                  (by default such a cloud is two-sided); -closed_a, -closed_b: one input\n"
        "  -nmax N         = "
     << D::n_max
     << "      hierarchy: a node with more points is split (n_min = min(" << D::n_min

@@ -120,6 +120,10 @@ struct Options
   /** \brief -ignore_normals: with -surface, a cloud file's normal_x normal_y normal_z are not
     * read (the cloud is oriented by its viewpoint or by propagation, as one without normals). */
   bool ignore_normals = false;
+  /** \brief -closed (both), -closed_a, -closed_b: with -surface, the input samples closed solids
+    * (CloudModelParams::closed_objects). */
+  bool closed_a = false;
+  bool closed_b = false;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

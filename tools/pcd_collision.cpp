@@ -255,11 +255,12 @@ requestFor (const Options& o)
   return r;
 }
 
-/** \brief How both inputs are modelled (the noise is set per input). */
+/** \brief How an input (<a> when `input`, else <b>) is modelled; the noise is set per input. */
 pcl_probcollision::CloudModelParams
-modelParamsFor (const Options& o)
+modelParamsFor (const Options& o, bool input)
 {
   pcl_probcollision::CloudModelParams m;
+  m.closed_objects = input ? o.closed_a : o.closed_b;
   m.k = o.k;
   m.noise_resolution = o.noise_resolution;
   m.surface_projection = !o.measured;
@@ -400,7 +401,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("surface_ladder").boolean (rq.surface_ladder);
   j.key ("surface_calibrated").boolean (rq.surface_calibrated);
   j.key ("distance").boolean (rq.distance);
-  const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o).hierarchy;
+  const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o, true).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);
   j.key ("sigma_max").number (hierarchy.sigma_max);
@@ -551,6 +552,15 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
     why = "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
           " % of the points lie behind others (one scan hides none)";
+  // -closed: whether the winding number confirmed a closed solid, so that the surface has an inside.
+  const double closed = model.surface ().closedShare ();
+  auto percent = [] (double share) { return std::to_string (static_cast<int> (std::lround (100.0 * share))); };
+  if (std::isfinite (closed))
+    why += std::string (model.surface ().insideKnown () ? "; closed: " : "; not closed, so two-sided: ") + "outside in front of " +
+           percent (closed) + " %, inside behind " + percent (model.surface ().solidShare ()) +
+           " % of the probed samples (closed needs 90 and 50)";
+  else if (orientation == pcl_probcollision::NormalOrientation::Propagate)
+    why += "; two-sided (-closed if it samples closed solids)";
   std::fprintf (log, "Orienting %s [%s: %s%s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how,
                 why.c_str ());
 }
@@ -723,7 +733,7 @@ run (int argc, char** argv)
   // A cloud's model as compute() builds it: the tool's parameters with that input's noise, and
   // the name compute() gives it.
   auto buildCloud = [&o] (const Input& in, const std::string& sensor, double sigma, bool input) {
-    pcl_probcollision::CloudModelParams params = modelParamsFor (o);
+    pcl_probcollision::CloudModelParams params = modelParamsFor (o, input);
     params.noise = SensorNoiseModel::fromName (sensor, sigma);
     return pcl_probcollision::buildCloudModel (*in.cloud, params, nullptr, nullptr, input ? "input" : "target");
   };
@@ -780,29 +790,29 @@ run (int argc, char** argv)
   pcl_probcollision::ProbabilisticCollision<pcl::PointXYZ> pc;
   pc.setInputCloud (a.cloud);
   pc.setTargetCloud (b.cloud);
-  pc.setInputModelParams (modelParamsFor (o));
-  pc.setTargetModelParams (modelParamsFor (o));
+  pc.setInputModelParams (modelParamsFor (o, true));
+  pc.setTargetModelParams (modelParamsFor (o, false));
   // A mesh is exact (zero covariance) and oriented by its faces: its model is built here from
   // the samples with their normals. A cloud whose file has normals (with -surface) is built here
   // too, as compute() would build it (its noise, the same name), from the points with their
   // normals, which the surface model takes as outward.
-  auto orientedModel = [&] (const Input& in, const SensorNoiseModel& noise, const char* which) {
+  auto orientedModel = [&] (const Input& in, const SensorNoiseModel& noise, bool input) {
     const auto shown = ticker.show ("Building " + in.path);
     if (in.kind == InputKind::Mesh)
     {
       const pcl::PointCloud<pcl_probcollision::Covariance> exact (in.oriented->width, in.oriented->height);
-      return pcl_probcollision::buildCloudModel (*in.oriented, modelParamsFor (o), nullptr, &exact, in.path);
+      return pcl_probcollision::buildCloudModel (*in.oriented, modelParamsFor (o, input), nullptr, &exact, in.path);
     }
-    pcl_probcollision::CloudModelParams params = modelParamsFor (o);
+    pcl_probcollision::CloudModelParams params = modelParamsFor (o, input);
     params.noise = noise;
-    return pcl_probcollision::buildCloudModel (*in.oriented, params, nullptr, nullptr, which);
+    return pcl_probcollision::buildCloudModel (*in.oriented, params, nullptr, nullptr, input ? "input" : "target");
   };
   if (a.oriented)
-    pc.setInputModel (orientedModel (a, SensorNoiseModel::fromName (o.sensor_a, o.sigma_a), "input"));
+    pc.setInputModel (orientedModel (a, SensorNoiseModel::fromName (o.sensor_a, o.sigma_a), true));
   else
     pc.setInputNoise (SensorNoiseModel::fromName (o.sensor_a, o.sigma_a));
   if (b.oriented)
-    pc.setTargetModel (orientedModel (b, SensorNoiseModel::fromName (o.sensor_b, o.sigma_b), "target"));
+    pc.setTargetModel (orientedModel (b, SensorNoiseModel::fromName (o.sensor_b, o.sigma_b), false));
   else
     pc.setTargetNoise (SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
   // The build time of the clouds built here, which compute() would otherwise have counted.

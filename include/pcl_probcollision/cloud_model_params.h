@@ -60,6 +60,17 @@ struct CloudModelParams
   bool surface = false;
   /** \brief How the surface's normals are oriented. Default Auto. */
   NormalOrientation orientation = NormalOrientation::Auto;
+  /** \brief The cloud samples closed objects: solids sampled all round (a segmented object from
+    * several views, a solid's mesh vertices without faces), not an open sheet, one scan's partial
+    * view or an environment seen from within. Where the orientation is propagated (no normals
+    * and no usable viewpoint), the build then checks it with the winding number
+    * (SurfaceModel::closedShare) and, where it checks out, the surface layer trusts it to say
+    * where the inside is (SurfaceModel::insideKnown): a point behind it is inside, and a part
+    * deep inside, out of reach of its surface, is found. Default off: a propagated surface is
+    * two-sided (a point behind it is as far from it as one in front), since propagation cannot
+    * tell a solid from a room seen from within. No effect on given normals or a viewpoint,
+    * which are trusted anyway. */
+  bool closed_objects = false;
   /** \brief Resolution tied to the noise (issue #17): samples closer than noise_resolution
     * times the sensor noise's smallest standard deviation (at the sample seeding a merge, see
     * detail::noiseClusters) are merged into one sample at their centroid, whose covariance is

@@ -45,6 +45,8 @@ public:
     int k = 0;
     /** \brief The sensor origin in the local frame, when the cloud has one. */
     std::optional<Eigen::Vector3d> viewpoint;
+    /** \brief CloudModelParams::closed_objects: a propagated orientation is checked (closedShare()). */
+    bool closed_objects = false;
     /** \brief Threads of the per-point passes (CloudModelParams::threads: 0 = every core);
       * the model is the same for any count. */
     int threads = 1;
@@ -113,6 +115,22 @@ public:
     * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
     * NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
+  /** \brief Where Inputs::closed_objects asked for it and the orientation was propagated: the
+    * share of the probed samples (at most 1,024, evenly spread over the oriented ones) in front
+    * of which the surface reads outside, |winding number| under 1/4 two spacings and three
+    * noise deviations (along the normal) off the sample. An open sheet reads about -1/2 there,
+    * a patch oriented inward about 1. NaN where not checked. */
+  double closedShare () const { return closed_share_; }
+  /** \brief With closedShare(): the share of the same probes behind which the surface reads
+    * inside (winding number above 3/4). Samples at an edge and on parts thinner than the offset
+    * come out of the solid (a plate: none inside), so this is lower than closedShare() even on
+    * a well oriented solid. NaN where not checked. */
+  double solidShare () const { return solid_share_; }
+  /** \brief Whether the orientation says where the inside is: the caller's normals, a viewpoint,
+    * or a propagated orientation checked closed (closedShare() at least 0.9 and solidShare() at
+    * least 0.5). Without it the surface is two-sided to the query: a point behind it is as far
+    * from it as one in front, and no point is found deep inside it. */
+  bool insideKnown () const;
   /** \brief Points without a normal (too few distinct neighbours): they bound nothing. */
   std::size_t unorientedPoints () const { return unoriented_; }
   /** \brief Points whose orientation came from propagation alone in Viewpoint mode (grazing
@@ -172,5 +190,7 @@ private:
   std::size_t unoriented_ = 0;
   std::size_t propagated_ = 0;
   double hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
+  double closed_share_ = std::numeric_limits<double>::quiet_NaN ();
+  double solid_share_ = std::numeric_limits<double>::quiet_NaN ();
 };
 } // namespace pcl_probcollision

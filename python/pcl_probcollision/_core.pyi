@@ -64,6 +64,7 @@ class CloudModelParams:
     split: str
     surface: bool
     orientation: NormalOrientation
+    closed_objects: bool
     noise_resolution: float
     noise_resolution_gated: bool
     noise_stop: float
@@ -71,7 +72,7 @@ class CloudModelParams:
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
                  k_sigma: float = ..., surface: bool = False,
-                 orientation: NormalOrientation = NormalOrientation.Auto) -> None: ...
+                 orientation: NormalOrientation = NormalOrientation.Auto, closed_objects: bool = False) -> None: ...
     def validate(self) -> None: ...
 
 class CollisionRequest:
@@ -193,6 +194,10 @@ class CloudModel:
     def has_surface(self) -> bool: ...
     @property
     def surface_orientation(self) -> Optional[NormalOrientation]: ...
+    @property
+    def surface_inside_known(self) -> Optional[bool]: ...
+    @property
+    def surface_closed_share(self) -> float: ...
     def __len__(self) -> int: ...
 
 def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDArray[np.floating]] = None,

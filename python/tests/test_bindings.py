@@ -56,7 +56,7 @@ def test_defaults_are_the_cpp_defaults():
     assert r.surface is False
     p = pc.CloudModelParams()
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
-    assert p.surface is False and p.orientation == pc.NormalOrientation.Auto
+    assert p.surface is False and p.orientation == pc.NormalOrientation.Auto and p.closed_objects is False
     assert p.noise_resolution == 0.0
     assert p.noise_stop == 0.0
     assert p.noise_resolution_gated is False
@@ -74,7 +74,8 @@ def test_defaults_are_the_cpp_defaults():
     doc = pc.CloudModelParams.__init__.__doc__
     for text in ("k: int = 10", "n_max: int = 20", "n_min: int = 8", "sigma_max: float = 0.05", "epsilon: float = 0.02",
                  "noise: pcl_probcollision._core.SensorNoiseModel = SensorNoiseModel.none()", "surface: bool = False",
-                 "orientation: pcl_probcollision._core.NormalOrientation = <NormalOrientation.Auto: 0>"):
+                 "orientation: pcl_probcollision._core.NormalOrientation = <NormalOrientation.Auto: 0>",
+                 "closed_objects: bool = False"):
         assert text in doc, text
     assert "threads: int = 0" in pc.collide_batch.__doc__
 
@@ -432,12 +433,36 @@ def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
             assert np.isnan(r.signed_distance)
 
 
+def test_closed_objects_know_their_inside():
+    # A sphere's samples without normals or a viewpoint: declared closed objects, the propagated
+    # orientation is checked by the winding number and trusted, so a small ball wholly inside it,
+    # out of reach of its surface, reads collision; undeclared, the surface is two-sided and the
+    # ball reads free.
+    i = np.arange(3000) + 0.5
+    polar, azimuth = np.arccos(1.0 - 2.0 * i / 3000), np.pi * (1.0 + 5.0 ** 0.5) * i
+    unit = np.stack([np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=1)
+    big = 0.5 * unit + [1.0, 2.0, 3.0]
+    params = dict(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, orientation=pc.NormalOrientation.Propagate)
+    closed = pc.CloudModelParams(**params, closed_objects=True)
+    assert closed.closed_objects and "closed_objects=True" in repr(closed)
+    declared = pc.build_model(big, params=closed)
+    undeclared = pc.build_model(big, params=pc.CloudModelParams(**params))
+    assert declared.surface_inside_known is True and declared.surface_closed_share > 0.9
+    assert undeclared.surface_inside_known is False and np.isnan(undeclared.surface_closed_share)
+    ball = pc.build_model(0.05 * unit[::10] + [1.1, 2.0, 3.0], params=pc.CloudModelParams(**params))
+    request = pc.CollisionRequest(surface=True)
+    inside = pc.collide(ball, declared, np.eye(4), request)
+    assert inside.verdict == pc.Verdict.InCollision and inside.signed_distance < -0.2, inside
+    assert pc.collide(ball, undeclared, np.eye(4), request).verdict == pc.Verdict.Free
+
+
 def test_surface_normals_and_orientation_options(sheets):
     a, b, A, B = sheets
     # The normals change the surface only: the points' model (origin, size) is the same.
     A0 = pc.build_model(a, params=SURFACE)
     np.testing.assert_array_equal(A0.origin, A.origin)
     assert A0.size == A.size and A0.surface_orientation == pc.NormalOrientation.Propagate  # viewpoint inside
+    assert A0.surface_inside_known is False and np.isnan(A0.surface_closed_share)  # two-sided, not checked
     for mode in (pc.NormalOrientation.Propagate, pc.NormalOrientation.Viewpoint):
         p = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, orientation=mode)
         assert p.orientation == mode and f"orientation=NormalOrientation.{mode.name}" in repr(p)

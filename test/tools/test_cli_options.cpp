@@ -126,6 +126,27 @@ TEST (CliOptions, SurfacePooledImpliesSurface)
   expectUsageError ({"-ignore_normals=1"}, "-ignore_normals");
 }
 
+// -closed marks both inputs closed solids, -closed_a / -closed_b one each; they need the surface
+// layer, whose inside they define.
+TEST (CliOptions, ClosedMarksTheInputsClosedSolids)
+{
+  const ParseResult none = parse ({"-surface"});
+  ASSERT_EQ (none.kind, Kind::Run) << none.error;
+  EXPECT_FALSE (none.options.closed_a);
+  EXPECT_FALSE (none.options.closed_b);
+  const ParseResult both = parse ({"-surface_ladder", "-closed"});
+  ASSERT_EQ (both.kind, Kind::Run) << both.error;
+  EXPECT_TRUE (both.options.closed_a);
+  EXPECT_TRUE (both.options.closed_b);
+  const ParseResult b = parse ({"-closed_b", "-surface"});
+  ASSERT_EQ (b.kind, Kind::Run) << b.error;
+  EXPECT_FALSE (b.options.closed_a);
+  EXPECT_TRUE (b.options.closed_b);
+  expectUsageError ({"-closed_a"}, "need -surface");
+  expectUsageError ({"-surface", "-closed=1"}, "-closed");
+  expectUsageError ({"-surface", "-closed_b", "-closed_b"}, "-closed_b");
+}
+
 // -surface_ladder implies -surface and cannot be combined with -surface_pooled.
 TEST (CliOptions, SurfaceLadderImpliesSurfaceAndExcludesPooled)
 {

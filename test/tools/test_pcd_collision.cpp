@@ -1336,6 +1336,45 @@ TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
   EXPECT_EQ (inward_err.find ("Orienting"), std::string::npos) << inward_err;
 }
 
+// -closed_b: the plain sphere (no normals, PCL's default VIEWPOINT, which sees it as no scan does)
+// samples a closed solid, so its propagated orientation, checked by the winding number, says
+// where its inside is: the probe 1-2 cm inside it collides, where without the option the
+// propagated surface is two-sided and the probe, deeper than its points reach, reads free.
+// -closed_a (the probe alone) leaves the sphere two-sided. The stage line says which.
+TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
+{
+  constexpr int kSphere = 2000, kProbe = 60;
+  writeFile (dir_ / "plain.pcd", pcdHeader ("x y z", kSphere) + sphereRows (kSphere, 0.1, 1.0, false));
+  writeFile (dir_ / "probe.pcd", pcdHeader ("x y z", kProbe) + sphereRows (kProbe, 0.005, 1.0, false));
+  const std::string sphere = (dir_ / "plain.pcd").string ();
+  auto query = [&] (std::vector<std::string> extra) {
+    std::vector<std::string> args = {(dir_ / "probe.pcd").string (), sphere, "-sigma", "0.001", "-pose",
+                                     "0.085,0,0,0,0,0", "-json", "-surface"};
+    args.insert (args.end (), extra.begin (), extra.end ());
+    const ToolRun r = run (args);
+    EXPECT_EQ (r.status, 0) << r.err;
+    const auto out = lines (r.out);
+    EXPECT_EQ (out.size (), 1u) << r.out;
+    std::string stage;
+    for (const auto& l : lines (r.err))
+      if (l.rfind ("Orienting " + sphere + " [", 0) == 0)
+        stage = l;
+    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), stage);
+  };
+  const auto [closed, closed_stage] = query ({"-closed_b"});
+  EXPECT_EQ (closed["verdict"].text, "collision");
+  ASSERT_EQ (closed["signed_distance"].type, Value::Type::Number);
+  EXPECT_LT (closed["signed_distance"].number, -0.005);
+  EXPECT_NE (closed_stage.find ("[propagate: "), std::string::npos) << closed_stage;
+  EXPECT_NE (closed_stage.find ("; closed: outside in front of 100 %"), std::string::npos) << closed_stage;
+  for (const std::vector<std::string>& extra : {std::vector<std::string> {}, std::vector<std::string> {"-closed_a"}})
+  {
+    const auto [open, open_stage] = query (extra);
+    EXPECT_EQ (open["verdict"].text, "free") << (extra.empty () ? "" : extra[0]);
+    EXPECT_NE (open_stage.find ("two-sided (-closed if it samples closed solids)"), std::string::npos) << open_stage;
+  }
+}
+
 // Only some normal fields: with -surface an error naming the file and the missing field (exit
 // 1); without -surface the normals are not read and the file is a plain cloud.
 TEST_F (PcdCollisionTool, PartialNormalFieldsFailWithSurface)

@@ -258,6 +258,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     const Eigen::Vector3d view = cloud.sensor_origin_.template head<3> ().template cast<double> ();
     if (view.allFinite ())
       in.viewpoint = view - model->origin_;
+    in.closed_objects = params.closed_objects;
     model->surface_.build (model->bvh_, std::move (in), params.orientation);
   }
   model->params_ = params;
