@@ -756,6 +756,17 @@ evaluatePrimitives (const Options& o, Results& results)
         results.queries.push_back (row);
       };
       std::vector<OursSetting> w2_settings = oursSettings (false);
+      // W2 only (W1's and W3's clouds carry their sides or viewpoints, so it would change
+      // nothing there): the surface layer with the closed solids declared, as a user who knows
+      // the shapes would (CloudModelParams::closed_objects; docs/SURFACE.md, "Closed objects").
+      for (const OursSetting& s : std::vector<OursSetting> (w2_settings))
+        if (s.name == "surface")
+        {
+          OursSetting closed = s;
+          closed.name = "surface-closed";
+          closed.model.closed_objects = true;
+          w2_settings.push_back (closed);
+        }
       if (o.surface_calibrated)
         calibratedSurface (w2_settings);
       for (const OursSetting& s : w2_settings)
@@ -763,7 +774,7 @@ evaluatePrimitives (const Options& o, Results& results)
         if (!o.keeps (s.name))
           continue;
         BuildRow unused;
-        const PoseQuery q = buildOurs (pq.b, pq.a, pq.sigma, s, unused, nullptr);
+        const PoseQuery q = buildOurs (pq.b, pq.a, pq.sigma, s, unused, nullptr, ScanSides (), Solids {true, pq.solid_a});
         const auto start = Clock::now ();
         const Answer a = q (I);
         push ("ours", s.name, a, microsecondsSince (start));

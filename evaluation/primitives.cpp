@@ -367,6 +367,9 @@ struct Scenario
   std::string name;
   FixedObject fixed;
   std::function<Placement (const WorkloadSampler&, double gap, std::uint64_t seed)> place;
+  /** \brief The fixed object is a solid seen from outside (PrimitiveQuery::solid_a): not the
+    * floor patch (an open sheet) nor the room (the cube is inside it). */
+  bool fixed_solid = true;
 };
 
 /** \brief A scenario's fixed object: `shape` sampled at `spacing`. */
@@ -399,7 +402,7 @@ makeScenarios (bool quick)
                   [=] (const WorkloadSampler& sample, double gap, std::uint64_t seed) {
                     const Sphere s{Eigen::Vector3d (0.03, -0.02, 0.06 + gap), 0.06};
                     return Placement{sample (s, kDefaultSpacing, seed), signedDistance (s, kFloor)};
-                  }});
+                  }, false});
   out.push_back ({"box_box_face",
                   fixedObject (kBigBox, kDefaultSpacing),
                   [=] (const WorkloadSampler& sample, double gap, std::uint64_t seed) {
@@ -421,7 +424,7 @@ makeScenarios (bool quick)
                   [=] (const WorkloadSampler& sample, double gap, std::uint64_t seed) {
                     const Cylinder c{Eigen::Vector3d (-0.02, 0.03, gap), 0.05, 0.15};
                     return Placement{sample (c, kDefaultSpacing, seed), signedDistance (c, kFloor)};
-                  }});
+                  }, false});
   out.push_back ({"plate_sphere",
                   fixedObject (kPlate, kDefaultSpacing),
                   [=] (const WorkloadSampler& sample, double gap, std::uint64_t seed) {
@@ -447,7 +450,7 @@ makeScenarios (bool quick)
                   [=] (const WorkloadSampler& sample, double gap, std::uint64_t seed) {
                     const Box cube{Eigen::Vector3d (2.0 - 0.025 - gap, 0.4, 1.1), Eigen::Vector3d::Constant (0.025)};
                     return Placement{sample (cube, kDefaultSpacing, seed), clearanceInside (room, cube)};
-                  }});
+                  }, false});
   const Sphere sparse_sphere{Eigen::Vector3d::Zero (), 0.1};
   out.push_back ({"sphere_sphere_sparse",
                   fixedObject (sparse_sphere, kSparseSpacing),
@@ -502,6 +505,7 @@ makePrimitiveQueries (const PrimitiveWorkloadOptions& options)
       q.sigma = sigma;
       q.spacing_a = fixed.spacing;
       q.spacing_b = placed.b.spacing;
+      q.solid_a = scenario.fixed_solid;
       // Rounding must not turn a nominal gap of 0 (resting contact) into a 1e-17 m gap.
       q.exact_distance = std::abs (placed.exact_distance) < kTouchingTolerance ? 0.0 : placed.exact_distance;
       q.exact_collision = q.exact_distance <= 0.0;

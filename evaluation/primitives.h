@@ -113,6 +113,9 @@ struct PrimitiveQuery
   double spacing_b = 0.0;    ///< sampling spacing of b (m)
   double exact_distance = 0.0;  ///< closed-form signed distance (m): > 0 gap, < 0 penetration depth
   bool exact_collision = false; ///< exact_distance <= 0 (touching counts; |d| < 1e-12 m reads as 0)
+  /** \brief a is a closed solid seen from outside (every placed object b is): what a user would
+    * declare with CloudModelParams::closed_objects; false for the floor patch and the room. */
+  bool solid_a = true;
 };
 
 /** \brief Options of makePrimitiveQueries(). */

@@ -162,10 +162,13 @@ orientedScan (const CloudXYZ& noisy, const Outward& outward, int k)
 
 OursModels
 buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
-                 const CloudModelParams& model, BuildRow& build, const ScanSides& sides)
+                 const CloudModelParams& model, BuildRow& build, const ScanSides& sides, const Solids& solids)
 {
   CloudModelParams params = model;
   params.noise = SensorNoiseModel::isotropic (sigma);
+  CloudModelParams robot_params = params, env_params = params;
+  robot_params.closed_objects = model.closed_objects && solids.robot;
+  env_params.closed_objects = model.closed_objects && solids.env;
   const bool scans = sides.robot && sides.env && model.surface;
   pcl::PointCloud<pcl::PointNormal>::Ptr robot_scan, env_scan;
   if (scans)
@@ -175,10 +178,10 @@ buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env,
   }
   const auto start = std::chrono::steady_clock::now ();
   OursModels m;
-  m.robot = scans ? buildCloudModel (*robot_scan, params, nullptr, nullptr, "robot")
-                  : buildCloudModel (*robot, params, nullptr, nullptr, "robot");
-  m.env = scans ? buildCloudModel (*env_scan, params, nullptr, nullptr, "environment")
-                : buildCloudModel (*env, params, nullptr, nullptr, "environment");
+  m.robot = scans ? buildCloudModel (*robot_scan, robot_params, nullptr, nullptr, "robot")
+                  : buildCloudModel (*robot, robot_params, nullptr, nullptr, "robot");
+  m.env = scans ? buildCloudModel (*env_scan, env_params, nullptr, nullptr, "environment")
+                : buildCloudModel (*env, env_params, nullptr, nullptr, "environment");
   build.build_ms = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   build.memory_bytes = static_cast<double> (m.robot->bytes () + m.env->bytes ());
   build.nodes = static_cast<double> (m.robot->hierarchy ().nodes ().size () + m.env->hierarchy ().nodes ().size ());
@@ -218,9 +221,10 @@ oursQuery (const OursModels& models, const CollisionRequest& request,
 
 PoseQuery
 buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma, const OursSetting& setting,
-           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query, const ScanSides& sides)
+           BuildRow& build, std::function<void (std::size_t, std::size_t, double)> on_query, const ScanSides& sides,
+           const Solids& solids)
 {
-  return oursQuery (buildOursModels (robot, env, sigma, setting.model, build, sides), setting.request,
+  return oursQuery (buildOursModels (robot, env, sigma, setting.model, build, sides, solids), setting.request,
                     std::move (on_query));
 }
 

@@ -73,7 +73,8 @@ struct OursSetting
   * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
   * (ResolutionGate::WhereNoiseExceedsSpacing); each c of stop "stop<c>" and "surface-stop<c>",
   * the hierarchy not split within the noise (BVHParams::noise_stop = c). Each n of cap adds
-  * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2). */
+  * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2). W2 adds
+  * "surface-closed" itself (CloudModelParams::closed_objects on its solids, Solids). */
 std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {},
                                        const std::vector<double>& gate = {}, const std::vector<double>& stop = {},
                                        const std::vector<double>& cap = {});
@@ -116,6 +117,15 @@ struct ScanSides
   const Outward* env = nullptr;
 };
 
+/** \brief Which clouds are closed solids seen from outside: a setting's
+  * CloudModelParams::closed_objects applies only to those (W2 declares what a user knows of its
+  * shapes: not the floor patch, nor the room the cube is inside of). */
+struct Solids
+{
+  bool robot = true;
+  bool env = true;
+};
+
 /** \brief A noisy cloud as a scan with oriented normals: each normal is the plane fitted to the
   * point's k nearest noisy neighbours (the library's own estimate), turned to the side the
   * point was seen from. Only the side comes from the mesh, never the direction. */
@@ -126,7 +136,7 @@ pcl::PointCloud<pcl::PointNormal>::Ptr orientedScan (const CloudXYZ& noisy, cons
   * orientedScan (normals estimated before the timed build, as a scan would bring them). */
 OursModels buildOursModels (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
                             const pcl_probcollision::CloudModelParams& model, BuildRow& build,
-                            const ScanSides& sides = ScanSides ());
+                            const ScanSides& sides = ScanSides (), const Solids& solids = Solids ());
 
 /** \brief The query of one request on prebuilt models (several requests may share them). */
 PoseQuery oursQuery (const OursModels& models, const pcl_probcollision::CollisionRequest& request,
@@ -137,7 +147,7 @@ PoseQuery oursQuery (const OursModels& models, const pcl_probcollision::Collisio
 PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, double sigma,
                      const OursSetting& setting, BuildRow& build,
                      std::function<void (std::size_t leaf_pairs, std::size_t kernel, double features)> on_query,
-                     const ScanSides& sides = ScanSides ());
+                     const ScanSides& sides = ScanSides (), const Solids& solids = Solids ());
 
 /** \brief W3: every SCENES.md query (data_dir/scenes/queries.csv) with our default and max
   * settings; right counts the default's answers that match the listed verdict (resting:

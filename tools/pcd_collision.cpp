@@ -401,6 +401,8 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("surface_ladder").boolean (rq.surface_ladder);
   j.key ("surface_calibrated").boolean (rq.surface_calibrated);
   j.key ("distance").boolean (rq.distance);
+  j.key ("closed_a").boolean (o.closed_a);
+  j.key ("closed_b").boolean (o.closed_b);
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o, true).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);

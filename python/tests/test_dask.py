@@ -305,6 +305,37 @@ def test_cli_surface_with_stored_normals_equals_pcd_collision(tmp_path):
     assert answers[False][3]["verdict"] == "free"
 
 
+def test_cli_closed_equals_pcd_collision(tmp_path):
+    # The sphere's points without normals (PCL's default VIEWPOINT, which is no scan's): -closed_b
+    # declares it a closed solid, so both CLIs check its propagated orientation and the probe at
+    # its centre collides, printing the same JSON lines; without it the surface is two-sided and
+    # the probe, out of reach of it, reads free. closed needs surface, in both.
+    points, _ = _sphere_with_normals(normal_length=1.0)
+    write_pcd(tmp_path / "sphere.pcd", points.astype(np.float32))
+    g = np.linspace(-0.01, 0.01, 5)
+    write_pcd(tmp_path / "probe.pcd", np.array([[x, y, 0.0] for x in g for y in g], dtype=np.float32))
+    (tmp_path / "poses.txt").write_text("0 0 0 0 0 0\n0.5 0 0 0 0 0\n")
+    args = [str(tmp_path / "probe.pcd"), str(tmp_path / "sphere.pcd")]
+    poses = str(tmp_path / "poses.txt")
+    verdicts = {}
+    for extra in ([], ["-closed_b"]):
+        cpp = subprocess.run([_pcd_collision(), *args, "-poses", poses, "-json", "-surface", "-sigma", "0.001", *extra],
+                             capture_output=True, text=True, timeout=300)
+        assert cpp.returncode == 0, cpp.stderr
+        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, poses, "--scheduler", "local:1",
+                             "-surface", "-json", "-sigma", "0.001", *extra], capture_output=True, text=True, timeout=300)
+        assert py.returncode == 0, py.stderr
+        lines = _compare_json_lines(cpp.stdout, py.stdout)
+        assert all(line["parameters"]["closed_b"] == bool(extra) and not line["parameters"]["closed_a"] for line in lines)
+        verdicts[bool(extra)] = [line["verdict"] for line in lines]
+    assert verdicts == {False: ["free", "free"], True: ["collision", "free"]}
+    with pytest.raises(ValueError, match="need surface"):
+        pcd.resolve_options({"closed": True})
+    o = pcd.resolve_options({"closed": True, "surface_ladder": True})
+    assert o["closed_a"] and o["closed_b"]
+    assert pcd.model_params(o, "a", exact=False).closed_objects
+
+
 def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     # Two noisy sheets, b under and over a: surface=True gives the surface models' answers and
     # signed distances (in b's frame a pose moves a: a above b is a gap); off, NaN as before.

@@ -76,6 +76,12 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     # With surface: a cloud file's normal_x normal_y normal_z are not read (pcd_collision's
     # -ignore_normals); the cloud is oriented as one without them.
     "ignore_normals": False,
+    # With surface: both inputs (closed), or <a> or <b>, sample closed solids (pcd_collision's
+    # -closed, -closed_a, -closed_b; CloudModelParams.closed_objects): a propagated orientation,
+    # checked by the winding number, says where the inside is.
+    "closed": False,
+    "closed_a": _MODEL.closed_objects,
+    "closed_b": _MODEL.closed_objects,
     "nmax": _MODEL.n_max,
     "sigma_max": _MODEL.sigma_max,
     "epsilon": _MODEL.epsilon,
@@ -103,6 +109,11 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
     o["surface"] = bool(o["surface"] or o["surface_pooled"] or o["surface_ladder"])
     if o["surface_pooled"] and o["surface_ladder"]:
         raise ValueError("options surface_pooled and surface_ladder cannot be combined")
+    o["closed_a"] = bool(o["closed_a"] or o["closed"])
+    o["closed_b"] = bool(o["closed_b"] or o["closed"])
+    if (o["closed_a"] or o["closed_b"]) and not o["surface"]:
+        raise ValueError("options closed, closed_a and closed_b need surface (or surface_pooled, surface_ladder): they "
+                         "say where the surface layer's inside is")
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
@@ -144,6 +155,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
     p.split = o["split"]
     p.noise_resolution = float(o["noise_resolution"])
     p.noise_stop = float(o["noise_stop"])
+    p.closed_objects = bool(o["closed_" + side])
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
     return p
