@@ -106,7 +106,7 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
   * order. */
 bool
 collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b,
-                const CollisionRequest& request, CollisionResult& result)
+                const CollisionRequest& request, CollisionResult& result, bool containment_only = false)
 {
   result.points_a = a.size ();
   result.points_b = b.size ();
@@ -118,8 +118,10 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   detail::SurfaceAnswer s;
   try
   {
-    s = detail::surfaceTest (a, b, T_a_b, request, request.per_point ? &result.probabilities_a : nullptr,
-                             request.per_point ? &result.probabilities_b : nullptr);
+    s = containment_only ? detail::containmentTest (a, b, T_a_b, request.per_point ? &result.probabilities_a : nullptr,
+                                                    request.per_point ? &result.probabilities_b : nullptr)
+                         : detail::surfaceTest (a, b, T_a_b, request, request.per_point ? &result.probabilities_a : nullptr,
+                                                request.per_point ? &result.probabilities_b : nullptr);
   }
   catch (const pcl::PCLException& e)
   {
@@ -270,9 +272,7 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
       return false;
     }
     from_surface = !separators.no_leaf_tested && !(separators.probability > request.collision_above);
-    if (!from_surface)
-      result = std::move (separators);
-    else
+    if (from_surface)
     {
       if (!collideSurface (a, b, T_local, request, result))
         return false;
@@ -282,6 +282,20 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
       else
         addSeparators (result, separators);
     }
+    else if (separators.no_leaf_tested)
+    {
+      // Nothing within the separators' reach: one object may still lie wholly inside the other,
+      // which two winding numbers tell (where a surface says where its inside is).
+      if (!collideSurface (a, b, T_local, request, result, true))
+        return false;
+      from_surface = !result.no_leaf_tested;
+      if (from_surface)
+        addSeparators (result, separators);
+      else
+        result = std::move (separators);
+    }
+    else
+      result = std::move (separators);
   }
   else
   {

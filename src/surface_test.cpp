@@ -1079,7 +1079,68 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
   }
   return deep;
 }
+
+/** \brief A point found inside the other surface, out of reach of it (deepInside, containment):
+  * P = 1, the distance minus its depth to the other's nearest sample (about a spacing uncertain),
+  * unless the answer already reads deeper. */
+void
+answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, SurfaceAnswer& answer)
+{
+  const SurfaceModel& s = deep.side > 0 ? b.surface () : a.surface ();
+  answer.contained = !answer.reached;
+  answer.reached = true;
+  if (!(answer.signed_distance <= -deep.depth))
+  {
+    answer.witness_side = deep.side;
+    answer.witness_index = deep.index;
+    answer.witness_point = deep.point;
+    answer.witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+    answer.signed_distance = -deep.depth;
+    // The depth is measured to the nearest sample: uncertain by about one spacing.
+    answer.signed_distance_std = s.medianSpacing ();
+    // Inside a surface seen from one viewpoint: behind it, where no sample looked.
+    answer.unobserved = s.orientation () == NormalOrientation::Viewpoint;
+  }
+  answer.probability = 1.0;
+}
 } // namespace
+
+SurfaceAnswer
+containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, std::vector<float>* per_point_a,
+                 std::vector<float>* per_point_b)
+{
+  SurfaceAnswer answer;
+  // One point of `query` (its first), mapped by T_q into A's frame, against `surface` (by T_s).
+  auto inside = [] (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface,
+                    const Eigen::Isometry3d& T_s, int side) {
+    DeepPoint deep;
+    const ProbabilisticBVH& s_bvh = surface.hierarchy ();
+    if (!trustedOrientation (surface.surface ()) || query.hierarchy ().means ().empty () || s_bvh.nodes ().empty ())
+      return deep;
+    const Eigen::Vector3d x = T_s.inverse () * (T_q * query.hierarchy ().means ().front ());
+    const OrientedBox& bound = s_bvh.node (ProbabilisticBVH::rootId ()).box;
+    if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0 ||
+        surface.surface ().windingNumber (s_bvh, x) <= kInsideWinding)
+      return deep;
+    deep.found = true;
+    deep.side = side;
+    deep.index = 0;
+    deep.point = T_q * query.hierarchy ().means ().front ();
+    deep.depth = nearestSampleDistance (surface, x);
+    return deep;
+  };
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
+  DeepPoint deep = inside (a, I, b, T_a_b, +1);
+  if (!deep.found)
+    deep = inside (b, T_a_b, a, I, -1);
+  if (deep.found)
+  {
+    answerDeep (deep, a, b, answer);
+    if (std::vector<float>* values = deep.side > 0 ? per_point_a : per_point_b)
+      std::fill (values->begin (), values->end (), 1.0f);
+  }
+  return answer;
+}
 
 SurfaceAnswer
 surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
@@ -1149,23 +1210,8 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   }
   if (deep.found)
   {
-    const SurfaceModel& s = deep.side > 0 ? b.surface () : a.surface ();
-    const double depth = deep.depth;
-    answer.contained = !answer.reached;
-    answer.reached = true;
-    if (!(answer.signed_distance <= -depth))
-    {
-      answer.witness_side = deep.side;
-      answer.witness_index = deep.index;
-      answer.witness_point = deep.point;
-      answer.witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
-      answer.signed_distance = -depth;
-      // The depth is measured to the nearest sample: uncertain by about one spacing.
-      answer.signed_distance_std = s.medianSpacing ();
-      // Inside a surface seen from one viewpoint: behind it, where no sample looked.
-      answer.unobserved = s.orientation () == NormalOrientation::Viewpoint;
-    }
-    best_z = -std::numeric_limits<double>::infinity ();
+    answerDeep (deep, a, b, answer);
+    return answer;
   }
   answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;
   return answer;

@@ -65,5 +65,16 @@ struct SurfaceAnswer
 SurfaceAnswer
 surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
              std::vector<float>* per_point_a, std::vector<float>* per_point_b);
+/** \brief Where no leaf pair comes within reach (the ladder, when the separators reached none):
+  * whether one object lies entirely inside the other, by the winding number of each surface
+  * that says where its inside is (SurfaceModel::insideKnown) at one point of the other object
+  * (its first). Found: P = 1 and the depth to the other's nearest sample, as surfaceTest's deep
+  * points, and P_in = 1 for every point of the object inside (per_point_a, per_point_b: as
+  * surfaceTest's); otherwise nothing reached. Two winding numbers at most: an object partly
+  * inside the other, through a gap between its leaves, is not seen (surfaceTest descends for
+  * that). */
+SurfaceAnswer
+containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, std::vector<float>* per_point_a,
+                 std::vector<float>* per_point_b);
 } // namespace detail
 } // namespace pcl_probcollision

@@ -598,8 +598,9 @@ TEST (SurfaceModel, ClosedObjectsCheckTheirPropagatedOrientation)
 
 // A small box wholly inside a big noisy box sampled without normals, deeper than any point's
 // reach of its surface: declared closed objects, the winding number finds it (collision, about
-// as deep as it lies); undeclared, the propagated surface is two-sided and says nothing about an
-// inside, so the query reads free, as the separators do. Outside, both read free.
+// as deep as it lies), with the surface layer and with the ladder; undeclared, the propagated
+// surface is two-sided and says nothing about an inside, so the query reads free, as the
+// separators do. Outside, both read free.
 TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
 {
   const auto solid = boxSurface (Eigen::Vector3d::Zero (), Eigen::Vector3d (0.3, 0.25, 0.2), 0.01, 0.002, 11);
@@ -618,6 +619,27 @@ TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
   EXPECT_EQ (two_sided.verdict, Verdict::Free) << "P " << two_sided.probability;
   ASSERT_TRUE (collide (*small, *declared, shift (0.5, 0.0, 0.0), surfaceRequest (), outside));
   EXPECT_EQ (outside.verdict, Verdict::Free) << "P " << outside.probability;
+  // The ladder: the separators reach no leaf pair, and the two winding numbers of its
+  // containment check find the box inside the declared solid (every point of it, per point).
+  CollisionRequest ladder = surfaceRequest ();
+  ladder.surface_ladder = true;
+  ladder.per_point = true;
+  CollisionResult climbed, stays, apart;
+  ASSERT_TRUE (collide (*small, *declared, shift (0.05, -0.02, 0.01), ladder, climbed));
+  EXPECT_EQ (climbed.verdict, Verdict::InCollision) << "P " << climbed.probability;
+  EXPECT_EQ (climbed.answered_by, AnsweredBy::SurfaceLayer);
+  EXPECT_FALSE (climbed.no_leaf_tested);
+  EXPECT_EQ (climbed.leaf_pairs_tested, 0u);
+  EXPECT_NEAR (climbed.signed_distance, inside.signed_distance, 0.05);
+  ASSERT_EQ (climbed.probabilities_a.size (), small->size ());
+  EXPECT_TRUE (std::all_of (climbed.probabilities_a.begin (), climbed.probabilities_a.end (), [] (float p) { return p == 1.0f; }));
+  ASSERT_TRUE (collide (*small, *undeclared, shift (0.05, -0.02, 0.01), ladder, stays));
+  EXPECT_EQ (stays.verdict, Verdict::Free);
+  EXPECT_EQ (stays.answered_by, AnsweredBy::Separators);
+  EXPECT_TRUE (stays.no_leaf_tested);
+  ASSERT_TRUE (collide (*small, *declared, shift (0.5, 0.0, 0.0), ladder, apart));
+  EXPECT_EQ (apart.verdict, Verdict::Free);
+  EXPECT_EQ (apart.answered_by, AnsweredBy::Separators);
   // A small box half way through a face: both read collision (its points on both sides).
   for (const auto* model : {&declared, &undeclared})
   {

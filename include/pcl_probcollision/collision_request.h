@@ -86,8 +86,10 @@ struct CollisionRequest
   bool surface_pooled = false;
   /** \brief With surface on: a ladder, the separators first and the surface layer only where they
     * leave the answer open. The separators' answer stands where they reached no leaf pair (the
-    * objects apart) or found P above collision_above (they see two sheets crossing, which the
-    * surface layer cannot where the noise is as thick as the parts). Otherwise the surface
+    * objects apart, unless two winding numbers find one wholly inside the other, where a surface
+    * says where its inside is: then P = 1, the surface layer's) or found P above collision_above
+    * (they see two sheets crossing, which the surface layer cannot where the noise is as thick
+    * as the parts). Otherwise the surface
     * layer runs too, and answers alone where the separators' P lies in the contact band (they
     * cannot tell a touch from a part through a single scanned sheet: the README demo's 2 cm
     * penetration), or pooled with them as surface_pooled does where they answered free (between
