@@ -759,14 +759,15 @@ evaluatePrimitives (const Options& o, Results& results)
       // W2 only (W1's and W3's clouds carry their sides or viewpoints, so it would change
       // nothing there): the surface layer with the closed solids declared, as a user who knows
       // the shapes would (CloudModelParams::closed_objects; docs/SURFACE.md, "Closed objects").
-      for (const OursSetting& s : std::vector<OursSetting> (w2_settings))
-        if (s.name == "surface")
-        {
-          OursSetting closed = s;
-          closed.name = "surface-closed";
-          closed.model.closed_objects = true;
-          w2_settings.push_back (closed);
-        }
+      const auto surface = std::find_if (w2_settings.begin (), w2_settings.end (),
+                                         [] (const OursSetting& s) { return s.name == "surface"; });
+      if (surface != w2_settings.end ())
+      {
+        OursSetting closed = *surface;
+        closed.name = "surface-closed";
+        closed.model.closed_objects = true;
+        w2_settings.push_back (closed);
+      }
       if (o.surface_calibrated)
         calibratedSurface (w2_settings);
       for (const OursSetting& s : w2_settings)

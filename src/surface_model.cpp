@@ -57,7 +57,8 @@ constexpr double kMinViewCosine = 0.2;
   * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
 constexpr double kMaxHiddenShare = 0.1;
 /** \brief Samples probed by the closed-objects check (SurfaceModel::closedShare), evenly spread:
-  * 2,048 winding numbers, a few ms on the evaluation's clouds. */
+  * 2,048 winding numbers, on one thread 7 ms for a 9,000-point sphere and 25-40 ms for a
+  * 50,000-point room (docs/SURFACE.md, "Closed objects"). */
 constexpr std::size_t kClosedProbes = 1024;
 /** \brief The probes' offset from the sample, in its spacings (plus kClosedProbeSigmas noise
   * deviations along its normal): far enough that its own disc and noise do not decide the
@@ -67,14 +68,6 @@ constexpr double kClosedProbeSigmas = 3.0;
 /** \brief A probe in front reads outside below this |winding number|, one behind inside above
   * one minus it (an open sheet reads about -1/2 in front and 1/2 behind). */
 constexpr double kClosedProbeWinding = 0.25;
-/** \brief Shares of the probes that must read outside in front (closedShare) and inside behind
-  * (solidShare) for the orientation to be trusted (SurfaceModel::insideKnown). In front, all
-  * but stray normals read outside on a closed surface oriented outward; behind, the probes of
-  * samples at an edge (their normals between the two faces') or on a part thinner than the
-  * offset come out of the solid (a noisy box sampled 6 mm apart: 89 % inside), and on a plate
-  * all of them: then the orientation cannot be checked there. */
-constexpr double kMinClosedShare = 0.9;
-constexpr double kMinSolidShare = 0.5;
 
 /** \brief The share of `points` hidden from `view` (outside their bounding box lo..hi) behind
   * others: in one bin of directions from view (gnomonic, across the axis that separates view

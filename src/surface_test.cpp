@@ -113,7 +113,7 @@ struct Scratch
   std::vector<double> keys;
   std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
-  /** \brief The side's surface is two-sided: its orientation is not trusted (trustedOrientation). */
+  /** \brief The side's surface is two-sided: its orientation does not say where its inside is (SurfaceModel::insideKnown). */
   bool two_sided = false;
   std::vector<std::pair<std::int32_t, std::int32_t>> pairs, grouped;
   std::vector<std::size_t> group_start;  ///< groupByFirst's counts, then offsets
@@ -765,16 +765,6 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
   scratch.earlier_leaves.push_back (leaf);
 }
 
-/** \brief Whether the surface's orientation says where its inside is (SurfaceModel::insideKnown):
-  * the points' own normals, a viewpoint, or a propagated one checked closed for a cloud declared
-  * closed objects. A propagated one otherwise does not: an open sheet's side is a coin toss, and
-  * a room seen from within is oriented inside out (its free space read as inside the walls). */
-bool
-trustedOrientation (const SurfaceModel& s)
-{
-  return s.insideKnown ();
-}
-
 /** \brief True when the surface's area-weighted normals cancel to within kClosedFlux of its
   * area: a closed surface (exactly 0 by the divergence theorem; the evaluation's rooms sum to
   * under 1 %, its piano, with noisy normals on thin parts, to 6 %), not an open sheet (100 % when
@@ -800,7 +790,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const SurfaceModel& s_model = surface.surface ();
   const SurfaceModel& q_model = query.surface ();
   const bool behind_unseen = s_model.orientation () == NormalOrientation::Viewpoint;
-  scratch.two_sided = !trustedOrientation (s_model);
+  scratch.two_sided = !s_model.insideKnown ();
   // Behind a scan from one viewpoint or any open surface (winding about 1/2 behind a sheet) the
   // space is occupied; inside a closed surface means a winding number above 1/2.
   const double behind_threshold = behind_unseen || !closedSurface (s_model) ? kBehindWinding : kInsideWinding;
@@ -1003,6 +993,18 @@ struct DeepPoint
   double depth = 0.0;     ///< distance to the other's nearest sample
 };
 
+/** \brief Whether x (in `surface`'s local frame) lies inside it by its winding number. Outside its
+  * bounding box a point is outside it (behind an open sheet's box edge the winding number is
+  * below 1/2 too): no winding number needed. */
+bool
+insideOf (const CloudModel& surface, const Eigen::Vector3d& x)
+{
+  const ProbabilisticBVH& bvh = surface.hierarchy ();
+  const OrientedBox& bound = bvh.node (ProbabilisticBVH::rootId ()).box;
+  return (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () <= 0.0 &&
+         surface.surface ().windingNumber (bvh, x) > kInsideWinding;
+}
+
 /** \brief True when some leaf box of `s_bvh` (mapped into the box's frame by T_box_s), grown by
   * margin as the box is, overlaps box: the surface may pass through it. */
 bool
@@ -1057,10 +1059,7 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
     }
     const int first = *q_bvh.indices (node).begin ();
     const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (first)];
-    // Outside the surface's bounding box a point is outside it (behind an open sheet's box
-    // edge the winding number is below 1/2 too): no winding number needed.
-    if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0 ||
-        surface.surface ().windingNumber (s_bvh, x) <= kInsideWinding)
+    if (!insideOf (surface, x))
       continue;
     // In decision mode the first inside node decides; otherwise the deepest one sets the depth.
     const double depth = nearestSampleDistance (surface, x);
@@ -1114,18 +1113,16 @@ containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry
   auto inside = [] (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface,
                     const Eigen::Isometry3d& T_s, int side) {
     DeepPoint deep;
-    const ProbabilisticBVH& s_bvh = surface.hierarchy ();
-    if (!trustedOrientation (surface.surface ()) || query.hierarchy ().means ().empty () || s_bvh.nodes ().empty ())
+    if (!surface.surface ().insideKnown () || query.hierarchy ().means ().empty () || surface.hierarchy ().nodes ().empty ())
       return deep;
-    const Eigen::Vector3d x = T_s.inverse () * (T_q * query.hierarchy ().means ().front ());
-    const OrientedBox& bound = s_bvh.node (ProbabilisticBVH::rootId ()).box;
-    if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0 ||
-        surface.surface ().windingNumber (s_bvh, x) <= kInsideWinding)
+    const Eigen::Vector3d point = T_q * query.hierarchy ().means ().front ();
+    const Eigen::Vector3d x = T_s.inverse () * point;
+    if (!insideOf (surface, x))
       return deep;
     deep.found = true;
     deep.side = side;
     deep.index = 0;
-    deep.point = T_q * query.hierarchy ().means ().front ();
+    deep.point = point;
     deep.depth = nearestSampleDistance (surface, x);
     return deep;
   };
@@ -1199,9 +1196,9 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   // a viewpoint) may declare it: a propagated one can be inside out (a room seen from within).
   const double margin = params.box_margin;
   DeepPoint deep;
-  if (trustedOrientation (b.surface ()))
+  if (b.surface ().insideKnown ())
     deep = deepInside (a, Eigen::Isometry3d::Identity (), b, T_a_b, margin, !may_stop, per_point_a);
-  if ((!deep.found || !may_stop) && trustedOrientation (a.surface ()))
+  if ((!deep.found || !may_stop) && a.surface ().insideKnown ())
   {
     DeepPoint other = deepInside (b, T_a_b, a, Eigen::Isometry3d::Identity (), margin, !may_stop, per_point_b);
     other.side = -1;

@@ -560,7 +560,8 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   if (std::isfinite (closed))
     why += std::string (model.surface ().insideKnown () ? "; closed: " : "; not closed, so two-sided: ") + "outside in front of " +
            percent (closed) + " %, inside behind " + percent (model.surface ().solidShare ()) +
-           " % of the probed samples (closed needs 90 and 50)";
+           " % of the probed samples (closed needs " + percent (pcl_probcollision::SurfaceModel::kMinClosedShare) + " and " +
+           percent (pcl_probcollision::SurfaceModel::kMinSolidShare) + ")";
   else if (orientation == pcl_probcollision::NormalOrientation::Propagate)
     why += "; two-sided (-closed if it samples closed solids)";
   std::fprintf (log, "Orienting %s [%s: %s%s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how,

@@ -115,6 +115,14 @@ public:
     * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
     * NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
+  /** \brief Shares of the closed-objects check's probes that must read outside in front
+    * (closedShare) and inside behind (solidShare) for a propagated orientation to be trusted
+    * (insideKnown). In front, all but stray normals read outside on a closed surface oriented
+    * outward; behind, the probes of samples at an edge (their normals between the two faces') or
+    * on a part thinner than the offset come out of the solid (a noisy box sampled 6 mm apart: 89 %
+    * inside), and on a plate all of them: then the orientation cannot be checked there. */
+  static constexpr double kMinClosedShare = 0.9;
+  static constexpr double kMinSolidShare = 0.5;
   /** \brief Where Inputs::closed_objects asked for it and the orientation was propagated: the
     * share of the probed samples (at most 1,024, evenly spread over the oriented ones) in front
     * of which the surface reads outside, |winding number| under 1/4 two spacings and three
@@ -127,8 +135,8 @@ public:
     * a well oriented solid. NaN where not checked. */
   double solidShare () const { return solid_share_; }
   /** \brief Whether the orientation says where the inside is: the caller's normals, a viewpoint,
-    * or a propagated orientation checked closed (closedShare() at least 0.9 and solidShare() at
-    * least 0.5). Without it the surface is two-sided to the query: a point behind it is as far
+    * or a propagated orientation checked closed (closedShare() at least kMinClosedShare and
+    * solidShare() at least kMinSolidShare). Without it the surface is two-sided to the query: a point behind it is as far
     * from it as one in front, and no point is found deep inside it. */
   bool insideKnown () const;
   /** \brief Points without a normal (too few distinct neighbours): they bound nothing. */

@@ -273,6 +273,18 @@ def _sphere_with_normals(n=600, radius=0.1, normal_length=1.0):
     return radius * u, normal_length * u
 
 
+def _both_clis_with_surface(args, poses, extra):
+    """pcd_collision and the Dask CLI on the same inputs with -surface -sigma 0.001 and extra:
+    both succeed and print the same JSON lines (returned parsed), and pcd_collision's stderr."""
+    cpp = subprocess.run([_pcd_collision(), *args, "-poses", poses, "-json", "-surface", "-sigma", "0.001", *extra],
+                         capture_output=True, text=True, timeout=300)
+    assert cpp.returncode == 0, cpp.stderr
+    py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, poses, "--scheduler", "local:1",
+                         "-surface", "-json", "-sigma", "0.001", *extra], capture_output=True, text=True, timeout=300)
+    assert py.returncode == 0, py.stderr
+    return _compare_json_lines(cpp.stdout, py.stdout), cpp.stderr
+
+
 def test_cli_surface_with_stored_normals_equals_pcd_collision(tmp_path):
     # A cloud file with normal_x normal_y normal_z (of length 2: the surface model normalizes
     # them, as pcd_collision reads them): with -surface both CLIs orient the sphere by them (the
@@ -292,14 +304,8 @@ def test_cli_surface_with_stored_normals_equals_pcd_collision(tmp_path):
     poses = str(tmp_path / "poses.txt")
     answers = {}
     for extra in ([], ["-ignore_normals"]):
-        cpp = subprocess.run([_pcd_collision(), *args, "-poses", poses, "-json", "-surface", "-sigma", "0.001", *extra],
-                             capture_output=True, text=True, timeout=300)
-        assert cpp.returncode == 0, cpp.stderr
-        assert ("[point_normals:" in cpp.stderr) != bool(extra), cpp.stderr
-        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, poses, "--scheduler", "local:1",
-                             "-surface", "-json", "-sigma", "0.001", *extra], capture_output=True, text=True, timeout=300)
-        assert py.returncode == 0, py.stderr
-        answers[bool(extra)] = _compare_json_lines(cpp.stdout, py.stdout)
+        answers[bool(extra)], stderr = _both_clis_with_surface(args, poses, extra)
+        assert ("[point_normals:" in stderr) != bool(extra), stderr
     inside = answers[False][0]
     assert inside["verdict"] == "collision" and inside["signed_distance"] < -0.05
     assert answers[False][3]["verdict"] == "free"
@@ -319,13 +325,7 @@ def test_cli_closed_equals_pcd_collision(tmp_path):
     poses = str(tmp_path / "poses.txt")
     verdicts = {}
     for extra in ([], ["-closed_b"]):
-        cpp = subprocess.run([_pcd_collision(), *args, "-poses", poses, "-json", "-surface", "-sigma", "0.001", *extra],
-                             capture_output=True, text=True, timeout=300)
-        assert cpp.returncode == 0, cpp.stderr
-        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, poses, "--scheduler", "local:1",
-                             "-surface", "-json", "-sigma", "0.001", *extra], capture_output=True, text=True, timeout=300)
-        assert py.returncode == 0, py.stderr
-        lines = _compare_json_lines(cpp.stdout, py.stdout)
+        lines, _ = _both_clis_with_surface(args, poses, extra)
         assert all(line["parameters"]["closed_b"] == bool(extra) and not line["parameters"]["closed_a"] for line in lines)
         verdicts[bool(extra)] = [line["verdict"] for line in lines]
     assert verdicts == {False: ["free", "free"], True: ["collision", "free"]}
