@@ -336,6 +336,28 @@ def test_cli_closed_equals_pcd_collision(tmp_path):
     assert pcd.model_params(o, "a", exact=False).closed_objects
 
 
+def test_model_cache_rebuilds_when_a_model_option_changes():
+    # The model cache (per process: the workers', and this one's without a client) once keyed on a
+    # list of options that missed closed_a / closed_b: a call after one with the other setting
+    # reused its model and answered silently wrong, whichever came first. The probe inside the
+    # closed sphere collides only with closed_b; each answer must equal a first call's.
+    points, _ = _sphere_with_normals()
+    g = np.linspace(-0.01, 0.01, 5)
+    probe = np.array([[x, y, 0.0] for x in g for y in g])
+    P = np.zeros((1, 6))
+    answers = [pcd.collide_poses(probe, points, P, surface=True, sigma=0.001, closed_b=closed).verdict[0]
+               for closed in (True, False, True, False)]
+    assert answers == [int(pc.Verdict.InCollision), int(pc.Verdict.Free)] * 2
+    # Every member of the built CloudModelParams is in the key, whatever option sets it.
+    o = pcd.resolve_options({"surface": True})
+    for change in ({"closed_b": True}, {"k": 7}, {"noise_stop": 2.0}, {"split": "octree"}, {"measured": True},
+                   {"sigma_b": 0.002}, {"sensor_b": "kinect"}):
+        changed = pcd.resolve_options({"surface": True, **change})
+        assert pcd._params_key(changed, "b", exact=False) != pcd._params_key(o, "b", exact=False), change
+    assert pcd._params_key(pcd.resolve_options({"surface": True, "threads": 1}), "b", False) == \
+        pcd._params_key(o, "b", False)  # the model is the same for any thread count
+
+
 def test_surface_in_process_equals_collide_batch_and_fills_signed_distance():
     # Two noisy sheets, b under and over a: surface=True gives the surface models' answers and
     # signed distances (in b's frame a pose moves a: a above b is a gap); off, NaN as before.

@@ -283,9 +283,15 @@ _builds = collections.Counter()  # models built in this process, by token (tests
 
 
 def _params_key(o: Dict[str, Any], side: str, exact: bool) -> tuple:
-    keys = ("k", "measured", "nmax", "sigma_max", "epsilon", "split", "surface", "noise_resolution", "noise_stop")
-    noise = () if exact else (o["sensor_" + side], float(o["sigma_" + side]))
-    return tuple(o[k] for k in keys) + noise
+    """The model cache's key beside the token: every member of the CloudModelParams the model is
+    built with, read from the object so that no option can be left out of it (a cached model
+    built with other settings would answer silently wrong); the noise by its options, since a
+    SensorNoiseModel shows no sigma; threads left out, the model being the same for any count."""
+    p = model_params(o, side, exact)
+    members = tuple((name, repr(getattr(p, name))) for name in dir(p)
+                    if not name.startswith("_") and name not in ("validate", "threads", "noise"))
+    noise = None if exact else (o["sensor_" + side], float(o["sigma_" + side]))
+    return members + (noise,)
 
 
 def _model(spec: Dict[str, Any], o: Dict[str, Any], side: str):
