@@ -414,6 +414,15 @@ noiseFactory (const SensorNoiseModel& n)
   return "?";
 }
 
+/** \brief A CloudModel property reading one number of its surface model: NaN without one. */
+auto
+surfaceNumber (double (SurfaceModel::*member) () const)
+{
+  return [member] (const CloudModel& c) {
+    return c.surface ().empty () ? std::numeric_limits<double>::quiet_NaN () : (c.surface ().*member) ();
+  };
+}
+
 /** A loaded cloud's x y z as an (N, 3) float32 array. */
 template <typename PointT>
 py::array_t<float>
@@ -980,13 +989,15 @@ PYBIND11_MODULE (_core, m)
                               "Whether the surface model's orientation says where the inside is (given normals, a viewpoint,\n"
                               "or a propagated one checked closed with CloudModelParams.closed_objects); False: two-sided.\n"
                               "None without a surface.")
-      .def_property_readonly ("surface_closed_share",
-                              [] (const CloudModel& c) {
-                                return c.surface ().empty () ? std::numeric_limits<double>::quiet_NaN ()
-                                                             : c.surface ().closedShare ();
-                              },
+      .def_property_readonly ("surface_closed_share", surfaceNumber (&SurfaceModel::closedShare),
                               "With closed_objects and a propagated orientation, the share of probed samples in front of\n"
                               "which the surface reads outside (SurfaceModel::closedShare); NaN where not checked.")
+      .def_property_readonly ("surface_solid_share", surfaceNumber (&SurfaceModel::solidShare),
+                              "With surface_closed_share, the share of the same probes behind which the surface reads inside\n"
+                              "(SurfaceModel::solidShare); NaN where not checked.")
+      .def_property_readonly ("surface_hidden_from_viewpoint", surfaceNumber (&SurfaceModel::hiddenFromViewpoint),
+                              "Where orientation Auto weighed a viewpoint outside the cloud, the share of points hidden from it\n"
+                              "behind others (above 0.1 it propagated instead; SurfaceModel::hiddenFromViewpoint); NaN otherwise.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +

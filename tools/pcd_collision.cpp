@@ -276,8 +276,28 @@ modelParamsFor (const Options& o, bool input)
   return m;
 }
 
+/** \brief How the model's surface was oriented (SurfaceModel), the JSON member "surface" of an
+  * input: null without -surface. */
 void
-inputJson (JsonWriter& j, const Input& in)
+surfaceJson (JsonWriter& j, const pcl_probcollision::CloudModel* model)
+{
+  if (!model || model->surface ().empty ())
+  {
+    j.null ();
+    return;
+  }
+  const auto& s = model->surface ();
+  j.beginObject ();
+  j.key ("orientation").string (pcl_probcollision::orientationName (s.orientation ()));
+  j.key ("inside_known").boolean (s.insideKnown ());
+  j.key ("hidden_from_viewpoint").number (s.hiddenFromViewpoint ());
+  j.key ("closed_share").number (s.closedShare ());
+  j.key ("solid_share").number (s.solidShare ());
+  j.endObject ();
+}
+
+void
+inputJson (JsonWriter& j, const Input& in, const pcl_probcollision::CloudModel* model)
 {
   j.beginObject ();
   j.key ("path").string (in.path);
@@ -298,11 +318,14 @@ inputJson (JsonWriter& j, const Input& in)
     j.key ("spacing").number (in.spacing);
     j.key ("spacing_source").string (in.spacing_source);
   }
+  j.key ("surface");
+  surfaceJson (j, model);
   j.endObject ();
 }
 
 std::string
-resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcollision::CollisionResult& r,
+resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcollision::CloudModel* model_a,
+            const pcl_probcollision::CloudModel* model_b, const pcl_probcollision::CollisionResult& r,
             const Pose& pose, long long pose_index, const std::optional<double>& write_ms,
             std::size_t points_written)
 {
@@ -370,9 +393,9 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.endObject ();
   j.key ("inputs").beginObject ();
   j.key ("a");
-  inputJson (j, a);
+  inputJson (j, a, model_a);
   j.key ("b");
-  inputJson (j, b);
+  inputJson (j, b, model_b);
   j.endObject ();
   j.key ("parameters").beginObject ();
   // "sensor" is the model of both inputs, null when they differ; a mesh gets no noise.
@@ -926,7 +949,8 @@ run (int argc, char** argv)
     const long long index = batch ? static_cast<long long> (i) : -1;
     if (o.json)
     {
-      std::fprintf (stdout, "%s\n", resultJson (o, a, b, result, poses[i], index, write_ms, written).c_str ());
+      std::fprintf (stdout, "%s\n", resultJson (o, a, b, pc.getInputModel ().get (), pc.getTargetModel ().get (), result, poses[i], index,
+                                                write_ms, written).c_str ());
       std::fflush (stdout);
     }
     else

@@ -418,6 +418,8 @@ def test_surface_numpy_equals_pcd_path_bit_for_bit(sheets, tmp_path):
     arrays = (pc.build_model(a, params=SURFACE, viewpoint=view_a, name="a.pcd"),
               pc.build_model(b, params=SURFACE, viewpoint=view_b, name="b.pcd"))
     assert files[0].surface_orientation == arrays[0].surface_orientation == pc.NormalOrientation.Viewpoint
+    # Auto weighed the viewpoint, outside the sheet, and found no point hidden from it.
+    assert files[0].surface_hidden_from_viewpoint == arrays[0].surface_hidden_from_viewpoint == 0.0
     request = pc.CollisionRequest(surface=True, exhaustive=True, per_point=True)
     poses = np.array([translation(0.005, -0.003, z) for z in GAPS + [0.2]])
     batch = pc.collide_batch(*arrays, poses, request, threads=2)
@@ -448,7 +450,9 @@ def test_closed_objects_know_their_inside():
     declared = pc.build_model(big, params=closed)
     undeclared = pc.build_model(big, params=pc.CloudModelParams(**params))
     assert declared.surface_inside_known is True and declared.surface_closed_share > 0.9
+    assert declared.surface_solid_share > 0.9  # a smooth sphere: every probe behind reads inside
     assert undeclared.surface_inside_known is False and np.isnan(undeclared.surface_closed_share)
+    assert np.isnan(undeclared.surface_solid_share) and np.isnan(declared.surface_hidden_from_viewpoint)
     ball = pc.build_model(0.05 * unit[::10] + [1.1, 2.0, 3.0], params=pc.CloudModelParams(**params))
     request = pc.CollisionRequest(surface=True)
     inside = pc.collide(ball, declared, np.eye(4), request)

@@ -345,9 +345,13 @@ def test_model_cache_rebuilds_when_a_model_option_changes():
     g = np.linspace(-0.01, 0.01, 5)
     probe = np.array([[x, y, 0.0] for x in g for y in g])
     P = np.zeros((1, 6))
-    answers = [pcd.collide_poses(probe, points, P, surface=True, sigma=0.001, closed_b=closed).verdict[0]
+    results = [pcd.collide_poses(probe, points, P, surface=True, sigma=0.001, closed_b=closed)
                for closed in (True, False, True, False)]
-    assert answers == [int(pc.Verdict.InCollision), int(pc.Verdict.Free)] * 2
+    assert [r.verdict[0] for r in results] == [int(pc.Verdict.InCollision), int(pc.Verdict.Free)] * 2
+    # The results say which model answered: b's inside known only where declared closed.
+    assert [r.surfaces["b"]["inside_known"] for r in results] == [True, False] * 2
+    assert all(r.surfaces["b"]["orientation"] == "propagate" for r in results)
+    assert pcd.collide_poses(probe, points, P, sigma=0.001).surfaces == {"a": None, "b": None}
     # Every member of the built CloudModelParams is in the key, whatever option sets it.
     o = pcd.resolve_options({"surface": True})
     for change in ({"closed_b": True}, {"k": 7}, {"noise_stop": 2.0}, {"split": "octree"}, {"measured": True},

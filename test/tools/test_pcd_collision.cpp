@@ -292,17 +292,22 @@ TEST_F (PcdCollisionTool, JsonKeysAreDocumented)
       example = l;
   }
 
-  // Every branch: batch (pose_index), -o (output, write), a mesh and a cloud, a witness.
+  // Every branch: batch (pose_index), -o (output, write), a mesh and a cloud, a witness, the
+  // surfaces' orientation (-surface).
   writeFile (dir_ / "poses.txt", "-0.15,0.05,-0.02,0,0,0\n");
   const auto batch = runJson ({kGripper.string (), kScene.string (), "-poses", (dir_ / "poses.txt").string ()});
   const auto written = runJson ({kScene.string (), kGripper.string (), "-pose", "0.15,-0.05,0.02,0,0,0", "-o",
                                  (dir_ / "out.pcd").string ()});
+  const auto surface = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-surface"});
   ASSERT_EQ (batch.size (), 1u);
   ASSERT_EQ (written.size (), 1u);
+  ASSERT_EQ (surface.size (), 1u);
   ASSERT_EQ (batch[0]["witness"].type, Value::Type::Object);
+  ASSERT_EQ (surface[0]["inputs"]["b"]["surface"].type, Value::Type::Object);
   std::set<std::string> keys;
   collectKeys (batch[0], "", keys);
   collectKeys (written[0], "", keys);
+  collectKeys (surface[0], "", keys);
   for (const std::string& path : keys)
   {
     const std::string key = path.substr (path.rfind ('.') + 1);
@@ -1340,7 +1345,8 @@ TEST_F (PcdCollisionTool, SurfaceOrientsACloudByItsFilesNormals)
 // samples a closed solid, so its propagated orientation, checked by the winding number, says
 // where its inside is: the probe 1-2 cm inside it collides, where without the option the
 // propagated surface is two-sided and the probe, deeper than its points reach, reads free.
-// -closed_a (the probe alone) leaves the sphere two-sided. The stage line says which.
+// -closed_a (the probe alone) leaves the sphere two-sided. The stage line says which, and so does
+// the JSON (inputs.b.surface).
 TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
 {
   constexpr int kSphere = 2000, kProbe = 60;
@@ -1367,11 +1373,22 @@ TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
   EXPECT_LT (closed["signed_distance"].number, -0.005);
   EXPECT_NE (closed_stage.find ("[propagate: "), std::string::npos) << closed_stage;
   EXPECT_NE (closed_stage.find ("; closed: outside in front of 100 %"), std::string::npos) << closed_stage;
+  const Value& solid = closed["inputs"]["b"]["surface"];
+  ASSERT_EQ (solid.type, Value::Type::Object);
+  EXPECT_EQ (solid["orientation"].text, "propagate");
+  EXPECT_TRUE (solid["inside_known"].boolean);
+  EXPECT_EQ (solid["closed_share"].number, 1.0);
+  EXPECT_GE (solid["solid_share"].number, 0.9);
   for (const std::vector<std::string>& extra : {std::vector<std::string> {}, std::vector<std::string> {"-closed_a"}})
   {
     const auto [open, open_stage] = query (extra);
     EXPECT_EQ (open["verdict"].text, "free") << (extra.empty () ? "" : extra[0]);
     EXPECT_NE (open_stage.find ("two-sided (-closed if it samples closed solids)"), std::string::npos) << open_stage;
+    const Value& two_sided = open["inputs"]["b"]["surface"];
+    ASSERT_EQ (two_sided.type, Value::Type::Object);
+    EXPECT_EQ (two_sided["orientation"].text, "propagate");
+    EXPECT_FALSE (two_sided["inside_known"].boolean);
+    EXPECT_EQ (two_sided["closed_share"].type, Value::Type::Null);  // not checked
   }
 }
 

@@ -327,8 +327,24 @@ _INT_FIELDS = ("points_a", "points_b", "points_skipped_nonfinite", "leaf_pairs_t
                "kernel_leaf_pairs", "degenerate_leaf_pairs", "classifier_iterations", "witness_index")
 
 
-def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start: int, o: Dict[str, Any]) -> Dict[str, np.ndarray]:
-    """Answers poses[start:start + len(T_b_a)] with collide_batch; plain numpy arrays back."""
+# NormalOrientation as orientationName() spells it (pcd_collision's JSON).
+_ORIENTATION_NAMES = {core.NormalOrientation.Auto: "auto", core.NormalOrientation.PointNormals: "point_normals",
+                      core.NormalOrientation.Viewpoint: "viewpoint", core.NormalOrientation.Propagate: "propagate"}
+
+
+def surface_summary(model) -> Optional[Dict[str, Any]]:
+    """How a model's surface was oriented, pcd_collision's JSON member "surface" of an input
+    (NaN for its nulls); None without a surface model."""
+    if not model.has_surface:
+        return None
+    return {"orientation": _ORIENTATION_NAMES[model.surface_orientation], "inside_known": model.surface_inside_known,
+            "hidden_from_viewpoint": model.surface_hidden_from_viewpoint,
+            "closed_share": model.surface_closed_share, "solid_share": model.surface_solid_share}
+
+
+def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start: int, o: Dict[str, Any]) -> Dict[str, Any]:
+    """Answers poses[start:start + len(T_b_a)] with collide_batch; plain numpy arrays back, and
+    the models' build time and surface summaries."""
     A = _model(a, o, "a")
     B = _model(b, o, "b")
     results = core.collide_batch(A, B, core.invert_poses(T_b_a), request_of(o), threads=int(o["threads"]))
@@ -368,6 +384,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         out[field] = rotated(field) + T_b_a[:, :3, 3]
     out["witness_normal"] = rotated("witness_normal")
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
+    out["surfaces"] = {"a": surface_summary(A), "b": surface_summary(B)}
     out["pid"] = np.array([os.getpid()])
     return out
 
@@ -383,11 +400,14 @@ class BatchResults:
     nearest_point_a/_b (those samples, b's frame; NaN otherwise),
     the counters (points_a, points_b, points_skipped_nonfinite, leaf_pairs_tested, bv_tests,
     kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
-    witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; chunk_size
-    and chunks how it was split."""
+    witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; surfaces
+    how each model's surface was oriented ({"a": ..., "b": ...}, surface_summary(); None without
+    surface); chunk_size and chunks how it was split."""
 
-    def __init__(self, fields: Dict[str, np.ndarray], inputs, chunk_size: int, chunks: int, build_ms: float):
+    def __init__(self, fields: Dict[str, np.ndarray], inputs, chunk_size: int, chunks: int, build_ms: float,
+                 surfaces: Dict[str, Optional[Dict[str, Any]]]):
         self.fields = fields
+        self.surfaces = surfaces
         for k, v in fields.items():
             setattr(self, k, v)
         self.inputs = inputs
@@ -535,10 +555,10 @@ def _scatter(client, spec):
 def _assemble(parts, m: int, inputs, chunk_size: int) -> BatchResults:
     if not parts:
         raise ValueError("poses: no pose given")
-    fields = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k not in ("build_ms", "pid")}
+    fields = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k not in ("build_ms", "pid", "surfaces")}
     index = fields.pop("index")
     # Every pose answered exactly once, in pose order.
     if len(index) != m or not np.array_equal(index, np.arange(m)):
         raise RuntimeError(f"internal error: {len(index)} answers for {m} poses")
     build_ms = float(parts[0]["build_ms"][0])
-    return BatchResults(fields, inputs, chunk_size, len(parts), build_ms)
+    return BatchResults(fields, inputs, chunk_size, len(parts), build_ms, parts[0]["surfaces"])
