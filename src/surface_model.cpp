@@ -50,6 +50,18 @@ constexpr double kOpenLineRatio = 0.1;
   * own error can flip the side. */
 constexpr double kMinViewCosine = 0.2;
 
+/** \brief Viewpoint orientation: above this share of neighbour pairs among the points it
+  * orients whose oriented normals point apart (a negative dot product), the viewpoint sees the
+  * surface edge-on (a sheet in its plane: the points' noise tilts their normals toward it or
+  * away at random, about half the pairs) and orients nothing. A scan's neighbours facing its
+  * sensor agree but for stray normals and creases sharper than a right angle. */
+constexpr double kMaxViewConflicts = 0.25;
+/** \brief Viewpoint orientation: below this share of the points facing the viewpoint (|cos| at
+  * least kMinViewCosine), it sees the surface edge-on too: a sheet in the viewpoint's plane
+  * with 0.5 mm noise at 5 mm spacing has 1 of 1,600, tilted toward it or away at random; at 8
+  * degrees above its plane, 89, every one toward it. */
+constexpr double kMinViewSeeds = 0.01;
+
 /** \brief Auto takes a viewpoint outside the cloud for a scan's only if at most this share of
   * the points lies hidden behind others as seen from it (hiddenFromView). One scan holds none
   * (a sensor sees no point behind another; mixed pixels at depth edges, grazing surfaces a
@@ -146,6 +158,28 @@ struct Graph
 {
   std::vector<int> offsets, targets;
 };
+
+/** \brief The share of graph edges between seeded points (component 0) whose normals point
+  * apart; 0 without such an edge. */
+double
+viewConflicts (const Graph& graph, const std::vector<Eigen::Vector3f>& normals, const std::vector<int>& component)
+{
+  std::size_t edges = 0, apart = 0;
+  for (std::size_t i = 0; i < normals.size (); ++i)
+  {
+    if (component[i] != 0)
+      continue;
+    for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
+    {
+      const std::size_t t = static_cast<std::size_t> (graph.targets[static_cast<std::size_t> (e)]);
+      if (t <= i || component[t] != 0)
+        continue;
+      ++edges;
+      apart += normals[i].dot (normals[t]) < 0.0f ? 1 : 0;
+    }
+  }
+  return edges ? static_cast<double> (apart) / static_cast<double> (edges) : 0.0;
+}
 
 Graph
 symmetricGraph (const std::vector<int>& neighbours, int k, std::size_t n)
@@ -574,6 +608,20 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       ++seeded;
     }
   }
+  // A viewpoint that faces no point (a sheet seen edge-on, every point grazing), or normals asked
+  // for where none is given, say nothing of either side: the orientation is then propagation's,
+  // with its rules (two-sided unless checked closed), rather than a side picked by the farthest
+  // point below and trusted.
+  // Seen edge-on, the viewpoint orients nothing (kMinViewSeeds, kMaxViewConflicts).
+  if (mode == NormalOrientation::Viewpoint &&
+      (static_cast<double> (seeded) < kMinViewSeeds * static_cast<double> (n) ||
+       viewConflicts (graph, normals_, component) > kMaxViewConflicts))
+  {
+    std::fill (component.begin (), component.end (), -1);
+    seeded = 0;
+  }
+  if (mode != NormalOrientation::Propagate && seeded == 0)
+    orientation_ = mode = NormalOrientation::Propagate;
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));

@@ -26,11 +26,16 @@ enum class NormalOrientation
     * SurfaceModel::hiddenFromViewpoint), else propagation. */
   Auto,
   /** \brief The normals the points carry (PointNormal and the other *Normal types), taken as
-    * outward; points without a finite one are oriented by propagation from their neighbours. */
+    * outward; points without a finite one are oriented by propagation from their neighbours.
+    * With none given at all, the surface is propagated (SurfaceModel::orientation() says
+    * Propagate). */
   PointNormals,
   /** \brief Toward the sensor origin (sensor_origin_): a scan sees the outside of what it
     * scans. Trusted only where the surface faces the sensor (|cos| >= 0.2); grazing points take
-    * their orientation from their neighbours. */
+    * their orientation from their neighbours. A viewpoint that sees the cloud edge-on (under 1 %
+    * of the points facing it, or over a quarter of their neighbour pairs oriented apart: a sheet
+    * in the sensor's plane, whose noise tilts its normals either way) orients nothing, and the
+    * surface is propagated instead (SurfaceModel::orientation() says Propagate). */
   Viewpoint,
   /** \brief Propagated over the neighbour graph (Hoppe et al. 1992) from the point farthest
     * from the centroid, pointing away from it; then each connected part is flipped if needed so

@@ -481,6 +481,12 @@ def test_surface_normals_and_orientation_options(sheets):
     partial[::3] = np.nan
     partial[1::3] = 0
     assert pc.build_model(a, params=SURFACE, normals=partial).surface_orientation == pc.NormalOrientation.PointNormals
+    # PointNormals asked for without normals: nothing to take the sides from, so propagation
+    # (two-sided), not a side picked and trusted.
+    asked = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True,
+                                orientation=pc.NormalOrientation.PointNormals)
+    none = pc.build_model(a, params=asked)
+    assert none.surface_orientation == pc.NormalOrientation.Propagate and none.surface_inside_known is False
     with pytest.raises(ValueError, match="normals"):
         pc.build_model(a, normals=np.zeros((len(a) - 1, 3)))
     with pytest.raises(ValueError, match="normals"):
