@@ -62,12 +62,6 @@ constexpr double kMaxViewConflicts = 0.25;
   * degrees above its plane, 89, every one toward it. */
 constexpr double kMinViewSeeds = 0.01;
 
-/** \brief Auto takes a viewpoint outside the cloud for a scan's only if at most this share of
-  * the points lies hidden behind others as seen from it (hiddenFromView). One scan holds none
-  * (a sensor sees no point behind another; mixed pixels at depth edges, grazing surfaces a
-  * few); a closed object sampled all round, seen from a point outside it, about half (its far
-  * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
-constexpr double kMaxHiddenShare = 0.1;
 /** \brief Samples probed by the closed-objects check (SurfaceModel::closedShare), evenly spread:
   * 2,048 winding numbers, on one thread 7 ms for a 9,000-point sphere and 25-40 ms for a
   * 50,000-point room (docs/SURFACE.md, "Closed objects"). */
@@ -574,7 +568,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
   if (mode == NormalOrientation::Auto)
     mode = any_given ? NormalOrientation::PointNormals
-                     : view_outside && hidden_from_view_ <= kMaxHiddenShare ? NormalOrientation::Viewpoint
+                     : view_outside && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
                                                                            : NormalOrientation::Propagate;
   if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
     mode = NormalOrientation::Propagate;

@@ -575,8 +575,10 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   std::string why;
   const double hidden = model.surface ().hiddenFromViewpoint ();
   if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
-    why = "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
-          " % of the points lie behind others (one scan hides none)";
+    why = hidden > pcl_probcollision::SurfaceModel::kMaxHiddenShare
+              ? "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
+                    " % of the points lie behind others (one scan hides none)"
+              : std::string ("; not toward its VIEWPOINT, which sees it edge-on");
   // -closed: whether the winding number confirmed a closed solid, so that the surface has an inside.
   const double closed = model.surface ().closedShare ();
   auto percent = [] (double share) { return std::to_string (static_cast<int> (std::lround (100.0 * share))); };

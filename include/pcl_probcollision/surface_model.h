@@ -110,6 +110,12 @@ public:
   double surfaceSpacing () const { return surface_spacing_; }
   /** \brief The orientation used (never Auto). */
   NormalOrientation orientation () const { return orientation_; }
+  /** \brief Auto takes a viewpoint outside the cloud for a scan's only if at most this share of
+    * the points lies hidden behind others as seen from it (hiddenFromViewpoint()). One scan holds
+    * none (a sensor sees no point behind another; mixed pixels at depth edges, grazing surfaces a
+    * few); a closed object sampled all round, seen from a point outside it, about half (its far
+    * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
+  static constexpr double kMaxHiddenShare = 0.1;
   /** \brief Where Auto weighed a viewpoint outside the cloud: the share of points hidden from
     * it behind others (a scan from there hides none). Above 0.1 the viewpoint is not the
     * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
