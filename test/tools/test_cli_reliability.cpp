@@ -418,6 +418,36 @@ TEST_F (CliReliability, MeshesWithDegenerateDuplicateAndOpenTriangles)
   EXPECT_FALSE (hasNonFiniteNumber (nan_vertex.out)) << nan_vertex.out;
 }
 
+// Meshes with a hole under the surface layer (issue #16, "Bad input and limits"): the faces'
+// normals are taken as given (point_normals, inside known). A closed box and the same box without
+// its lid, a tray of single-sided walls whose faces point outward: a probe at half height reads
+// collision in both, since by the tray's own normals (winding number about 0.7 there, above 1/2)
+// its cavity is the inside of a solid with a hole; above both, free. An open container whose
+// cavity is free space needs its walls modelled with two faces (docs/RELIABILITY.md).
+TEST_F (CliReliability, MeshesWithAHoleUnderTheSurfaceLayer)
+{
+  const std::string walls = "v 0 0 0\nv 0.1 0 0\nv 0.1 0.1 0\nv 0 0.1 0\nv 0 0 0.05\nv 0.1 0 0.05\nv 0.1 0.1 0.05\n"
+                            "v 0 0.1 0.05\nf 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\n"
+                            "f 4 1 5\nf 4 5 8\n";
+  writeFile (dir_ / "tray.obj", walls);
+  writeFile (dir_ / "box.obj", walls + "f 5 6 7\nf 5 7 8\n");
+  Cloud probe;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      probe.push_back (pcl::PointXYZ (0.005f * i, 0.005f * j, 0.0f));
+  const std::string p = save ("probe.pcd", probe);
+  for (const char* mesh : {"box.obj", "tray.obj"})
+  {
+    const std::string m = (dir_ / mesh).string ();
+    const Value inside = expectAnswer ({p, m, "-surface", "-sigma", "0.001", "-pose", "0.05,0.05,0.025,0,0,0"});
+    EXPECT_EQ (inside["verdict"].text, "collision") << mesh;
+    EXPECT_EQ (inside["inputs"]["b"]["surface"]["orientation"].text, "point_normals") << mesh;
+    EXPECT_TRUE (inside["inputs"]["b"]["surface"]["inside_known"].boolean) << mesh;
+    const Value above = expectAnswer ({p, m, "-surface", "-sigma", "0.001", "-pose", "0.05,0.05,0.1,0,0,0"});
+    EXPECT_EQ (above["verdict"].text, "free") << mesh;
+  }
+}
+
 // SIGINT during a long batch: the tool dies of SIGINT, prints whole lines only, leaves no file.
 TEST_F (CliReliability, SigintDuringABatchLeavesNothingBehind)
 {
