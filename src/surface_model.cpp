@@ -17,19 +17,6 @@
 
 namespace pcl_probcollision
 {
-const char*
-orientationName (NormalOrientation orientation)
-{
-  switch (orientation)
-  {
-    case NormalOrientation::Auto: return "auto";
-    case NormalOrientation::PointNormals: return "point_normals";
-    case NormalOrientation::Viewpoint: return "viewpoint";
-    case NormalOrientation::Propagate: return "propagate";
-  }
-  return "unknown";
-}
-
 namespace
 {
 constexpr double kPi = 3.14159265358979323846;

@@ -40,7 +40,7 @@ fmt (double v)
 const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
-  "-noise_stop", "-max_leaf_fits"};
+  "-noise_stop", "-max_leaf_fits", "-orientation", "-orientation_a", "-orientation_b"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-surface_ladder", "-surface_calibrated", "-distance", "-ignore_normals",
                                             "-closed", "-closed_a", "-closed_b", "-v"};
@@ -248,6 +248,7 @@ parseCommandLine (const std::vector<std::string>& args)
   std::set<std::string> seen;
   std::optional<double> sigma, sigma_a, sigma_b;
   std::optional<std::string> sensor, sensor_a, sensor_b;
+  std::optional<pcl_probcollision::NormalOrientation> orientation, orientation_a, orientation_b;
   bool deterministic = false;
   bool only_positional = false;
 
@@ -435,6 +436,16 @@ parseCommandLine (const std::vector<std::string>& args)
         return usage (bad + "is not a non-negative integer (0: no cap)");
       o.max_leaf_fits = static_cast<std::size_t> (n);
     }
+    else if (a == "-orientation" || a == "-orientation_a" || a == "-orientation_b")
+    {
+      auto& slot = a == "-orientation" ? orientation : a == "-orientation_a" ? orientation_a : orientation_b;
+      slot.reset ();
+      for (const auto mode : pcl_probcollision::kNormalOrientations)
+        if (v == pcl_probcollision::orientationName (mode))
+          slot = mode;
+      if (!slot)
+        return usage (bad + "must be one of auto, point_normals, viewpoint, propagate");
+    }
     else if (a == "-split")
     {
       if (v != "pca" && v != "octree")
@@ -478,6 +489,12 @@ parseCommandLine (const std::vector<std::string>& args)
   if ((o.closed_a || o.closed_b) && !o.surface)
     return usage ("options -closed, -closed_a and -closed_b need -surface (or -surface_pooled, -surface_ladder): they "
                   "say where the surface layer's inside is");
+  if ((orientation || orientation_a || orientation_b) && !o.surface)
+    return usage ("options -orientation, -orientation_a and -orientation_b need -surface (or -surface_pooled, "
+                  "-surface_ladder): they orient the surface layer's surfaces");
+  // -orientation sets both inputs, -orientation_a / -orientation_b one each whatever the order.
+  o.orientation_a = orientation_a.value_or (orientation.value_or (o.orientation_a));
+  o.orientation_b = orientation_b.value_or (orientation.value_or (o.orientation_b));
   // -sensor sets both inputs, -sensor_a / -sensor_b one each whatever the order; likewise the
   // sigmas, which only an isotropic input uses.
   o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
@@ -592,6 +609,12 @@ helpText ()
        "                  scan's view or a room seen from within): a cloud oriented by propagation\n"
        "                  is checked by the winding number and, where it checks out, has an inside\n"
        "                  (by default such a cloud is two-sided); -closed_a, -closed_b: one input\n"
+       "  -orientation auto|point_normals|viewpoint|propagate   = "
+    << pcl_probcollision::orientationName (pcl_probcollision::CloudModelParams ().orientation)
+    << "\n"
+       "                  with -surface: how both surfaces are oriented (auto: a mesh's faces or a\n"
+       "                  file's normals, else a VIEWPOINT that sees the cloud as one scan does, else\n"
+       "                  propagation); -orientation_a M, -orientation_b M: one input\n"
        "  -nmax N         = "
     << D::n_max
     << "      hierarchy: a node with more points is split (n_min = min(" << D::n_min

@@ -124,6 +124,10 @@ struct Options
     * (CloudModelParams::closed_objects). */
   bool closed_a = false;
   bool closed_b = false;
+  /** \brief -orientation M (both), -orientation_a M, -orientation_b M: with -surface, how the
+    * input's surface is oriented (CloudModelParams::orientation; default Auto). */
+  pcl_probcollision::NormalOrientation orientation_a = pcl_probcollision::NormalOrientation::Auto;
+  pcl_probcollision::NormalOrientation orientation_b = pcl_probcollision::NormalOrientation::Auto;
 
   /** \brief -mesh_density S: sample spacing of mesh inputs in data units (> 0). */
   std::optional<double> mesh_spacing;

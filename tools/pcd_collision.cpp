@@ -261,6 +261,7 @@ modelParamsFor (const Options& o, bool input)
 {
   pcl_probcollision::CloudModelParams m;
   m.closed_objects = input ? o.closed_a : o.closed_b;
+  m.orientation = input ? o.orientation_a : o.orientation_b;
   m.k = o.k;
   m.noise_resolution = o.noise_resolution;
   m.surface_projection = !o.measured;
@@ -426,6 +427,8 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("distance").boolean (rq.distance);
   j.key ("closed_a").boolean (o.closed_a);
   j.key ("closed_b").boolean (o.closed_b);
+  j.key ("orientation_a").string (pcl_probcollision::orientationName (o.orientation_a));
+  j.key ("orientation_b").string (pcl_probcollision::orientationName (o.orientation_b));
   const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o, true).hierarchy;
   j.key ("nmax").integer (hierarchy.n_max);
   j.key ("nmin").integer (hierarchy.n_min);

@@ -43,8 +43,24 @@ enum class NormalOrientation
   Propagate
 };
 
-/** \brief "auto", "point_normals", "viewpoint" or "propagate". */
-const char* orientationName (NormalOrientation orientation);
+/** \brief "auto", "point_normals", "viewpoint" or "propagate" (inline: pcd_collision's option
+  * parser, which links no library, reads the names from here). */
+inline const char*
+orientationName (NormalOrientation orientation)
+{
+  switch (orientation)
+  {
+    case NormalOrientation::Auto: return "auto";
+    case NormalOrientation::PointNormals: return "point_normals";
+    case NormalOrientation::Viewpoint: return "viewpoint";
+    case NormalOrientation::Propagate: return "propagate";
+  }
+  return "unknown";
+}
+
+/** \brief Every NormalOrientation, in declaration order. */
+constexpr NormalOrientation kNormalOrientations[] = {NormalOrientation::Auto, NormalOrientation::PointNormals,
+                                                     NormalOrientation::Viewpoint, NormalOrientation::Propagate};
 
 struct CloudModelParams
 {

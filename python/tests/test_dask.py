@@ -303,12 +303,18 @@ def test_cli_surface_with_stored_normals_equals_pcd_collision(tmp_path):
     args = [str(tmp_path / "probe.pcd"), str(tmp_path / "sphere.pcd")]
     poses = str(tmp_path / "poses.txt")
     answers = {}
-    for extra in ([], ["-ignore_normals"]):
-        answers[bool(extra)], stderr = _both_clis_with_surface(args, poses, extra)
+    for extra in ([], ["-ignore_normals"], ["-orientation_b", "propagate"]):
+        answers[" ".join(extra)], stderr = _both_clis_with_surface(args, poses, extra)
         assert ("[point_normals:" in stderr) != bool(extra), stderr
-    inside = answers[False][0]
+    inside = answers[""][0]
     assert inside["verdict"] == "collision" and inside["signed_distance"] < -0.05
-    assert answers[False][3]["verdict"] == "free"
+    assert answers[""][3]["verdict"] == "free"
+    # -orientation_b propagate: the stored normals are not taken, the sphere is two-sided, and the
+    # probe at its centre, out of reach of its surface, reads free; both CLIs say which.
+    propagated = answers["-orientation_b propagate"]
+    assert propagated[0]["verdict"] == "free" and propagated[0]["parameters"]["orientation_b"] == "propagate"
+    assert propagated[0]["inputs"]["b"]["surface"]["orientation"] == "propagate"
+    assert propagated[0]["inputs"]["b"]["surface"]["inside_known"] is False
 
 
 def test_cli_closed_equals_pcd_collision(tmp_path):

@@ -147,6 +147,32 @@ TEST (CliOptions, ClosedMarksTheInputsClosedSolids)
   expectUsageError ({"-surface", "-closed_b", "-closed_b"}, "-closed_b");
 }
 
+// -orientation sets how both surfaces are oriented, -orientation_a / -orientation_b one each
+// whatever the order; the names are orientationName()'s; they need the surface layer.
+TEST (CliOptions, OrientationSetsEachInputsSurfaceOrientation)
+{
+  using pcl_probcollision::NormalOrientation;
+  const ParseResult none = parse ({"-surface"});
+  ASSERT_EQ (none.kind, Kind::Run) << none.error;
+  EXPECT_EQ (none.options.orientation_a, NormalOrientation::Auto);
+  EXPECT_EQ (none.options.orientation_b, NormalOrientation::Auto);
+  const ParseResult both = parse ({"-surface_ladder", "-orientation", "propagate"});
+  ASSERT_EQ (both.kind, Kind::Run) << both.error;
+  EXPECT_EQ (both.options.orientation_a, NormalOrientation::Propagate);
+  EXPECT_EQ (both.options.orientation_b, NormalOrientation::Propagate);
+  for (const auto& args : {std::vector<std::string> {"-surface", "-orientation_b", "viewpoint", "-orientation=point_normals"},
+                           std::vector<std::string> {"-surface", "-orientation=point_normals", "-orientation_b", "viewpoint"}})
+  {
+    const ParseResult one = parse (args);
+    ASSERT_EQ (one.kind, Kind::Run) << one.error;
+    EXPECT_EQ (one.options.orientation_a, NormalOrientation::PointNormals);
+    EXPECT_EQ (one.options.orientation_b, NormalOrientation::Viewpoint);
+  }
+  expectUsageError ({"-orientation", "propagate"}, "need -surface");
+  expectUsageError ({"-surface", "-orientation_a", "Propagate"}, "-orientation_a: 'Propagate' must be one of auto");
+  expectUsageError ({"-surface", "-orientation"}, "-orientation");
+}
+
 // -surface_ladder implies -surface and cannot be combined with -surface_pooled.
 TEST (CliOptions, SurfaceLadderImpliesSurfaceAndExcludesPooled)
 {

@@ -1392,6 +1392,29 @@ TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
   }
 }
 
+// -orientation_b: the table scan, oriented toward its VIEWPOINT by default, is propagated when
+// asked (two-sided: its inside no longer known); the JSON's parameters and inputs.b.surface
+// and the Orienting line say so. The gripper keeps its faces' normals.
+TEST_F (PcdCollisionTool, OrientationSetsHowASurfaceIsOriented)
+{
+  for (const std::string mode : {"auto", "propagate"})
+  {
+    const ToolRun r = run ({kGripper.string (), kScene.string (), "-surface", "-orientation_b", mode, "-pose",
+                            "0.1,0,0.25,0,0,0", "-json"});
+    ASSERT_EQ (r.status, 0) << r.err;
+    const auto out = lines (r.out);
+    ASSERT_EQ (out.size (), 1u) << r.out;
+    const Value j = mini_json::parse (out[0]);
+    EXPECT_EQ (j["parameters"]["orientation_a"].text, "auto");
+    EXPECT_EQ (j["parameters"]["orientation_b"].text, mode);
+    EXPECT_EQ (j["inputs"]["a"]["surface"]["orientation"].text, "point_normals");
+    const std::string used = mode == "auto" ? "viewpoint" : "propagate";
+    EXPECT_EQ (j["inputs"]["b"]["surface"]["orientation"].text, used);
+    EXPECT_EQ (j["inputs"]["b"]["surface"]["inside_known"].boolean, mode == "auto");
+    EXPECT_NE (r.err.find ("Orienting " + kScene.string () + " [" + used + ": "), std::string::npos) << r.err;
+  }
+}
+
 // Only some normal fields: with -surface an error naming the file and the missing field (exit
 // 1); without -surface the normals are not read and the file is a plain cloud.
 TEST_F (PcdCollisionTool, PartialNormalFieldsFailWithSurface)

@@ -82,6 +82,12 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "closed": False,
     "closed_a": _MODEL.closed_objects,
     "closed_b": _MODEL.closed_objects,
+    # With surface: how both surfaces (orientation), or <a>'s or <b>'s, are oriented, by
+    # pcd_collision's names (-orientation, -orientation_a, -orientation_b; CloudModelParams.
+    # orientation): auto, point_normals, viewpoint or propagate. None: auto.
+    "orientation": None,
+    "orientation_a": None,
+    "orientation_b": None,
     "nmax": _MODEL.n_max,
     "sigma_max": _MODEL.sigma_max,
     "epsilon": _MODEL.epsilon,
@@ -114,6 +120,15 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
     if (o["closed_a"] or o["closed_b"]) and not o["surface"]:
         raise ValueError("options closed, closed_a and closed_b need surface (or surface_pooled, surface_ladder): they "
                          "say where the surface layer's inside is")
+    if any(o[k] is not None for k in ("orientation", "orientation_a", "orientation_b")) and not o["surface"]:
+        raise ValueError("options orientation, orientation_a and orientation_b need surface (or surface_pooled, "
+                         "surface_ladder): they orient the surface layer's surfaces")
+    for side in ("a", "b"):
+        name = o["orientation_" + side] or o["orientation"] or _ORIENTATION_NAMES[_MODEL.orientation]
+        if name not in _ORIENTATION_NAMES.values():
+            raise ValueError(f"option orientation{'_' + side if o['orientation_' + side] else ''}: expected one of "
+                             f"{', '.join(_ORIENTATION_NAMES.values())}, got {name!r}")
+        o["orientation_" + side] = name
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
@@ -156,6 +171,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
     p.noise_resolution = float(o["noise_resolution"])
     p.noise_stop = float(o["noise_stop"])
     p.closed_objects = bool(o["closed_" + side])
+    p.orientation = next(m for m, name in _ORIENTATION_NAMES.items() if name == o["orientation_" + side])
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
     return p
@@ -484,7 +500,8 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     chunk_size: poses per task (default: about 8 tasks per worker thread, 32 to 2000 poses).
     options: pcd_collision's flags without the dash (sensor, sensor_a, sensor_b, sigma, sigma_a,
         sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, defer_kernel_fits, surface, nmax,
-        sigma_max, epsilon, split, mesh_density, ignore_normals) and threads (collide_batch threads per task).
+        sigma_max, epsilon, split, mesh_density, ignore_normals, closed, closed_a, closed_b, orientation,
+        orientation_a, orientation_b, ...: OPTION_NAMES) and threads (collide_batch threads per task).
         surface=True is pcd_collision's -surface: both models get the oriented surface (meshes
         by their faces' normals, a cloud file with normal_x normal_y normal_z by them unless
         ignore_normals) and signed_distance / signed_distance_std are filled (NaN
