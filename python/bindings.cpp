@@ -646,8 +646,10 @@ PYBIND11_MODULE (_core, m)
       "Auto (default): the points' own normals when build_model() was given finite ones (a mesh's faces) or\n"
       "    load_model() read them from the file, else the viewpoint when it lies outside the cloud's bounding box\n"
       "    and sees it as one scan does (at most 10 % of the points hidden behind others from there), else Propagate.\n"
-      "PointNormals: the given normals, taken as outward; points without one are oriented from their neighbours.\n"
-      "Viewpoint: toward the sensor origin (the viewpoint); grazing points (|cos| < 0.2) from their neighbours.\n"
+      "PointNormals: the given normals, taken as outward; points without one are oriented from their neighbours\n"
+      "    (none given at all: Propagate).\n"
+      "Viewpoint: toward the sensor origin (the viewpoint); grazing points (|cos| < 0.2) from their neighbours;\n"
+      "    a viewpoint that sees the cloud edge-on orients nothing: Propagate (CloudModel.surface_orientation says so).\n"
       "Propagate: propagated over the neighbour graph from the point farthest from the centroid, then each\n"
       "    connected part flipped so that its enclosed volume is positive (closed objects). Not trusted to say\n"
       "    where the inside is (an open sheet, a room seen from within): the surface layer takes it as two-sided.")
