@@ -1393,11 +1393,12 @@ TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
 }
 
 // -orientation_b: the table scan, oriented toward its VIEWPOINT by default, is propagated when
-// asked (two-sided: its inside no longer known); the JSON's parameters and inputs.b.surface
-// and the Orienting line say so. The gripper keeps its faces' normals.
+// asked (two-sided: its inside no longer known), and when normals are asked of it, which it has
+// not; the JSON's parameters and inputs.b.surface and the Orienting line say so, and why. The
+// gripper keeps its faces' normals.
 TEST_F (PcdCollisionTool, OrientationSetsHowASurfaceIsOriented)
 {
-  for (const std::string mode : {"auto", "propagate"})
+  for (const std::string mode : {"auto", "propagate", "point_normals"})
   {
     const ToolRun r = run ({kGripper.string (), kScene.string (), "-surface", "-orientation_b", mode, "-pose",
                             "0.1,0,0.25,0,0,0", "-json"});
@@ -1412,6 +1413,9 @@ TEST_F (PcdCollisionTool, OrientationSetsHowASurfaceIsOriented)
     EXPECT_EQ (j["inputs"]["b"]["surface"]["orientation"].text, used);
     EXPECT_EQ (j["inputs"]["b"]["surface"]["inside_known"].boolean, mode == "auto");
     EXPECT_NE (r.err.find ("Orienting " + kScene.string () + " [" + used + ": "), std::string::npos) << r.err;
+    EXPECT_EQ (r.err.find ("-orientation point_normals refused: it has no normals") != std::string::npos,
+               mode == "point_normals")
+        << r.err;
   }
 }
 
