@@ -589,11 +589,10 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       ++seeded;
     }
   }
-  // A viewpoint that faces no point (a sheet seen edge-on, every point grazing), or normals asked
+  // A viewpoint that sees the cloud edge-on (kMinViewSeeds, kMaxViewConflicts), or normals asked
   // for where none is given, say nothing of either side: the orientation is then propagation's,
   // with its rules (two-sided unless checked closed), rather than a side picked by the farthest
   // point below and trusted.
-  // Seen edge-on, the viewpoint orients nothing (kMinViewSeeds, kMaxViewConflicts).
   if (mode == NormalOrientation::Viewpoint &&
       (static_cast<double> (seeded) < kMinViewSeeds * static_cast<double> (n) ||
        viewConflicts (graph, normals_, component) > kMaxViewConflicts))

@@ -439,12 +439,15 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-orientation" || a == "-orientation_a" || a == "-orientation_b")
     {
       auto& slot = a == "-orientation" ? orientation : a == "-orientation_a" ? orientation_a : orientation_b;
-      slot.reset ();
+      std::string names;
       for (const auto mode : pcl_probcollision::kNormalOrientations)
+      {
         if (v == pcl_probcollision::orientationName (mode))
           slot = mode;
+        names += (names.empty () ? "" : ", ") + std::string (pcl_probcollision::orientationName (mode));
+      }
       if (!slot)
-        return usage (bad + "must be one of auto, point_normals, viewpoint, propagate");
+        return usage (bad + "must be one of " + names);
     }
     else if (a == "-split")
     {

@@ -117,7 +117,7 @@ public:
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
   /** \brief Where Auto weighed a viewpoint outside the cloud: the share of points hidden from
-    * it behind others (a scan from there hides none). Above 0.1 the viewpoint is not the
+    * it behind others (a scan from there hides none). Above kMaxHiddenShare the viewpoint is not the
     * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
     * NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
