@@ -809,6 +809,42 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
   EXPECT_GT (contact, 0);
 }
 
+// A known limit of the separators, and so of the ladder (docs/SURFACE.md, "The ladder"): a small
+// ball pushed 10 mm through a sparse scanned table (samples 60 mm apart, 60 times the noise) at
+// positions between the samples. Where it passes between the table's leaf boxes the separators
+// reach no leaf pair and read P = 0, and the ladder keeps their answer. The surface layer, whose
+// reach is grown by a sample spacing, reads every such position as collision.
+TEST (SurfaceLayer, APartBetweenSparseSamplesIsSeenByTheSurfaceLayerAlone)
+{
+  const auto table = buildCloudModel (sheet (1.0, 0.06, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto ball = buildCloudModel (sphere (300, 0.015, Eigen::Vector3d::Zero ()), noisy (0.001));
+  const Answerers q (false);
+  int positions = 0, between = 0;
+  for (double x = -0.06; x <= 0.0601; x += 0.006)
+    for (double y = -0.06; y <= 0.0601; y += 0.006)
+    {
+      ++positions;
+      SCOPED_TRACE ("ball at x = " + std::to_string (x) + ", y = " + std::to_string (y));
+      // T_a_b places the table in the ball's frame: the ball's centre at (x, y, 5 mm) over the
+      // table, its bottom 10 mm under the table's top.
+      const Eigen::Isometry3d T = shift (-x, -y, -0.005);
+      CollisionResult rc, rl, rs;
+      ASSERT_TRUE (collide (*ball, *table, T, q.separators, rc));
+      ASSERT_TRUE (collide (*ball, *table, T, q.surface, rs));
+      EXPECT_EQ (rs.verdict, Verdict::InCollision) << "P = " << rs.probability;
+      EXPECT_LT (rs.signed_distance, 0.0);
+      if (!rc.no_leaf_tested)
+        continue;
+      ++between;
+      ASSERT_TRUE (collide (*ball, *table, T, q.ladder, rl));
+      EXPECT_EQ (rl.answered_by, AnsweredBy::Separators);
+      EXPECT_EQ (rl.verdict, Verdict::Free);
+    }
+  std::cout << "[ ladder ] ball between the separators' leaves (read free by them and the ladder) at " << between
+            << " of " << positions << " positions\n";
+  EXPECT_GT (between, 0);
+}
+
 // A surface request on models built without the surface model (CloudModelParams::surface off)
 // falls back to the separators, and the result says so rather than passing their answer off as
 // the surface layer's; a failed query names no answerer.
