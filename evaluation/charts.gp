@@ -6,7 +6,8 @@
 # reads  dir/{summary,queries,flips,model_size,reliability}.csv   (comma separated, header line)
 # writes out/accuracy_vs_time.png, free_probability_vs_distance.png, flip_rate_vs_noise.png,
 #        model_size_vs_accuracy.png, reliability.png, rescan_flips.png,
-#        reliability_grid.png, signed_distance_vs_exact.png          (out defaults to dir)
+#        reliability_grid.png, signed_distance_vs_exact.png, hidden_collisions.png
+#                                                                     (out defaults to dir)
 #
 # Optional variables, given with -e before the script, e.g. -e "dir='x'; noise=1":
 #   out       directory of the PNGs (default: dir)
@@ -530,6 +531,54 @@ if (!readable("queries.csv")) {
       }
     }
     unset multiplot
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (9) Hidden collisions (issue 16): the share of near-band "free" answers (P < 0.1, |d| <= 2.8
+# σ_eff) that collide, the error a planner pays for, against the noise level, per room density
+# (solid: W1, the dense room; dashed: W1-sparse), for ours and the 2-sigma collision maps. A cell
+# without a free answer has no share and no point. Dotted: issue 16's target, at most 5 %.
+
+hidden_series = "ours:classifier ours:surface ours:pooled ours:ladder octomap_2x:mesh octomap_2x:cloud"
+hidden_prog(w, s) = sprintf("$c[\"workload\"] == \"%s\" && %s \":\" %s == \"%s\" && num(%s) && num(%s) && %s > 0 && %s > 0 { print %s, %s }", \
+  w, col("method"), col("setting"), s, col("noise_pct"), col("hidden_rate_near_sigma"), col("noise_pct"), \
+  col("free_near_sigma"), col("noise_pct"), col("hidden_rate_near_sigma"))
+cmd9(w, s) = select("summary.csv", noise, hidden_prog(w, s)) . " | sort -g -k1,1"
+hidden_rows(s) = count(cmd9("W1", s)) + count(cmd9("W1-sparse", s))
+
+if (!readable("summary.csv")) {
+  print skip("hidden_collisions.png", "no summary.csv")
+} else {
+  hseries = ""
+  do for [s in hidden_series] {
+    if (hidden_rows(s) > 0) { hseries = hseries . " " . s }
+  }
+  if (words(hseries) == 0) {
+    print skip("hidden_collisions.png", "no W1 row with a near-band free answer")
+  } else {
+    reset
+    set output png("hidden_collisions.png")
+    set title "W1: share of the near-band \"free\" answers (P < 0.1, |d| <= 2.8 σ_eff) that collide\n(ours:classifier is the default)"
+    set xlabel sprintf("noise σ (%s; log scale)", noiseunit)
+    set ylabel "hidden collisions / free answers"
+    hlevels = system(select("summary.csv", noise, sprintf("%s ~ /^W1/ && num(%s) && %s > 0 { print %s }", \
+                     col("workload"), col("noise_pct"), col("noise_pct"), col("noise_pct"))) . " | sort -gu | tr '\\n' ' '")
+    set logscale x
+    set xtics ()
+    do for [lv in hlevels] {
+      set xtics add (lv lv + 0)
+    }
+    set xrange [(word(hlevels, 1) + 0) / 1.4 : (word(hlevels, words(hlevels)) + 0) * 1.4]
+    set yrange [0:*]
+    set grid
+    set key outside right center
+    plot 0.05 with lines dt 3 lw 2 lc rgb "#555555" title "target: 5 %", \
+         for [i = 1:words(hseries)] "< " . cmd9("W1", word(hseries, i)) using 1:2 with linespoints \
+           lw 2 pt 7 dt 1 lc rgb colour(i) title "dense: " . word(hseries, i), \
+         for [i = 1:words(hseries)] "< " . cmd9("W1-sparse", word(hseries, i)) using 1:2 with linespoints \
+           lw 2 pt 6 dt 2 lc rgb colour(i) title "sparse: " . word(hseries, i)
     unset output
   }
 }
