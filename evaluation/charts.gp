@@ -44,11 +44,10 @@ if (!exists("relband")) relband = "near_sigma"
 if (!exists("gridwl")) gridwl = "W1 W1-sparse W2 W3"
 
 set encoding utf8
-if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
-  set terminal pngcairo size 900,600 noenhanced font "DejaVu Sans,11"
-} else {
-  set terminal png size 900,600 noenhanced
-}
+# The terminal of the single charts; charts 7 and 8 size it to their grids, chart 9 sets it back.
+single_terminal = (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) \
+  ? 'set terminal pngcairo size 900,600 noenhanced font "DejaVu Sans,11"' : 'set terminal png size 900,600 noenhanced'
+eval single_terminal
 set datafile separator "\t"
 set datafile missing "nan"
 
@@ -559,12 +558,7 @@ if (!readable("summary.csv")) {
     print skip("hidden_collisions.png", "no W1 row with a near-band free answer")
   } else {
     reset
-    # The size of charts 1-6 again: charts 7 and 8 size the terminal to their grids.
-    if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
-      set terminal pngcairo size 900,600 noenhanced font "DejaVu Sans,11"
-    } else {
-      set terminal png size 900,600 noenhanced
-    }
+    eval single_terminal
     set output png("hidden_collisions.png")
     set title "W1: share of the near-band \"free\" answers (P < 0.1, |d| <= 2.8 σ_eff) that collide\n(ours:classifier is the default)"
     set xlabel sprintf("noise σ (%s; log scale)", noiseunit)
