@@ -35,7 +35,8 @@
 // --dump also writes each W1 cell's noisy scans, with the normals the surface layer is given
 // (ScanSides), and its poses into DIR/scans: any row of queries.csv can then be re-run alone,
 //   pcd_collision scans/W1_0.5_robot.pcd scans/W1_0.5_env.pcd -sigma S -surface -pose ...
-// with S and the pose from scans/W1_0.5_poses.txt.
+// with S and the pose from scans/W1_0.5_poses.txt, and located against the meshes (where the
+// piano touches the room, which part, the samples nearest it) by scripts/locate-contact.py.
 
 #include "baselines.h"
 #include "fit_scenes.h"
