@@ -24,8 +24,8 @@
 //   evaluate_collision --out DIR --data SHARED_DATA_DIR [--quick] [--seed N] [--poses N]
 //                      [--sigma-poses N] [--rescans N] [--rescan-poses N] [--ours-only] [--dump]
 //                      [--surface-calibrated] [--fit-scene]
-//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...]
-//                      [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
+//                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...]
+//                      [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
 // --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
 // --surface-calibrated passes the surface layer's P through its calibration maps
@@ -99,6 +99,10 @@ struct Options
   /** \brief The same merge gated by the local spacing ("gate<c>", "surface-gate<c>"); empty
     * (default) leaves them out. */
   std::vector<double> gate;
+  /** \brief The same merge of a whole cloud where it is sampled finer than its noise
+    * ("cloudmerge<c>", "surface-cloudmerge<c>"; ResolutionGate::WholeCloud); empty leaves them
+    * out. At noise below the clouds' spacing they answer exactly as classifier and surface. */
+  std::vector<double> cloud_merge {2.0};
   /** \brief BVHParams::noise_stop of the "stop<c>" and "surface-stop<c>" settings (issue #17
     * item 1), one pair per value; empty (default) leaves them out (docs/PERFORMANCE.md: no c
     * met the targets; each pair adds a surface-layer run to every cell). */
@@ -474,7 +478,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   };
 
   // Ours: the whole sweep on the dense room at 0.5 %, default, classifier, surface and max elsewhere.
-  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop, o.cap);
+  std::vector<OursSetting> settings = oursSettings (!o.quick && dense && pct == 0.5, o.merge, o.gate, o.stop, o.cap, o.cloud_merge);
   if (o.surface_calibrated)
     calibratedSurface (settings);
   for (const double f : o.drop)
@@ -1415,7 +1419,7 @@ numbers (const std::vector<std::string>& items)
   return out;
 }
 
-/** \brief The values > 0 (a 0 in --merge, --gate, --stop or --cap leaves those settings out). */
+/** \brief The values > 0 (a 0 in --merge, --gate, --cloud-merge, --stop or --cap leaves those settings out). */
 std::vector<double>
 positive (std::vector<double> values)
 {
@@ -1465,6 +1469,8 @@ parse (int argc, char** argv)
       o.merge = positive (numbers (list (value ())));
     else if (a == "--gate")
       o.gate = positive (numbers (list (value ())));
+    else if (a == "--cloud-merge")
+      o.cloud_merge = positive (numbers (list (value ())));
     else if (a == "--stop")
       o.stop = positive (numbers (list (value ())));
     else if (a == "--cap")
@@ -1483,7 +1489,7 @@ parse (int argc, char** argv)
     else
       throw std::invalid_argument ("unknown option " + a +
                                    " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
+                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
   }
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument ("--out and --data are required");

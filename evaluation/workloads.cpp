@@ -30,7 +30,7 @@ calibratedSurface (std::vector<OursSetting>& settings)
 
 std::vector<OursSetting>
 oursSettings (bool full, const std::vector<double>& merge, const std::vector<double>& gate,
-              const std::vector<double>& stop, const std::vector<double>& cap)
+              const std::vector<double>& stop, const std::vector<double>& cap, const std::vector<double>& cloud_merge)
 {
   std::vector<OursSetting> s;
   // "default" is exactly what a user gets; "max" the paper's model (measured positions).
@@ -71,7 +71,8 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (surface_k20);
   s.push_back (other);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
-  // noise is at least the local sample spacing ("gate<c>"), or the hierarchy not split within
+  // noise is at least the local sample spacing ("gate<c>"), or the whole cloud where it is
+  // sampled finer than its noise ("cloudmerge<c>"), or the hierarchy not split within
   // c point sigmas ("stop<c>"); separators and surface layer each.
   auto addVariant = [&] (const std::string& prefix, double c, const std::function<void (CloudModelParams&)>& change) {
     std::ostringstream name;
@@ -94,6 +95,8 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
     addVariant ("merge", c, merged (c, CloudModelParams::ResolutionGate::Everywhere));
   for (const double c : gate)
     addVariant ("gate", c, merged (c, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing));
+  for (const double c : cloud_merge)
+    addVariant ("cloudmerge", c, merged (c, CloudModelParams::ResolutionGate::WholeCloud));
   for (const double c : stop)
     addVariant ("stop", c, [c] (CloudModelParams& m) { m.hierarchy.noise_stop = c; });
   // Issue #17 item 2: the separators' work capped at n leaf-pair fits a query.

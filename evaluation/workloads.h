@@ -71,13 +71,16 @@ struct OursSetting
   * ladder, surface-k20 and max. Each c of merge adds "merge<c>"
   * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c;
   * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
-  * (ResolutionGate::WhereNoiseExceedsSpacing); each c of stop "stop<c>" and "surface-stop<c>",
+  * (ResolutionGate::WhereNoiseExceedsSpacing); each c of cloud_merge "cloudmerge<c>" and
+  * "surface-cloudmerge<c>", the same merge of a whole cloud where it is sampled finer than its
+  * noise (ResolutionGate::WholeCloud); each c of stop "stop<c>" and "surface-stop<c>",
   * the hierarchy not split within the noise (BVHParams::noise_stop = c). Each n of cap adds
   * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2). W2 adds
   * "surface-closed" itself (CloudModelParams::closed_objects on its solids, Solids). */
 std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {},
                                        const std::vector<double>& gate = {}, const std::vector<double>& stop = {},
-                                       const std::vector<double>& cap = {});
+                                       const std::vector<double>& cap = {},
+                                       const std::vector<double>& cloud_merge = {});
 
 /** \brief evaluate_collision --surface-calibrated: the settings with the surface layer answer
   * with its calibration maps (CollisionRequest::surface_calibrated, off by default). */

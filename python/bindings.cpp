@@ -737,6 +737,17 @@ PYBIND11_MODULE (_core, m)
                      },
                      "Merge (noise_resolution) only samples whose local spacing is at most their noise sigma\n"
                      "(ResolutionGate.WhereNoiseExceedsSpacing; default False: Everywhere).")
+      .def_property ("noise_resolution_whole_cloud",
+                     [] (const CloudModelParams& p) {
+                       return p.noise_resolution_gate == CloudModelParams::ResolutionGate::WholeCloud;
+                     },
+                     [] (CloudModelParams& p, bool v) {
+                       p.noise_resolution_gate = v ? CloudModelParams::ResolutionGate::WholeCloud
+                                                   : CloudModelParams::ResolutionGate::Everywhere;
+                     },
+                     "Merge (noise_resolution) the whole cloud where it is sampled finer than its noise (its median\n"
+                     "noise sigma at least its area-weighted spacing), else nothing (ResolutionGate.WholeCloud;\n"
+                     "default False: Everywhere). It and noise_resolution_gated set one gate: the last set wins.")
       .def_readwrite ("threads", &CloudModelParams::threads,
                       "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
                       "hardware thread. The model is the same for any count.")

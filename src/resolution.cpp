@@ -74,5 +74,23 @@ localSpacing (const std::vector<Eigen::Vector3f>& positions, int k)
   }
   return spacing;
 }
+double
+areaWeightedMedian (std::vector<float>& spacings)
+{
+  spacings.erase (std::remove_if (spacings.begin (), spacings.end (), [] (float v) { return !(v >= 0.0f) || !std::isfinite (v); }),
+                  spacings.end ());
+  std::sort (spacings.begin (), spacings.end ());
+  double total = 0.0;
+  for (const float v : spacings)
+    total += static_cast<double> (v) * v;
+  double sum = 0.0;
+  for (const float v : spacings)
+  {
+    sum += static_cast<double> (v) * v;
+    if (sum >= 0.5 * total)
+      return v;
+  }
+  return 0.0;
+}
 } // namespace detail
 } // namespace pcl_probcollision

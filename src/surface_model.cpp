@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/surface_model.h>
 #include <pcl_probcollision/detail/parallel.h>
+#include <pcl_probcollision/detail/resolution.h>
 
 #include <pcl/exceptions.h>
 
@@ -508,25 +509,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   open = std::vector<Eigen::Vector4f> ();
   // The spacing's statistics (a sort of every point's) need nothing of what follows until the
   // end: on a thread of their own when the build has several.
-  auto spacingStatistics = [this, n] {
+  auto spacingStatistics = [this] {
     std::vector<float> sorted (spacing_);
-    std::sort (sorted.begin (), sorted.end ());
-    median_spacing_ = n ? sorted[n / 2] : 0.0;
-    // Weighted by area: half the surface's area lies on samples at most this far apart.
-    double total = 0.0;
-    for (const float v : sorted)
-      total += static_cast<double> (v) * v;
-    double sum = 0.0;
-    surface_spacing_ = median_spacing_;
-    for (const float v : sorted)
-    {
-      sum += static_cast<double> (v) * v;
-      if (sum >= 0.5 * total)
-      {
-        surface_spacing_ = v;
-        break;
-      }
-    }
+    // Weighted by area: half the surface's area lies on samples at most this far apart. The
+    // spacings are finite and >= 0, so none is dropped and sorted is sorted in full.
+    surface_spacing_ = detail::areaWeightedMedian (sorted);
+    median_spacing_ = sorted.empty () ? 0.0 : sorted[sorted.size () / 2];
   };
   std::future<void> statistics;
   if (workers > 1)

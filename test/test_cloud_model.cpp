@@ -14,7 +14,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -719,6 +721,95 @@ TEST (NoiseResolutionGate, DeterministicAndIndependentOfThreads)
 {
   const Cloud::Ptr a = randomSquare (4000, 0.1, 0.003, 15);  // spacing 1.6 mm, noise 3 mm
   CloudModelParams one = gated (0.003, 2.0);
+  one.threads = 1;
+  CloudModelParams two = one;
+  two.threads = 2;
+  const CloudModel::ConstPtr x = buildCloudModel (*a, one);
+  const CloudModel::ConstPtr y = buildCloudModel (*a, two);
+  ASSERT_GT (x->mergedSamples (), 0u);
+  EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
+  EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
+}
+
+// ---- The whole-cloud gate (CloudModelParams::ResolutionGate::WholeCloud) --------------------
+
+namespace
+{
+CloudModelParams
+wholeCloud (double sigma, double factor)
+{
+  CloudModelParams params = merging (sigma, factor);
+  params.noise_resolution_gate = CloudModelParams::ResolutionGate::WholeCloud;
+  return params;
+}
+} // namespace
+
+TEST (NoiseResolutionWholeCloud, AreaWeightedMedianWeighsClustersByTheAreaTheyCover)
+{
+  // 900 samples of a cluster (spacing 1) and 100 of a surface (spacing 30): the plain median
+  // is the cluster's, the area-weighted one the surface's (30^2 * 100 against 1 * 900).
+  std::vector<float> s (900, 1.0f);
+  s.insert (s.end (), 100, 30.0f);
+  s.push_back (std::numeric_limits<float>::quiet_NaN ());
+  EXPECT_EQ (detail::areaWeightedMedian (s), 30.0);
+  std::vector<float> none;
+  EXPECT_EQ (detail::areaWeightedMedian (none), 0.0);
+  // The gate compares the median noise with it: the spacing 30 here is sqrt(pi / k) r_k.
+  const double r = 30.0 / std::sqrt (M_PI / 10.0);
+  std::vector<float> radii (900, static_cast<float> (1.0 / std::sqrt (M_PI / 10.0)));
+  radii.insert (radii.end (), 100, static_cast<float> (r));
+  EXPECT_TRUE (detail::noiseExceedsTypicalSpacing (radii, 10, [] (std::size_t) { return 30.5; }));
+  EXPECT_FALSE (detail::noiseExceedsTypicalSpacing (radii, 10, [] (std::size_t) { return 29.5; }));
+}
+
+TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
+{
+  // A 5 mm grid: at noise 10 mm (above its spacing, about 5.6 mm) the whole cloud merges as the
+  // ungated rule does; at noise 2 mm (below) nothing merges and the model is the unmerged one.
+  const Cloud::Ptr a = sheet (0.2, 0.005, 0.0, 21);
+  const CloudModel::ConstPtr high = buildCloudModel (*a, wholeCloud (0.01, 2.0));
+  const CloudModel::ConstPtr all = buildCloudModel (*a, merging (0.01, 2.0));
+  EXPECT_LT (high->size (), a->size () / 4);
+  EXPECT_EQ (high->pointOfSource (), all->pointOfSource ());
+  EXPECT_EQ (high->hierarchy ().means (), all->hierarchy ().means ());
+  const CloudModel::ConstPtr low = buildCloudModel (*a, wholeCloud (0.002, 2.0));
+  const CloudModel::ConstPtr plain = buildCloudModel (*a, merging (0.002, 0.0));
+  ASSERT_GT (buildCloudModel (*a, merging (0.002, 3.0))->mergedSamples (), 0u);  // the radius would merge
+  EXPECT_EQ (buildCloudModel (*a, wholeCloud (0.002, 3.0))->mergedSamples (), 0u);
+  EXPECT_EQ (low->mergedSamples (), 0u);
+  EXPECT_TRUE (low->pointOfSource ().empty ());
+  EXPECT_EQ (low->hierarchy ().means (), plain->hierarchy ().means ());
+  EXPECT_EQ (low->hierarchy ().covariances ().size (), plain->hierarchy ().covariances ().size ());
+}
+
+TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotTriggerIt)
+{
+  // A surface sampled 40 mm apart plus, at each of 25 places, 12 copies of one vertex within
+  // 0.5 mm (a triangle soup's corners, as the evaluation's sparse room has): most samples sit
+  // in clusters, so their plain median spacing is under the 5 mm noise, but the area they
+  // cover is the surface's. The whole-cloud gate keeps the cloud as it is; the ungated rule
+  // merges the clusters.
+  Cloud::Ptr a = sheet (0.4, 0.04, 0.0, 22);
+  std::mt19937 rng (23);
+  std::uniform_real_distribution<double> u (-0.0005, 0.0005);
+  for (int c = 0; c < 25; ++c)
+    for (int m = 0; m < 12; ++m)
+      a->push_back (pcl::PointXYZ (static_cast<float> (-0.16 + 0.08 * (c % 5) + u (rng)),
+                                   static_cast<float> (-0.16 + 0.08 * (c / 5) + u (rng)), static_cast<float> (u (rng))));
+  std::vector<Eigen::Vector3f> positions;
+  for (const auto& p : *a)
+    positions.push_back (p.getVector3fMap ());
+  std::vector<float> spacing = detail::localSpacing (positions, 10);
+  std::nth_element (spacing.begin (), spacing.begin () + spacing.size () / 2, spacing.end ());
+  ASSERT_LT (spacing[spacing.size () / 2], 0.005f);
+  EXPECT_EQ (buildCloudModel (*a, wholeCloud (0.005, 2.0))->mergedSamples (), 0u);
+  EXPECT_GT (buildCloudModel (*a, merging (0.005, 2.0))->mergedSamples (), 200u);
+}
+
+TEST (NoiseResolutionWholeCloud, DeterministicAndIndependentOfThreads)
+{
+  const Cloud::Ptr a = randomSquare (4000, 0.1, 0.003, 24);  // spacing 1.6 mm, noise 3 mm
+  CloudModelParams one = wholeCloud (0.003, 2.0);
   one.threads = 1;
   CloudModelParams two = one;
   two.threads = 2;

@@ -40,7 +40,7 @@ fmt (double v)
 const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
-  "-noise_stop", "-max_leaf_fits", "-orientation", "-orientation_a", "-orientation_b"};
+  "-noise_resolution_gate", "-noise_stop", "-max_leaf_fits", "-orientation", "-orientation_a", "-orientation_b"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-surface_ladder", "-surface_calibrated", "-distance", "-ignore_normals",
                                             "-closed", "-closed_a", "-closed_b", "-v"};
@@ -422,6 +422,19 @@ parseCommandLine (const std::vector<std::string>& args)
       if (!(o.noise_resolution >= 0.0) || !std::isfinite (o.noise_resolution))
         return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging)");
     }
+    else if (a == "-noise_resolution_gate")
+    {
+      using Gate = pcl_probcollision::CloudModelParams::ResolutionGate;
+      bool known = false;
+      for (const Gate g : {Gate::Everywhere, Gate::WhereNoiseExceedsSpacing, Gate::WholeCloud})
+        if (v == pcl_probcollision::CloudModelParams::resolutionGateName (g))
+        {
+          o.noise_resolution_gate = g;
+          known = true;
+        }
+      if (!known)
+        return usage (bad + "must be everywhere, spacing or cloud");
+    }
     else if (a == "-noise_stop")
     {
       if (!parseDouble (v, o.noise_stop))
@@ -567,6 +580,11 @@ helpText ()
     << fmt (D::noise_resolution)
     << "   merge samples closer than C noise sigmas into one (0: none; 2 is\n"
        "                  the evaluated choice at high noise: faster, less accurate at low noise)\n"
+       "  -noise_resolution_gate everywhere|spacing|cloud   = "
+    << pcl_probcollision::CloudModelParams::resolutionGateName (D::noise_resolution_gate)
+    << "\n                  where -noise_resolution merges: every sample; only samples spaced\n"
+       "                  closer than their noise; or a whole cloud sampled finer than its noise\n"
+       "                  (its median noise sigma at least its area-weighted spacing), else none\n"
        "  -noise_stop C   = "
     << fmt (D::noise_stop)
     << "      do not split a hierarchy node of at most "

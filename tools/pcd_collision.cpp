@@ -264,6 +264,7 @@ modelParamsFor (const Options& o, bool input)
   m.orientation = input ? o.orientation_a : o.orientation_b;
   m.k = o.k;
   m.noise_resolution = o.noise_resolution;
+  m.noise_resolution_gate = o.noise_resolution_gate;
   m.surface_projection = !o.measured;
   m.surface = o.surface;
   m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
@@ -419,6 +420,7 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
   j.key ("defer_kernel_fits").boolean (rq.defer_kernel_fits);
   j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
   j.key ("noise_resolution").number (o.noise_resolution);
+  j.key ("noise_resolution_gate").string (pcl_probcollision::CloudModelParams::resolutionGateName (o.noise_resolution_gate));
   j.key ("noise_stop").number (o.noise_stop);
   j.key ("surface").boolean (rq.surface);
   j.key ("surface_pooled").boolean (rq.surface_pooled);

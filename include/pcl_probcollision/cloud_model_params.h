@@ -104,14 +104,31 @@ struct CloudModelParams
     * their noise's smallest standard deviation, the spacing sqrt(pi / k) times the distance to
     * the k-th nearest neighbour (k as above: the square root of the surface area per sample
     * that k neighbours cover); a sample spaced wider than its noise is never merged, so a cloud
-    * sampled coarser than its noise is modelled exactly as with noise_resolution = 0. Default
-    * Everywhere (see docs/PERFORMANCE.md, issue #17 item 1). */
+    * sampled coarser than its noise is modelled exactly as with noise_resolution = 0.
+    * WholeCloud: the whole cloud merges (as Everywhere) when it is sampled finer than its noise,
+    * its median noise deviation at least its typical spacing (the area-weighted median of the
+    * local spacings, detail::noiseExceedsTypicalSpacing, read from the covariance estimation's
+    * own neighbour search); otherwise nothing merges and the model is exactly the unmerged one.
+    * Default Everywhere (see docs/PERFORMANCE.md, issue #17 item 1). */
   enum class ResolutionGate
   {
     Everywhere,
-    WhereNoiseExceedsSpacing
+    WhereNoiseExceedsSpacing,
+    WholeCloud
   };
   ResolutionGate noise_resolution_gate = ResolutionGate::Everywhere;
+  /** \brief "everywhere", "spacing" or "cloud" (pcd_collision's -noise_resolution_gate). */
+  static const char*
+  resolutionGateName (ResolutionGate gate)
+  {
+    switch (gate)
+    {
+      case ResolutionGate::Everywhere: return "everywhere";
+      case ResolutionGate::WhereNoiseExceedsSpacing: return "spacing";
+      case ResolutionGate::WholeCloud: return "cloud";
+    }
+    return "unknown";
+  }
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;
   /** \brief Threads of the build (covariance estimation and hierarchy): 0 = one per hardware

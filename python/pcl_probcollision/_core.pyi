@@ -67,6 +67,7 @@ class CloudModelParams:
     closed_objects: bool
     noise_resolution: float
     noise_resolution_gated: bool
+    noise_resolution_whole_cloud: bool
     noise_stop: float
     threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,

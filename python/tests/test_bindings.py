@@ -63,6 +63,12 @@ def test_defaults_are_the_cpp_defaults():
     p.noise_resolution_gated = True
     assert p.noise_resolution_gated is True
     p.noise_resolution_gated = False
+    assert p.noise_resolution_whole_cloud is False
+    p.noise_resolution_whole_cloud = True
+    assert p.noise_resolution_whole_cloud is True and p.noise_resolution_gated is False
+    p.noise_resolution_gated = True  # one gate: the last set wins
+    assert p.noise_resolution_whole_cloud is False
+    p.noise_resolution_gated = False
     assert p.threads == 0
     assert [o.name for o in pc.NormalOrientation.__members__.values()] == ["Auto", "PointNormals", "Viewpoint", "Propagate"]
     assert p.noise.name == pc.SensorNoiseModel.none().name

@@ -108,6 +108,8 @@ def test_options_are_pcd_collision_flags():
         pcd.collide_poses("/nonexistent/a.pcd", patch(), np.zeros((1, 6)))
     with pytest.raises(ValueError, match="thresholds|free_below|collision_above"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), thresholds=(0.9, 0.1))
+    with pytest.raises(ValueError, match="noise_resolution_gate"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution=2, noise_resolution_gate="somewhere")
     # thresholds change verdicts, not probabilities
     P = near_table_poses(30)
     P[:, 2] = np.linspace(-0.01, 0.01, 30)

@@ -62,6 +62,11 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (o.noise_resolution, 0.0);    // no merging
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
+  EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::Everywhere);
+  EXPECT_EQ (parse ({"-noise_resolution_gate", "cloud"}).options.noise_resolution_gate,
+             pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);
+  EXPECT_EQ (parse ({"-noise_resolution_gate", "spacing"}).options.noise_resolution_gate,
+             pcl_probcollision::CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing);
   EXPECT_EQ (o.noise_stop, 0.0);  // every node split as the hierarchy's rules say
   EXPECT_FALSE (o.defer_kernel_fits);
   EXPECT_TRUE (parse ({"-defer_kernel_fits"}).options.defer_kernel_fits);
@@ -231,6 +236,7 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
   expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");
   expectUsageError ({"-noise_resolution", "inf"}, "-noise_resolution");
+  expectUsageError ({"-noise_resolution_gate", "somewhere"}, "-noise_resolution_gate");
   expectUsageError ({"-noise_stop", "-0.5"}, "-noise_stop");
   expectUsageError ({"-noise_stop", "nan"}, "-noise_stop");
 }

@@ -608,6 +608,22 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_EQ (merged[0]["parameters"]["noise_resolution"].number, 3.0);
   EXPECT_LT (merged[0]["points_b"].number, static_cast<double> (kScenePoints));
   EXPECT_GT (merged[0]["points_b"].number, 0.0);
+  EXPECT_EQ (merged[0]["parameters"]["noise_resolution_gate"].text, "everywhere");
+  // The whole-cloud gate: the table's area-weighted spacing is 5.3 mm, so at its declared 5 mm
+  // noise it keeps every point, and declared at 8 mm it merges as the ungated rule does.
+  const auto kept = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0",
+                              "-noise_resolution", "3", "-noise_resolution_gate", "cloud"});
+  ASSERT_EQ (kept.size (), 1u);
+  EXPECT_EQ (kept[0]["parameters"]["noise_resolution_gate"].text, "cloud");
+  EXPECT_EQ (kept[0]["points_b"].number, static_cast<double> (kScenePoints));
+  const auto noisy = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
+                               "-noise_resolution", "3", "-noise_resolution_gate", "cloud"});
+  const auto noisy_all = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
+                                   "-noise_resolution", "3"});
+  ASSERT_EQ (noisy.size (), 1u);
+  ASSERT_EQ (noisy_all.size (), 1u);
+  EXPECT_LT (noisy[0]["points_b"].number, static_cast<double> (kScenePoints) / 2.0);
+  EXPECT_EQ (noisy[0]["points_b"].number, noisy_all[0]["points_b"].number);
 
   // The demo's table is 5 mm noise on 3-4 mm spacing: at C = 20 most of it stays in whole nodes.
   const auto stopped = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-noise_stop", "20"});

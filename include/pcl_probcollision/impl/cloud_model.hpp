@@ -72,26 +72,28 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   }
 
   // Samples closer than their noise, merged (CloudModelParams::noise_resolution): the model of
-  // the merged cloud, mapped back to every sample of this one.
-  if (params.noise_resolution > 0.0 && !covariances)
-  {
+  // the merged cloud, mapped back to every sample of this one; null when no two samples merge.
+  // gate_k as detail::mergeByNoise takes it.
+  const auto mergedModel = [&] (int gate_k) -> std::shared_ptr<const CloudModel> {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    if (detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution,
-                              params.noise_resolution_gate == CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing
-                                  ? params.k
-                                  : 0,
-                              merged, cluster_of, seeds))
-    {
-      CloudModelParams once = params;
-      once.noise_resolution = 0.0;
-      const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
-      model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
-      model->neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();  // measured on the merged cloud
-      model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution, gate_k, merged, cluster_of, seeds))
+      return nullptr;
+    CloudModelParams once = params;
+    once.noise_resolution = 0.0;
+    const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
+    model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
+    model->neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();  // measured on the merged cloud
+    model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+    return model;
+  };
+  using Gate = CloudModelParams::ResolutionGate;
+  const bool merging = params.noise_resolution > 0.0 && !covariances;
+  // The whole-cloud gate reads the covariance estimation's neighbour radii (below) and decides
+  // there; the other gates merge first.
+  if (merging && params.noise_resolution_gate != Gate::WholeCloud)
+    if (auto model = mergedModel (params.noise_resolution_gate == Gate::WhereNoiseExceedsSpacing ? params.k : 0))
       return model;
-    }
-  }
 
   // Estimate what the caller did not give: covariances, neighbour radii (area weights) and the
   // surface displacements. The estimation reads the cloud through a non-owning pointer: it is
@@ -131,6 +133,21 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     }
     estimation.compute (estimated);
     radii = estimation.getNeighbourRadii ();
+    // Sampled finer than its noise (ResolutionGate::WholeCloud): the merged cloud's model instead,
+    // the estimation above spent once. A cloud sampled coarser goes on, modelled as unmerged.
+    if (merging && params.noise_resolution_gate == Gate::WholeCloud)
+    {
+      const SensorPose sensor = SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_);
+      const auto deviation = [&] (std::size_t j) {
+        const PointT& p = cloud[at (j)];
+        if (!pcl::isXYZFinite (p))
+          return std::numeric_limits<double>::quiet_NaN ();
+        return detail::smallestDeviation (params.noise, p.getVector3fMap ().template cast<double> (), sensor);
+      };
+      if (detail::noiseExceedsTypicalSpacing (radii, params.k, deviation))
+        if (auto model = mergedModel (0))
+          return model;
+    }
     displacements = estimation.getSurfaceDisplacements ();
     normals = estimation.getNormals ();
     neighbours = estimation.getNeighbours ();

@@ -19,6 +19,18 @@ namespace pcl_probcollision
 {
 namespace detail
 {
+/** \brief The smallest standard deviation of noise's covariance at position (the normal
+  * unknown): the merge radius's unit (0 where it is not finite). */
+inline double
+smallestDeviation (const SensorNoiseModel& noise, const Eigen::Vector3d& position, const SensorPose& sensor)
+{
+  const Eigen::Matrix3d sigma = noise.covariance (position, Eigen::Vector3d::Zero (), sensor);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect (sigma, Eigen::EigenvaluesOnly);
+  const double smallest = eig.eigenvalues ()(0);
+  return std::isfinite (smallest) ? std::sqrt (std::max (0.0, smallest)) : 0.0;
+}
+
 /** \brief Merges the samples of a cloud that lie closer than factor times their sensor noise
   * (CloudModelParams::noise_resolution; clusters by noiseClusters(), each seed's radius factor
   * times the smallest standard deviation of noise's covariance there, the normal unknown).
@@ -65,11 +77,7 @@ mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
   }
   for (std::size_t p = 0; p < positions.size (); ++p)
   {
-    const Eigen::Matrix3d sigma = noise.covariance (positions[p].cast<double> (), Eigen::Vector3d::Zero (), sensor);
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect (sigma, Eigen::EigenvaluesOnly);
-    const double smallest = eig.eigenvalues ()(0);
-    const double deviation = std::isfinite (smallest) ? std::sqrt (std::max (0.0, smallest)) : 0.0;
+    const double deviation = smallestDeviation (noise, positions[p].cast<double> (), sensor);
     if (gate_k > 0)
     {
       // The gate: the noise at least the local spacing (a sample spaced wider never merges).

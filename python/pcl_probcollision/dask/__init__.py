@@ -57,6 +57,10 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "max_leaf_fits": _REQUEST.max_leaf_fits,
     # Samples closer than this many noise sigmas merged into one (0: none).
     "noise_resolution": _MODEL.noise_resolution,
+    # Where it merges (pcd_collision's -noise_resolution_gate): everywhere, spacing (only samples
+    # spaced closer than their noise) or cloud (a whole cloud sampled finer than its noise).
+    "noise_resolution_gate": ("cloud" if _MODEL.noise_resolution_whole_cloud
+                              else "spacing" if _MODEL.noise_resolution_gated else "everywhere"),
     # A hierarchy node of at most 160 points within this many noise sigmas is not split (0: off).
     "noise_stop": _MODEL.noise_stop,
     # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
@@ -129,6 +133,9 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
             raise ValueError(f"option orientation{'_' + side if o['orientation_' + side] else ''}: expected one of "
                              f"{', '.join(_ORIENTATION_NAMES.values())}, got {name!r}")
         o["orientation_" + side] = name
+    if o["noise_resolution_gate"] not in ("everywhere", "spacing", "cloud"):
+        raise ValueError(f"option noise_resolution_gate: expected one of everywhere, spacing, cloud, got "
+                         f"{o['noise_resolution_gate']!r}")
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
@@ -169,6 +176,9 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
                               epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
     p.split = o["split"]
     p.noise_resolution = float(o["noise_resolution"])
+    p.noise_resolution_gated = o["noise_resolution_gate"] == "spacing"
+    if o["noise_resolution_gate"] == "cloud":
+        p.noise_resolution_whole_cloud = True
     p.noise_stop = float(o["noise_stop"])
     p.closed_objects = bool(o["closed_" + side])
     p.orientation = next(m for m, name in _ORIENTATION_NAMES.items() if name == o["orientation_" + side])

@@ -24,7 +24,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
   -measured -deterministic -stochastic -seed -exhaustive -defer_kernel_fits -max_leaf_fits
-  -noise_resolution -noise_stop -surface -surface_pooled -surface_ladder -surface_calibrated -distance -ignore_normals -closed -closed_a
+  -noise_resolution -noise_resolution_gate -noise_stop -surface -surface_pooled -surface_ladder -surface_calibrated -distance -ignore_normals -closed -closed_a
   -closed_b -orientation -orientation_a -orientation_b -nmax -sigma_max
   -epsilon -split -mesh_density -json (accepted; the output is always JSON lines) -v. A value is
   the next argument or follows '='. -surface (experimental) adds the signed distance between the
@@ -34,7 +34,7 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
           "split": str, "mesh_density": float, "max_leaf_fits": "u64", "noise_resolution": float,
-          "noise_stop": float, "orientation": str, "orientation_a": str, "orientation_b": str}
+          "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str, "orientation_b": str}
 _SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kernel_fits", "surface", "surface_pooled",
            "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b", "json",
            "v")
@@ -230,7 +230,7 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
                   f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
                   f'"exhaustive":{_bool(o["exhaustive"])},"defer_kernel_fits":{_bool(o["defer_kernel_fits"])},"max_leaf_fits":{int(o["max_leaf_fits"])},'
-                  f'"noise_resolution":{_num(o["noise_resolution"])},"noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
+                  f'"noise_resolution":{_num(o["noise_resolution"])},"noise_resolution_gate":"{o["noise_resolution_gate"]}","noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
     inputs = f'{{"a":{_input_json(a, r.surfaces["a"])},"b":{_input_json(b, r.surfaces["b"])}}}'
     sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
