@@ -604,10 +604,11 @@ TEST (NoiseResolution, DeterministicAndInvariantUnderRigidMotion)
 namespace
 {
 CloudModelParams
-gated (double sigma, double factor)
+gated (double sigma, double factor,
+       CloudModelParams::ResolutionGate gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing)
 {
   CloudModelParams params = merging (sigma, factor);
-  params.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
+  params.noise_resolution_gate = gate;
   return params;
 }
 } // namespace
@@ -719,16 +720,20 @@ TEST (NoiseResolutionGate, NoisySheetMergesMostlyOnceTheNoiseIsAboveTheSpacing)
 
 TEST (NoiseResolutionGate, DeterministicAndIndependentOfThreads)
 {
+  // Both gates: the spacing gate and the whole-cloud gate (ResolutionGate::WholeCloud).
   const Cloud::Ptr a = randomSquare (4000, 0.1, 0.003, 15);  // spacing 1.6 mm, noise 3 mm
-  CloudModelParams one = gated (0.003, 2.0);
-  one.threads = 1;
-  CloudModelParams two = one;
-  two.threads = 2;
-  const CloudModel::ConstPtr x = buildCloudModel (*a, one);
-  const CloudModel::ConstPtr y = buildCloudModel (*a, two);
-  ASSERT_GT (x->mergedSamples (), 0u);
-  EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
-  EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
+  for (const auto gate : {CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing, CloudModelParams::ResolutionGate::WholeCloud})
+  {
+    CloudModelParams one = gated (0.003, 2.0, gate);
+    one.threads = 1;
+    CloudModelParams two = one;
+    two.threads = 2;
+    const CloudModel::ConstPtr x = buildCloudModel (*a, one);
+    const CloudModel::ConstPtr y = buildCloudModel (*a, two);
+    ASSERT_GT (x->mergedSamples (), 0u);
+    EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
+    EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
+  }
 }
 
 // ---- The whole-cloud gate (CloudModelParams::ResolutionGate::WholeCloud) --------------------
@@ -738,9 +743,7 @@ namespace
 CloudModelParams
 wholeCloud (double sigma, double factor)
 {
-  CloudModelParams params = merging (sigma, factor);
-  params.noise_resolution_gate = CloudModelParams::ResolutionGate::WholeCloud;
-  return params;
+  return gated (sigma, factor, CloudModelParams::ResolutionGate::WholeCloud);
 }
 } // namespace
 
@@ -804,18 +807,4 @@ TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotTriggerIt)
   ASSERT_LT (spacing[spacing.size () / 2], 0.005f);
   EXPECT_EQ (buildCloudModel (*a, wholeCloud (0.005, 2.0))->mergedSamples (), 0u);
   EXPECT_GT (buildCloudModel (*a, merging (0.005, 2.0))->mergedSamples (), 200u);
-}
-
-TEST (NoiseResolutionWholeCloud, DeterministicAndIndependentOfThreads)
-{
-  const Cloud::Ptr a = randomSquare (4000, 0.1, 0.003, 24);  // spacing 1.6 mm, noise 3 mm
-  CloudModelParams one = wholeCloud (0.003, 2.0);
-  one.threads = 1;
-  CloudModelParams two = one;
-  two.threads = 2;
-  const CloudModel::ConstPtr x = buildCloudModel (*a, one);
-  const CloudModel::ConstPtr y = buildCloudModel (*a, two);
-  ASSERT_GT (x->mergedSamples (), 0u);
-  EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
-  EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
 }
