@@ -74,6 +74,7 @@ localSpacing (const std::vector<Eigen::Vector3f>& positions, int k)
   }
   return spacing;
 }
+
 double
 areaWeightedMedian (std::vector<float>& spacings)
 {

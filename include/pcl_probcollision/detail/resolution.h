@@ -59,6 +59,9 @@ localSpacing (const std::vector<Eigen::Vector3f>& positions, int k);
 double
 areaWeightedMedian (std::vector<float>& spacings);
 
+/** \brief Samples each statistic of noiseExceedsTypicalSpacing reads, at most. */
+constexpr std::size_t kWholeCloudGateSamples = 65536;
+
 /** \brief CloudModelParams::ResolutionGate::WholeCloud: whether a cloud is sampled finer than
   * its noise, its median noise deviation at least its area-weighted spacing (areaWeightedMedian
   * of sqrt(pi / k) times each sample's distance to its k-th neighbour). Both statistics read an
@@ -68,12 +71,6 @@ areaWeightedMedian (std::vector<float>& spacings);
   *            estimation's CovarianceEstimation::getNeighbourRadii; non-finite entries ignored)
   * \param[in] k neighbours those radii were found with (>= 1)
   * \param[in] deviation per sample index, its noise's smallest standard deviation */
-template <typename Deviation>
-bool
-noiseExceedsTypicalSpacing (const std::vector<float>& kth_radii, int k, const Deviation& deviation);
-
-/** \brief Samples each statistic of noiseExceedsTypicalSpacing reads, at most. */
-constexpr std::size_t kWholeCloudGateSamples = 65536;
 template <typename Deviation>
 bool
 noiseExceedsTypicalSpacing (const std::vector<float>& kth_radii, int k, const Deviation& deviation)
