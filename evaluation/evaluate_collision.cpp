@@ -110,8 +110,8 @@ struct Options
   /** \brief CollisionRequest::max_leaf_fits of the "cap<n>" settings (issue #17 item 2); empty
     * (default) leaves them out. */
   std::vector<double> cap;
-  /** \brief --only: the settings of ours run in the W1 cells and on W2 (empty: all); the
-    * stability passes and W3 are not filtered. */
+  /** \brief --only: the settings of ours run in the W1 cells, their stability passes and W2
+    * (empty: all); W3 is not filtered. */
   std::vector<std::string> only;
   /** \brief --drop: controls "drop<f>", the separators on clouds with f % of the samples left
     * out at random (how much the answers move for a model change unrelated to the noise). */
@@ -390,7 +390,8 @@ spreadNearSigma (const CellPoses& c, std::size_t count)
 
 /** \brief The settings of ours answered from one build in the stability runs: default,
   * classifier and surface differ only in the surface switches, so one model built with its
-  * surface serves the three (a request without the surface layer does not use it). */
+  * surface serves them (a request without the surface layer does not use it). Those --only
+  * keeps; none leaves the build out. */
 struct SharedBuild
 {
   pcl_probcollision::CloudModelParams model;
@@ -398,14 +399,14 @@ struct SharedBuild
 };
 
 SharedBuild
-sharedBuild (bool surface_calibrated)
+sharedBuild (const Options& o)
 {
   SharedBuild b;
   b.model = OursSetting ().model;
   b.model.surface = true;
   for (const OursSetting& s : oursSettings (false))
-    if (s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
-        s.name == "ladder")
+    if ((s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
+         s.name == "ladder") && o.keeps (s.name))
     {
       pcl_probcollision::CloudModelParams m = s.model;
       m.surface = true;
@@ -413,9 +414,25 @@ sharedBuild (bool surface_calibrated)
         throw std::logic_error ("sharedBuild: setting " + s.name + " needs its own model");
       b.settings.push_back (s);
     }
-  if (surface_calibrated)
+  if (o.surface_calibrated)
     calibratedSurface (b.settings);
   return b;
+}
+
+/** \brief The settings of ours the stability runs build on their own, as --only keeps them:
+  * the paper's model ("max") and the whole-cloud merges ("cloudmerge<c>", "surface-cloudmerge<c>"
+  * of --cloud-merge), whose models differ from the shared one. */
+std::vector<OursSetting>
+ownBuildSettings (const Options& o)
+{
+  std::vector<OursSetting> out;
+  for (const OursSetting& s : oursSettings (false, {}, {}, {}, {}, o.cloud_merge))
+    if ((s.name == "max" || s.name.rfind ("cloudmerge", 0) == 0 || s.name.rfind ("surface-cloudmerge", 0) == 0) &&
+        o.keeps (s.name))
+      out.push_back (s);
+  if (o.surface_calibrated)
+    calibratedSurface (out);
+  return out;
 }
 
 /** \brief --dump: the cell's noisy scans as the surface layer gets them (PointNormal, ScanSides'
@@ -635,23 +652,25 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const CloudXYZ::ConstPtr rob_r = addNoise (*den.rob_clean, sigma, seed);
       const CloudXYZ::ConstPtr env_r = addNoise (*den.env_clean, sigma, seed + 1);
       // default, classifier and surface on one build (the model with its surface built; a
-      // request without the surface layer ignores it); max on its own.
-      const SharedBuild shared = sharedBuild (o.surface_calibrated);
+      // request without the surface layer ignores it); max and the whole-cloud merges on their own.
+      const SharedBuild shared = sharedBuild (o);
       BuildRow unused;
-      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, den.sides ());
-      for (const OursSetting& s : shared.settings)
+      if (!shared.settings.empty ())
       {
-        const PoseQuery q = oursQuery (m, s.request, nullptr);
-        for (std::size_t k = 0; k < flip_poses.size (); ++k)
-          record ("ours", s.name, k, q (cell.poses[flip_poses[k]].T));
-      }
-      for (const OursSetting& s : oursSettings (false))
-        if (s.name == "max")
+        const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, den.sides ());
+        for (const OursSetting& s : shared.settings)
         {
-          const PoseQuery q = buildOurs (rob_r, env_r, sigma, s, unused, nullptr);
+          const PoseQuery q = oursQuery (m, s.request, nullptr);
           for (std::size_t k = 0; k < flip_poses.size (); ++k)
             record ("ours", s.name, k, q (cell.poses[flip_poses[k]].T));
         }
+      }
+      for (const OursSetting& s : ownBuildSettings (o))
+      {
+        const PoseQuery q = buildOurs (rob_r, env_r, sigma, s, unused, nullptr, den.sides ());
+        for (std::size_t k = 0; k < flip_poses.size (); ++k)
+          record ("ours", s.name, k, q (cell.poses[flip_poses[k]].T));
+      }
       if (o.ours_only)
         continue;
       for (const int factor : {1, 2, 4})
@@ -678,7 +697,7 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
   }
 
   // Stability by re-scan (issue 16): near-band poses; each re-scan samples both meshes anew
-  // (new sample positions, same counts) and draws new noise; ours default, classifier and surface
+  // (new sample positions, same counts) and draws new noise; ours: the shared build's settings
   // on one build, the 2-sigma collision map on the same re-scanned room.
   {
     const std::vector<std::size_t> scan_poses = spreadNearSigma (cell, o.rescan_poses ? o.rescan_poses : o.quick ? 20 : 100);
@@ -686,7 +705,8 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
     auto record = [&] (const std::string& method, const std::string& setting, std::size_t k, const Answer& a) {
       results.rescan[{den.workload, pct, method, setting}].record (k, scan_poses.size (), a);
     };
-    const SharedBuild shared = sharedBuild (o.surface_calibrated);
+    const SharedBuild shared = sharedBuild (o);
+    const std::vector<OursSetting> own = ownBuildSettings (o);
     for (int r = 0; r < rescans; ++r)
     {
       // Sampling seeds depend on the density and the re-scan, not the noise level (as the main
@@ -699,10 +719,20 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const CloudXYZ::ConstPtr env_r =
         addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1, &env_out), sigma, scan_noise + 1);
       BuildRow unused;
-      const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, ScanSides {&rob_out, &env_out});
-      for (const OursSetting& s : shared.settings)
+      const ScanSides sides {&rob_out, &env_out};
+      if (!shared.settings.empty ())
       {
-        const PoseQuery q = oursQuery (m, s.request, nullptr);
+        const OursModels m = buildOursModels (rob_r, env_r, sigma, shared.model, unused, sides);
+        for (const OursSetting& s : shared.settings)
+        {
+          const PoseQuery q = oursQuery (m, s.request, nullptr);
+          for (std::size_t k = 0; k < scan_poses.size (); ++k)
+            record ("ours", s.name, k, q (cell.poses[scan_poses[k]].T));
+        }
+      }
+      for (const OursSetting& s : own)
+      {
+        const PoseQuery q = buildOurs (rob_r, env_r, sigma, s, unused, nullptr, sides);
         for (std::size_t k = 0; k < scan_poses.size (); ++k)
           record ("ours", s.name, k, q (cell.poses[scan_poses[k]].T));
       }
@@ -760,7 +790,7 @@ evaluatePrimitives (const Options& o, Results& results)
         row.query_us = us;
         results.queries.push_back (row);
       };
-      std::vector<OursSetting> w2_settings = oursSettings (false);
+      std::vector<OursSetting> w2_settings = oursSettings (false, {}, {}, {}, {}, o.cloud_merge);
       // W2 only (W1's and W3's clouds carry their sides or viewpoints, so it would change
       // nothing there): the surface layer with the closed solids declared, as a user who knows
       // the shapes would (CloudModelParams::closed_objects; docs/SURFACE.md, "Closed objects").
@@ -1508,7 +1538,7 @@ main (int argc, char** argv)
     Results results;
     if (o.runs ("W3"))
     {
-      evaluateScenes (o.data_dir, results.queries, results.scenes_right, results.scenes_total);
+      evaluateScenes (o.data_dir, o.cloud_merge, results.queries, results.scenes_right, results.scenes_total);
       progress ("W3 scenes: " + std::to_string (results.scenes_right) + " / " + std::to_string (results.scenes_total) +
                 " answered as SCENES.md lists (default setting)");
     }

@@ -18,7 +18,8 @@ namespace pcl_probcollision_eval
 using namespace pcl_probcollision;
 
 void
-evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& right, int& total)
+evaluateScenes (const std::string& data_dir, const std::vector<double>& cloud_merge, std::vector<QueryRow>& rows,
+                int& right, int& total)
 {
   const std::string dir = data_dir + "/scenes/";
   std::ifstream csv (dir + "queries.csv");
@@ -40,7 +41,7 @@ evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& r
       throw std::runtime_error ("cannot read " + dir + f[2] + " or " + f[3]);
     const SensorNoiseModel noise = f[1] == "stereo_mug" ? SensorNoiseModel::stereo () : SensorNoiseModel::kinect ();
     const Eigen::Isometry3d pose (Eigen::Translation3d (std::stod (f[4]), std::stod (f[5]), std::stod (f[6])));
-    for (const OursSetting& s : oursSettings (false))
+    for (const OursSetting& s : oursSettings (false, {}, {}, {}, {}, cloud_merge))
     {
       ProbabilisticCollision<pcl::PointXYZ> pc;
       CloudModelParams params = s.model;

@@ -152,10 +152,11 @@ PoseQuery buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& 
                      std::function<void (std::size_t leaf_pairs, std::size_t kernel, double features)> on_query,
                      const ScanSides& sides = ScanSides (), const Solids& solids = Solids ());
 
-/** \brief W3: every SCENES.md query (data_dir/scenes/queries.csv) with our default and max
-  * settings; right counts the default's answers that match the listed verdict (resting:
-  * not free; lifted: free) out of total. */
-void evaluateScenes (const std::string& data_dir, std::vector<QueryRow>& rows, int& right, int& total);
+/** \brief W3: every SCENES.md query (data_dir/scenes/queries.csv) with every setting of
+  * oursSettings (false, {}, {}, {}, {}, cloud_merge); right counts the default's answers that match
+  * the listed verdict (resting: not free; lifted: free) out of total. */
+void evaluateScenes (const std::string& data_dir, const std::vector<double>& cloud_merge, std::vector<QueryRow>& rows,
+                     int& right, int& total);
 
 /** \brief The mesh sampled uniformly by area plus every vertex, aiming at `target` points in all
   * (pcl_probcollision::io::sampleMesh; deterministic for a seed). With outward, also each
