@@ -726,7 +726,24 @@ PYBIND11_MODULE (_core, m)
                       "says where the inside is (CloudModel.surface_inside_known). Default False: a propagated surface\n"
                       "is two-sided.")
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
-                      "Merge samples closer than this many sensor-noise sigmas into one (issue #17; default 0: off).")
+                      "Merge samples closer than this many sensor-noise sigmas into one (issue #17), where\n"
+                      "noise_resolution_gate lets them; 0: never. Default: CloudModelParams' (2).")
+      .def_property (
+        "noise_resolution_gate",
+        [] (const CloudModelParams& p) { return std::string (CloudModelParams::resolutionGateName (p.noise_resolution_gate)); },
+        [] (CloudModelParams& p, const std::string& v) {
+          for (const auto g : {CloudModelParams::ResolutionGate::Everywhere, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing,
+                               CloudModelParams::ResolutionGate::WholeCloud})
+            if (v == CloudModelParams::resolutionGateName (g))
+            {
+              p.noise_resolution_gate = g;
+              return;
+            }
+          throw py::value_error ("noise_resolution_gate: expected one of everywhere, spacing, cloud, got '" + v + "'");
+        },
+        "Where noise_resolution merges (pcd_collision's -noise_resolution_gate): 'everywhere' (every sample),\n"
+        "'spacing' (only samples spaced within their noise sigma) or 'cloud' (the whole cloud where it is\n"
+        "sampled finer than its noise, else nothing). Default: CloudModelParams' ('cloud').")
       .def_property ("noise_resolution_gated",
                      [] (const CloudModelParams& p) {
                        return p.noise_resolution_gate == CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
@@ -735,8 +752,7 @@ PYBIND11_MODULE (_core, m)
                        p.noise_resolution_gate = v ? CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing
                                                    : CloudModelParams::ResolutionGate::Everywhere;
                      },
-                     "Merge (noise_resolution) only samples whose local spacing is at most their noise sigma\n"
-                     "(ResolutionGate.WhereNoiseExceedsSpacing; default False: Everywhere).")
+                     "noise_resolution_gate == 'spacing'; setting False sets 'everywhere'.")
       .def_property ("noise_resolution_whole_cloud",
                      [] (const CloudModelParams& p) {
                        return p.noise_resolution_gate == CloudModelParams::ResolutionGate::WholeCloud;
@@ -745,9 +761,7 @@ PYBIND11_MODULE (_core, m)
                        p.noise_resolution_gate = v ? CloudModelParams::ResolutionGate::WholeCloud
                                                    : CloudModelParams::ResolutionGate::Everywhere;
                      },
-                     "Merge (noise_resolution) the whole cloud where it is sampled finer than its noise (its median\n"
-                     "noise sigma at least its area-weighted spacing), else nothing (ResolutionGate.WholeCloud;\n"
-                     "default False: Everywhere). It and noise_resolution_gated set one gate: the last set wins.")
+                     "noise_resolution_gate == 'cloud'; setting False sets 'everywhere'.")
       .def_readwrite ("threads", &CloudModelParams::threads,
                       "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
                       "hardware thread. The model is the same for any count.")

@@ -416,21 +416,24 @@ randomSquare (int n, double size, double sigma, unsigned seed)
   return c;
 }
 
+/** The merge itself, ungated (ResolutionGate::Everywhere; the default gate is tested below). */
 CloudModelParams
 merging (double sigma, double factor)
 {
   CloudModelParams params;
   params.noise = SensorNoiseModel::isotropic (sigma);
   params.noise_resolution = factor;
+  params.noise_resolution_gate = CloudModelParams::ResolutionGate::Everywhere;
   return params;
 }
 } // namespace
 
-TEST (NoiseResolution, OffByDefaultAndValidatedByName)
+TEST (NoiseResolution, WholeCloudByDefaultAndValidatedByName)
 {
-  EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
-  // The spacing gate stays an option (docs/PERFORMANCE.md, issue #17 item 1).
-  EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::Everywhere);
+  // A whole cloud sampled finer than its noise merges at 2 sigmas by default; the other gates
+  // stay options (docs/PERFORMANCE.md, issue #17 item 1).
+  EXPECT_EQ (CloudModelParams ().noise_resolution, 2.0);
+  EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::WholeCloud);
   for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
   {
     CloudModelParams params;
@@ -775,6 +778,12 @@ TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
   EXPECT_LT (high->size (), a->size () / 4);
   EXPECT_EQ (high->pointOfSource (), all->pointOfSource ());
   EXPECT_EQ (high->hierarchy ().means (), all->hierarchy ().means ());
+  // It is the default: a cloud given only its noise models as wholeCloud (sigma, 2) does.
+  CloudModelParams defaults;
+  defaults.noise = SensorNoiseModel::isotropic (0.01);
+  EXPECT_EQ (buildCloudModel (*a, defaults)->hierarchy ().means (), high->hierarchy ().means ());
+  defaults.noise = SensorNoiseModel::isotropic (0.002);
+  EXPECT_EQ (buildCloudModel (*a, defaults)->mergedSamples (), 0u);
   const CloudModel::ConstPtr low = buildCloudModel (*a, wholeCloud (0.002, 2.0));
   const CloudModel::ConstPtr plain = buildCloudModel (*a, merging (0.002, 0.0));
   ASSERT_GT (buildCloudModel (*a, merging (0.002, 3.0))->mergedSamples (), 0u);  // the radius would merge

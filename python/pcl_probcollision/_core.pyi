@@ -66,6 +66,7 @@ class CloudModelParams:
     orientation: NormalOrientation
     closed_objects: bool
     noise_resolution: float
+    noise_resolution_gate: str
     noise_resolution_gated: bool
     noise_resolution_whole_cloud: bool
     noise_stop: float

@@ -98,6 +98,7 @@ TEST (MedianSpacing, AModelThatCannotTellSaysSo)
   pcl_probcollision::CloudModelParams merged = noisyParams ();
   merged.noise = pcl_probcollision::SensorNoiseModel::isotropic (0.05);  // far above the spacing: samples merge
   merged.noise_resolution = 2.0;
+  merged.noise_resolution_gate = pcl_probcollision::CloudModelParams::ResolutionGate::Everywhere;
   const auto model = pcl_probcollision::buildCloudModel (plain, merged);
   ASSERT_GT (model->mergedSamples (), 0u);
   EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));

@@ -603,23 +603,25 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
     marked += l.find ("budget exhausted") != std::string::npos && l.find ("P >=") != std::string::npos;
   EXPECT_EQ (marked, exhausted);
 
-  const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3"});
+  const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3",
+                                "-noise_resolution_gate", "everywhere"});
   ASSERT_EQ (merged.size (), 1u);
   EXPECT_EQ (merged[0]["parameters"]["noise_resolution"].number, 3.0);
   EXPECT_LT (merged[0]["points_b"].number, static_cast<double> (kScenePoints));
   EXPECT_GT (merged[0]["points_b"].number, 0.0);
   EXPECT_EQ (merged[0]["parameters"]["noise_resolution_gate"].text, "everywhere");
-  // The whole-cloud gate: the table's area-weighted spacing is 5.3 mm, so at its declared 5 mm
-  // noise it keeps every point, and declared at 8 mm it merges as the ungated rule does.
-  const auto kept = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0",
-                              "-noise_resolution", "3", "-noise_resolution_gate", "cloud"});
+  // The whole-cloud gate, the default: the table's area-weighted spacing is 5.3 mm, so at its
+  // declared 5 mm noise it keeps every point, and declared at 8 mm it merges as the ungated rule
+  // does.
+  const auto kept = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0"});
   ASSERT_EQ (kept.size (), 1u);
   EXPECT_EQ (kept[0]["parameters"]["noise_resolution_gate"].text, "cloud");
+  EXPECT_EQ (kept[0]["parameters"]["noise_resolution"].number, 2.0);
   EXPECT_EQ (kept[0]["points_b"].number, static_cast<double> (kScenePoints));
   const auto noisy = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
                                "-noise_resolution", "3", "-noise_resolution_gate", "cloud"});
   const auto noisy_all = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
-                                   "-noise_resolution", "3"});
+                                   "-noise_resolution", "3", "-noise_resolution_gate", "everywhere"});
   ASSERT_EQ (noisy.size (), 1u);
   ASSERT_EQ (noisy_all.size (), 1u);
   EXPECT_LT (noisy[0]["points_b"].number, static_cast<double> (kScenePoints) / 2.0);

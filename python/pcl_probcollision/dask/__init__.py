@@ -55,12 +55,11 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "defer_kernel_fits": _REQUEST.defer_kernel_fits,
     # At most this many leaf pairs fitted a query, nearest first (0: no cap).
     "max_leaf_fits": _REQUEST.max_leaf_fits,
-    # Samples closer than this many noise sigmas merged into one (0: none).
+    # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none).
     "noise_resolution": _MODEL.noise_resolution,
     # Where it merges (pcd_collision's -noise_resolution_gate): everywhere, spacing (only samples
     # spaced closer than their noise) or cloud (a whole cloud sampled finer than its noise).
-    "noise_resolution_gate": ("cloud" if _MODEL.noise_resolution_whole_cloud
-                              else "spacing" if _MODEL.noise_resolution_gated else "everywhere"),
+    "noise_resolution_gate": _MODEL.noise_resolution_gate,
     # A hierarchy node of at most 160 points within this many noise sigmas is not split (0: off).
     "noise_stop": _MODEL.noise_stop,
     # The surface layer (experimental, issue #16): both models get a surface (meshes oriented by
@@ -176,9 +175,7 @@ def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelPa
                               epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
     p.split = o["split"]
     p.noise_resolution = float(o["noise_resolution"])
-    p.noise_resolution_gated = o["noise_resolution_gate"] == "spacing"
-    if o["noise_resolution_gate"] == "cloud":
-        p.noise_resolution_whole_cloud = True
+    p.noise_resolution_gate = o["noise_resolution_gate"]
     p.noise_stop = float(o["noise_stop"])
     p.closed_objects = bool(o["closed_" + side])
     p.orientation = next(m for m, name in _ORIENTATION_NAMES.items() if name == o["orientation_" + side])
