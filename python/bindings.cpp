@@ -988,6 +988,9 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("size", &CloudModel::size, "Points in the model (finite rows).")
       .def_property_readonly ("source_size", &CloudModel::sourceSize, "Rows of the input (per-point results align with it).")
       .def_property_readonly ("skipped_points", &CloudModel::skippedPoints, "Rows left out as non-finite (NaN / Inf).")
+      .def_property_readonly ("merged_samples", &CloudModel::mergedSamples,
+                              "Finite rows merged into another by noise_resolution (size is the finite rows minus these);\n"
+                              "0 when none merged.")
       .def_property_readonly ("origin", [] (const CloudModel& c) { return vec3 (c.origin ()); },
                               "Local frame origin (the centroid), in the cloud's frame.")
       .def_property_readonly ("warning", &CloudModel::warning, "A precision warning about the input, '' when none.")

@@ -578,8 +578,8 @@ helpText ()
     << "      neighbours of the covariance estimation\n"
        "  -noise_resolution C   = "
     << fmt (D::noise_resolution)
-    << "   merge samples closer than C noise sigmas into one (0: none; 2 is\n"
-       "                  the evaluated choice at high noise: faster, less accurate at low noise)\n"
+    << "   merge samples closer than C noise sigmas into one, where the gate lets\n"
+       "                  them (0: never)\n"
        "  -noise_resolution_gate everywhere|spacing|cloud   = "
     << pcl_probcollision::CloudModelParams::resolutionGateName (D::noise_resolution_gate)
     << "\n                  where -noise_resolution merges: every sample; only samples spaced\n"

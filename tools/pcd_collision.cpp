@@ -320,6 +320,13 @@ inputJson (JsonWriter& j, const Input& in, const pcl_probcollision::CloudModel* 
     j.key ("spacing").number (in.spacing);
     j.key ("spacing_source").string (in.spacing_source);
   }
+  // Samples the default resolution merged into others (CloudModel::mergedSamples; the model has
+  // points - merged_samples points); null when the input has no model.
+  j.key ("merged_samples");
+  if (model)
+    j.unsignedInteger (model->mergedSamples ());
+  else
+    j.null ();
   j.key ("surface");
   surfaceJson (j, model);
   j.endObject ();
@@ -884,9 +891,17 @@ run (int argc, char** argv)
   for (const auto& [in, model] : {std::pair (&a, pc.getInputModel ()), std::pair (&b, pc.getTargetModel ())})
     if (model)
       // The model's memory (CloudModel::bytes), for whoever sizes a large map.
-      std::fprintf (log, "Building %s [done, %.1f ms : %zu points, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
-                    model->buildMilliseconds (), model->size (), model->hierarchy ().nodes ().size (),
+    {
+      // A cloud sampled finer than its noise is modelled by its merged samples (the default
+      // resolution): say so, with how to keep every sample.
+      char merged[160] = "";
+      if (model->mergedSamples () > 0)
+        std::snprintf (merged, sizeof merged, " (%zu samples merged within %g noise sigmas; -noise_resolution 0 keeps them)",
+                       model->size () + model->mergedSamples (), model->params ().noise_resolution);
+      std::fprintf (log, "Building %s [done, %.1f ms : %zu points%s, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
+                    model->buildMilliseconds (), model->size (), merged, model->hierarchy ().nodes ().size (),
                     model->params ().surface ? ", surface model" : "", static_cast<double> (model->bytes ()) / 1e6);
+    }
   pc.setRequest (requestFor (o));
 
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));

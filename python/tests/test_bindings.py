@@ -47,8 +47,8 @@ def gripper_patch():
 def test_default_resolution_merges_the_patch(gripper_patch, table):
     # Sampled finer than its noise, the patch merges; the table (5 mm noise on about 5.3 mm
     # spacing) is kept whole; with noise_resolution = 0 nothing merges.
-    assert 0 < gripper_patch.size < 40
-    assert table.size == 10848
+    assert 0 < gripper_patch.size < 40 and gripper_patch.merged_samples == 400 - gripper_patch.size
+    assert table.size == 10848 and table.merged_samples == 0
     unmerged = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005))
     unmerged.noise_resolution = 0.0
     assert pc.build_model(patch(), params=unmerged).size == 400

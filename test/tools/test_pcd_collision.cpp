@@ -618,6 +618,7 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_EQ (kept[0]["parameters"]["noise_resolution_gate"].text, "cloud");
   EXPECT_EQ (kept[0]["parameters"]["noise_resolution"].number, 2.0);
   EXPECT_EQ (kept[0]["points_b"].number, static_cast<double> (kScenePoints));
+  EXPECT_EQ (kept[0]["inputs"]["b"]["merged_samples"].number, 0.0);
   const auto noisy = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
                                "-noise_resolution", "3", "-noise_resolution_gate", "cloud"});
   const auto noisy_all = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
@@ -626,6 +627,17 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   ASSERT_EQ (noisy_all.size (), 1u);
   EXPECT_LT (noisy[0]["points_b"].number, static_cast<double> (kScenePoints) / 2.0);
   EXPECT_EQ (noisy[0]["points_b"].number, noisy_all[0]["points_b"].number);
+  // The merge is reported: in the JSON (the model's points plus the merged samples are the finite
+  // ones) and on the stage line, with how to keep every sample.
+  EXPECT_EQ (noisy[0]["inputs"]["b"]["merged_samples"].number + noisy[0]["points_b"].number,
+             noisy[0]["inputs"]["b"]["finite"].number);
+  EXPECT_EQ (noisy[0]["inputs"]["a"]["merged_samples"].number, 0.0);  // the gripper mesh: exact samples
+  const ToolRun told = run ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008"});
+  ASSERT_EQ (told.status, 0) << told.err;
+  EXPECT_NE (told.err.find ("(" + std::to_string (kScenePoints) + " samples merged within 2 noise sigmas; -noise_resolution 0 keeps them)"),
+             std::string::npos)
+      << told.err;
+  EXPECT_EQ (told.err.find ("samples merged"), told.err.rfind ("samples merged")) << "only the table merges: " << told.err;
 
   // The demo's table is 5 mm noise on 3-4 mm spacing: at C = 20 most of it stays in whole nodes.
   const auto stopped = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-noise_stop", "20"});

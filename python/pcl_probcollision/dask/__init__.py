@@ -408,6 +408,7 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     out["witness_normal"] = rotated("witness_normal")
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
     out["surfaces"] = {"a": surface_summary(A), "b": surface_summary(B)}
+    out["merged_samples"] = {"a": A.merged_samples, "b": B.merged_samples}
     out["pid"] = np.array([os.getpid()])
     return out
 
@@ -425,12 +426,14 @@ class BatchResults:
     kernel_leaf_pairs, degenerate_leaf_pairs, classifier_iterations),
     witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; surfaces
     how each model's surface was oriented ({"a": ..., "b": ...}, surface_summary(); None without
-    surface); chunk_size and chunks how it was split."""
+    surface); merged_samples the samples of each model merged by noise_resolution ({"a": n, "b": n},
+    CloudModel.merged_samples); chunk_size and chunks how it was split."""
 
     def __init__(self, fields: Dict[str, np.ndarray], inputs, chunk_size: int, chunks: int, build_ms: float,
-                 surfaces: Dict[str, Optional[Dict[str, Any]]]):
+                 surfaces: Dict[str, Optional[Dict[str, Any]]], merged_samples: Dict[str, int]):
         self.fields = fields
         self.surfaces = surfaces
+        self.merged_samples = merged_samples
         for k, v in fields.items():
             setattr(self, k, v)
         self.inputs = inputs
@@ -579,10 +582,12 @@ def _scatter(client, spec):
 def _assemble(parts, m: int, inputs, chunk_size: int) -> BatchResults:
     if not parts:
         raise ValueError("poses: no pose given")
-    fields = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k not in ("build_ms", "pid", "surfaces")}
+    fields = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]
+              if k not in ("build_ms", "pid", "surfaces", "merged_samples")}
     index = fields.pop("index")
     # Every pose answered exactly once, in pose order.
     if len(index) != m or not np.array_equal(index, np.arange(m)):
         raise RuntimeError(f"internal error: {len(index)} answers for {m} poses")
     build_ms = float(parts[0]["build_ms"][0])
-    return BatchResults(fields, inputs, chunk_size, len(parts), build_ms, parts[0]["surfaces"])
+    return BatchResults(fields, inputs, chunk_size, len(parts), build_ms, parts[0]["surfaces"],
+                        parts[0]["merged_samples"])

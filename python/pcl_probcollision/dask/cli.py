@@ -201,14 +201,15 @@ def _surface_json(s):
             f'"solid_share":{_num(s["solid_share"])}}}')
 
 
-def _input_json(spec, surface):
+def _input_json(spec, surface, merged):
     if spec["kind"] == "cloud":
         return (f'{{"path":{_str(spec["path"])},"kind":"cloud","points":{len(spec["points"])},'
                 f'"finite":{spec["finite"]},"width":{spec["width"]},"height":{spec["height"]},'
-                f'"surface":{_surface_json(surface)}}}')
+                f'"merged_samples":{int(merged)},"surface":{_surface_json(surface)}}}')
     return (f'{{"path":{_str(spec["path"])},"kind":"mesh","vertices":{len(spec["vertices"])},'
             f'"triangles":{len(spec["triangles"])},"points":{len(spec["points"])},"spacing":{_num(spec["spacing"])},'
-            f'"spacing_source":{_str(spec["spacing_source"])},"surface":{_surface_json(surface)}}}')
+            f'"spacing_source":{_str(spec["spacing_source"])},"merged_samples":{int(merged)},'
+            f'"surface":{_surface_json(surface)}}}')
 
 
 _VERDICTS = {0: "unknown", 1: "free", 2: "contact", 3: "collision"}
@@ -232,7 +233,8 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"exhaustive":{_bool(o["exhaustive"])},"defer_kernel_fits":{_bool(o["defer_kernel_fits"])},"max_leaf_fits":{int(o["max_leaf_fits"])},'
                   f'"noise_resolution":{_num(o["noise_resolution"])},"noise_resolution_gate":"{o["noise_resolution_gate"]}","noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
-    inputs = f'{{"a":{_input_json(a, r.surfaces["a"])},"b":{_input_json(b, r.surfaces["b"])}}}'
+    inputs = (f'{{"a":{_input_json(a, r.surfaces["a"], r.merged_samples["a"])},'
+              f'"b":{_input_json(b, r.surfaces["b"], r.merged_samples["b"])}}}')
     sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
     # The surface layer's signed distance: null without -surface or out of reach, as pcd_collision;
     # unobserved always a boolean (false without -surface); sample_distance always a boolean and
