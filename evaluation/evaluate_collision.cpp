@@ -100,10 +100,9 @@ struct Options
     * (default) leaves them out. */
   std::vector<double> gate;
   /** \brief The same merge of a whole cloud where it is sampled finer than its noise
-    * ("cloudmerge<c>", "surface-cloudmerge<c>"; ResolutionGate::WholeCloud); empty (default)
-    * leaves them out. The library's default is this rule at c = 2 (so cloudmerge2 answers as
-    * classifier); at noise below the clouds' spacing every c answers as unmerged. */
-  std::vector<double> cloud_merge;
+    * ("cloudmerge<c>", "surface-cloudmerge<c>"; ResolutionGate::WholeCloud); empty leaves them
+    * out. At noise below the clouds' spacing they answer exactly as classifier and surface. */
+  std::vector<double> cloud_merge {2.0};
   /** \brief BVHParams::noise_stop of the "stop<c>" and "surface-stop<c>" settings (issue #17
     * item 1), one pair per value; empty (default) leaves them out (docs/PERFORMANCE.md: no c
     * met the targets; each pair adds a surface-layer run to every cell). */
@@ -422,16 +421,14 @@ sharedBuild (const Options& o)
 }
 
 /** \brief The settings of ours the stability runs build on their own, as --only keeps them:
-  * the paper's model ("max"), every sample modelled ("unmerged", "surface-unmerged") and the
-  * whole-cloud merges ("cloudmerge<c>", "surface-cloudmerge<c>" of --cloud-merge), whose models
-  * differ from the shared one. */
+  * the paper's model ("max") and the whole-cloud merges ("cloudmerge<c>", "surface-cloudmerge<c>"
+  * of --cloud-merge), whose models differ from the shared one. */
 std::vector<OursSetting>
 ownBuildSettings (const Options& o)
 {
   std::vector<OursSetting> out;
   for (const OursSetting& s : oursSettings (false, {}, {}, {}, {}, o.cloud_merge))
-    if ((s.name == "max" || s.name == "unmerged" || s.name == "surface-unmerged" || s.name.rfind ("cloudmerge", 0) == 0 ||
-         s.name.rfind ("surface-cloudmerge", 0) == 0) &&
+    if ((s.name == "max" || s.name.rfind ("cloudmerge", 0) == 0 || s.name.rfind ("surface-cloudmerge", 0) == 0) &&
         o.keeps (s.name))
       out.push_back (s);
   if (o.surface_calibrated)

@@ -65,14 +65,6 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   other.name = projection ? "max" : "projected";
   other.model.surface_projection = !projection;
   other.model.noise_resolution = 0.0;
-  // Every sample modelled, as before issue #17's resolution became the default ("unmerged",
-  // "surface-unmerged"): what the resolution rung changes, on the chart.
-  OursSetting unmerged = classifier;
-  unmerged.name = "unmerged";
-  unmerged.model.noise_resolution = 0.0;
-  OursSetting surface_unmerged = surface;
-  surface_unmerged.name = "surface-unmerged";
-  surface_unmerged.model.noise_resolution = 0.0;
   s.push_back (defaults);
   s.push_back (classifier);
   s.push_back (surface);
@@ -80,8 +72,6 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (ladder);
   s.push_back (surface_k20);
   s.push_back (other);
-  s.push_back (unmerged);
-  s.push_back (surface_unmerged);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the
   // noise is at least the local sample spacing ("gate<c>"), or the whole cloud where it is
   // sampled finer than its noise ("cloudmerge<c>"), or the hierarchy not split within

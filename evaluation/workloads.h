@@ -67,10 +67,9 @@ struct OursSetting
   * "pooled" is the surface layer pooled with the separators (CollisionRequest::surface_pooled),
   * "ladder" the separators first and the surface layer where they leave the answer open
   * (CollisionRequest::surface_ladder), "surface-k20" the surface layer on models of 20
-  * neighbours (CloudModelParams::k), "unmerged" and "surface-unmerged" classifier and surface
-  * with every sample modelled (CloudModelParams::noise_resolution = 0; max is unmerged too).
-  * full = false keeps default, classifier, surface, pooled, ladder, surface-k20, max, unmerged
-  * and surface-unmerged. Each c of merge adds "merge<c>"
+  * neighbours (CloudModelParams::k). max is unmerged whatever the default resolution. full =
+  * false keeps default, classifier, surface, pooled, ladder, surface-k20 and max. Each c of
+  * merge adds "merge<c>"
   * and "surface-merge<c>": classifier and surface with CloudModelParams::noise_resolution = c;
   * each c of gate "gate<c>" and "surface-gate<c>", the same merge gated by the local spacing
   * (ResolutionGate::WhereNoiseExceedsSpacing); each c of cloud_merge "cloudmerge<c>" and

@@ -428,11 +428,11 @@ merging (double sigma, double factor)
 }
 } // namespace
 
-TEST (NoiseResolution, WholeCloudByDefaultAndValidatedByName)
+TEST (NoiseResolution, OffByDefaultAndValidatedByName)
 {
-  // A whole cloud sampled finer than its noise merges at 2 sigmas by default; the other gates
-  // stay options (docs/PERFORMANCE.md, issue #17 item 1).
-  EXPECT_EQ (CloudModelParams ().noise_resolution, 2.0);
+  // Off by default (deep collisions lose confidence when merged, docs/PERFORMANCE.md); when it
+  // is set, the whole-cloud gate decides by default, the other gates are options.
+  EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
   EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::WholeCloud);
   for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
   {
@@ -778,9 +778,12 @@ TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
   EXPECT_LT (high->size (), a->size () / 4);
   EXPECT_EQ (high->pointOfSource (), all->pointOfSource ());
   EXPECT_EQ (high->hierarchy ().means (), all->hierarchy ().means ());
-  // It is the default: a cloud given only its noise models as wholeCloud (sigma, 2) does.
+  // It is the default gate: a cloud given only its noise and noise_resolution models as
+  // wholeCloud (sigma, 2) does, and without noise_resolution nothing merges.
   CloudModelParams defaults;
   defaults.noise = SensorNoiseModel::isotropic (0.01);
+  EXPECT_EQ (buildCloudModel (*a, defaults)->mergedSamples (), 0u);
+  defaults.noise_resolution = 2.0;
   EXPECT_EQ (buildCloudModel (*a, defaults)->hierarchy ().means (), high->hierarchy ().means ());
   defaults.noise = SensorNoiseModel::isotropic (0.002);
   EXPECT_EQ (buildCloudModel (*a, defaults)->mergedSamples (), 0u);

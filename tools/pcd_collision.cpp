@@ -892,11 +892,10 @@ run (int argc, char** argv)
     if (model)
       // The model's memory (CloudModel::bytes), for whoever sizes a large map.
     {
-      // A cloud sampled finer than its noise is modelled by its merged samples (the default
-      // resolution): say so, with how to keep every sample.
-      char merged[160] = "";
+      // A cloud modelled by its merged samples (-noise_resolution) says how many there were.
+      char merged[96] = "";
       if (model->mergedSamples () > 0)
-        std::snprintf (merged, sizeof merged, " (%zu samples merged within %g noise sigmas; -noise_resolution 0 keeps them)",
+        std::snprintf (merged, sizeof merged, " (%zu samples merged within %g noise sigmas)",
                        model->size () + model->mergedSamples (), model->params ().noise_resolution);
       std::fprintf (log, "Building %s [done, %.1f ms : %zu points%s, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
                     model->buildMilliseconds (), model->size (), merged, model->hierarchy ().nodes ().size (),

@@ -96,11 +96,13 @@ struct CloudModelParams
     * times the sensor noise's smallest standard deviation (at the sample seeding a merge, see
     * detail::noiseClusters) are merged into one sample at their centroid, whose covariance is
     * then estimated at the merged spacing; every merged sample reports its merged point's
-    * per-point values. In noise standard deviations, >= 0; 0 merges nothing. Default 2, with
-    * noise_resolution_gate WholeCloud: only a cloud sampled finer than its noise merges
-    * (docs/PERFORMANCE.md, "Merging a whole cloud sampled finer than its noise"). No effect
-    * without a noise model (noise None) or with covariances given by the caller. */
-  double noise_resolution = 2.0;
+    * per-point values. In noise standard deviations, >= 0; 0 (default) merges nothing; 2 is
+    * the evaluated choice, which with the default noise_resolution_gate merges only a cloud
+    * sampled finer than its noise. Off by default: it lowers the probability of some deep
+    * collisions to contact (docs/PERFORMANCE.md, "Merging a whole cloud sampled finer than its
+    * noise"). No effect without a noise model (noise None) or with covariances given by the
+    * caller. */
+  double noise_resolution = 0.0;
   /** \brief Where noise_resolution merges (issue #17 item 1). Everywhere: every sample within
     * the radius of a seed. WhereNoiseExceedsSpacing: only samples whose local spacing is at most
     * their noise's smallest standard deviation, the spacing sqrt(pi / k) times the distance to
@@ -113,7 +115,8 @@ struct CloudModelParams
     * own neighbour search); otherwise nothing merges and the model is exactly the unmerged one.
     * Default WholeCloud: on the evaluation it changes no answer at noise below the clouds'
     * spacing and, above it, cuts the near-contact Brier score by a third and the query time
-    * many times (docs/PERFORMANCE.md, issue #17 item 1). */
+    * many times, where Everywhere loses easy answers at 0.25-1 % noise (docs/PERFORMANCE.md,
+    * issue #17 item 1). */
   enum class ResolutionGate
   {
     Everywhere,

@@ -59,8 +59,7 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.exhaustive);
   EXPECT_FALSE (o.surface);
   EXPECT_EQ (o.max_leaf_fits, 0u);        // no cap
-  EXPECT_EQ (o.noise_resolution, 2.0);    // merging a cloud sampled finer than its noise
-  EXPECT_EQ (parse ({"-noise_resolution", "0"}).options.noise_resolution, 0.0);  // never
+  EXPECT_EQ (o.noise_resolution, 0.0);    // no merging
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);

@@ -610,10 +610,10 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_LT (merged[0]["points_b"].number, static_cast<double> (kScenePoints));
   EXPECT_GT (merged[0]["points_b"].number, 0.0);
   EXPECT_EQ (merged[0]["parameters"]["noise_resolution_gate"].text, "everywhere");
-  // The whole-cloud gate, the default: the table's area-weighted spacing is 5.3 mm, so at its
-  // declared 5 mm noise it keeps every point, and declared at 8 mm it merges as the ungated rule
-  // does.
-  const auto kept = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0"});
+  // The whole-cloud gate, the default gate: the table's area-weighted spacing is 5.3 mm, so at
+  // its declared 5 mm noise it keeps every point, and declared at 8 mm it merges as the ungated
+  // rule does.
+  const auto kept = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "2"});
   ASSERT_EQ (kept.size (), 1u);
   EXPECT_EQ (kept[0]["parameters"]["noise_resolution_gate"].text, "cloud");
   EXPECT_EQ (kept[0]["parameters"]["noise_resolution"].number, 2.0);
@@ -628,13 +628,14 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_LT (noisy[0]["points_b"].number, static_cast<double> (kScenePoints) / 2.0);
   EXPECT_EQ (noisy[0]["points_b"].number, noisy_all[0]["points_b"].number);
   // The merge is reported: in the JSON (the model's points plus the merged samples are the finite
-  // ones) and on the stage line, with how to keep every sample.
+  // ones) and on the stage line.
   EXPECT_EQ (noisy[0]["inputs"]["b"]["merged_samples"].number + noisy[0]["points_b"].number,
              noisy[0]["inputs"]["b"]["finite"].number);
   EXPECT_EQ (noisy[0]["inputs"]["a"]["merged_samples"].number, 0.0);  // the gripper mesh: exact samples
-  const ToolRun told = run ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008"});
+  const ToolRun told =
+      run ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008", "-noise_resolution", "2"});
   ASSERT_EQ (told.status, 0) << told.err;
-  EXPECT_NE (told.err.find ("(" + std::to_string (kScenePoints) + " samples merged within 2 noise sigmas; -noise_resolution 0 keeps them)"),
+  EXPECT_NE (told.err.find ("(" + std::to_string (kScenePoints) + " samples merged within 2 noise sigmas)"),
              std::string::npos)
       << told.err;
   EXPECT_EQ (told.err.find ("samples merged"), told.err.rfind ("samples merged")) << "only the table merges: " << told.err;
