@@ -727,19 +727,13 @@ PYBIND11_MODULE (_core, m)
                       "is two-sided.")
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
                       "Merge samples closer than this many sensor-noise sigmas into one (issue #17), where\n"
-                      "noise_resolution_gate lets them; 0: never. Default: CloudModelParams' (2).")
+                      "noise_resolution_gate lets them; 0 (default): never.")
       .def_property (
         "noise_resolution_gate",
         [] (const CloudModelParams& p) { return std::string (CloudModelParams::resolutionGateName (p.noise_resolution_gate)); },
         [] (CloudModelParams& p, const std::string& v) {
-          for (const auto g : {CloudModelParams::ResolutionGate::Everywhere, CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing,
-                               CloudModelParams::ResolutionGate::WholeCloud})
-            if (v == CloudModelParams::resolutionGateName (g))
-            {
-              p.noise_resolution_gate = g;
-              return;
-            }
-          throw py::value_error ("noise_resolution_gate: expected one of everywhere, spacing, cloud, got '" + v + "'");
+          if (!CloudModelParams::resolutionGateFromName (v, p.noise_resolution_gate))
+            throw py::value_error ("noise_resolution_gate: expected one of everywhere, spacing, cloud, got '" + v + "'");
         },
         "Where noise_resolution merges (pcd_collision's -noise_resolution_gate): 'everywhere' (every sample),\n"
         "'spacing' (only samples spaced within their noise sigma) or 'cloud' (the whole cloud where it is\n"

@@ -424,15 +424,7 @@ parseCommandLine (const std::vector<std::string>& args)
     }
     else if (a == "-noise_resolution_gate")
     {
-      using Gate = pcl_probcollision::CloudModelParams::ResolutionGate;
-      bool known = false;
-      for (const Gate g : {Gate::Everywhere, Gate::WhereNoiseExceedsSpacing, Gate::WholeCloud})
-        if (v == pcl_probcollision::CloudModelParams::resolutionGateName (g))
-        {
-          o.noise_resolution_gate = g;
-          known = true;
-        }
-      if (!known)
+      if (!pcl_probcollision::CloudModelParams::resolutionGateFromName (v, o.noise_resolution_gate))
         return usage (bad + "must be everywhere, spacing or cloud");
     }
     else if (a == "-noise_stop")

@@ -4,6 +4,8 @@
 #include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/sensor_noise.h>
 
+#include <string>
+
 namespace pcl_probcollision
 {
 /** \brief How a CloudModel is built from a point cloud: the per-cloud settings, with their
@@ -135,6 +137,18 @@ struct CloudModelParams
       case ResolutionGate::WholeCloud: return "cloud";
     }
     return "unknown";
+  }
+  /** \brief The gate resolutionGateName() names; false, leaving gate as it was, for any other name. */
+  static bool
+  resolutionGateFromName (const std::string& name, ResolutionGate& gate)
+  {
+    for (const ResolutionGate g : {ResolutionGate::Everywhere, ResolutionGate::WhereNoiseExceedsSpacing, ResolutionGate::WholeCloud})
+      if (name == resolutionGateName (g))
+      {
+        gate = g;
+        return true;
+      }
+    return false;
   }
   /** \brief The hierarchy built over the points (BVHParams' defaults). */
   BVHParams hierarchy;

@@ -132,9 +132,11 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
             raise ValueError(f"option orientation{'_' + side if o['orientation_' + side] else ''}: expected one of "
                              f"{', '.join(_ORIENTATION_NAMES.values())}, got {name!r}")
         o["orientation_" + side] = name
-    if o["noise_resolution_gate"] not in ("everywhere", "spacing", "cloud"):
+    try:  # the names CloudModelParams knows, checked before any work is sent out
+        core.CloudModelParams().noise_resolution_gate = o["noise_resolution_gate"]
+    except (ValueError, TypeError):
         raise ValueError(f"option noise_resolution_gate: expected one of everywhere, spacing, cloud, got "
-                         f"{o['noise_resolution_gate']!r}")
+                         f"{o['noise_resolution_gate']!r}") from None
     if o["stochastic"] and options.get("deterministic"):
         raise ValueError("options deterministic and stochastic cannot be combined")
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
