@@ -55,13 +55,13 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
 
   result.points_a = a.size ();
   result.points_b = b.size ();
-  detail::LeafPairTest leaf_test (a, b, T_a_b, request, *classifier, result);
-
   detail::TraversalParams params (request);
   // A pair whose reach weight is at most the maximum so far cannot raise it (its contribution
-  // is rho * P_leaf <= rho): same probability and witness, fewer classifier fits. Per-point
-  // values need every reachable leaf pair, so they keep the full traversal.
+  // is rho * P_leaf <= rho), nor can one whose start plane leaves every point at most there
+  // (the leaf test's): same probability and witness, fewer classifier fits. Per-point values
+  // need every reachable leaf pair's fit, so they keep the full traversal.
   params.skip_dominated = !request.per_point;
+  detail::LeafPairTest leaf_test (a, b, T_a_b, request, *classifier, result, params.skip_dominated);
   detail::TraversalResult traversal;
   try
   {

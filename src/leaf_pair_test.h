@@ -29,9 +29,12 @@ namespace detail
 class LeafPairTest
 {
 public:
-  /** \brief result's per-point arrays are sized here when request.per_point. */
+  /** \brief result's per-point arrays are sized here when request.per_point. With
+    * skip_dominated (the traversal's), a pair whose start plane cannot raise the maximum is
+    * not fitted (RobustClassifier::classify's skip_at_or_below). */
   LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
-                const CollisionRequest& request, const RobustClassifier& classifier, CollisionResult& result);
+                const CollisionRequest& request, const RobustClassifier& classifier, CollisionResult& result,
+                bool skip_dominated);
 
   /** \brief The traversal's leaf test: P_leaf of the two leaves, NaN when the classifier has
     * no usable separator (counted in failures()), 0 for a pair set aside. */
@@ -49,9 +52,11 @@ public:
   const std::string& firstFailure () const { return failure_; }
 
 private:
-  /** \brief Fits one pair with the given kernel mode into leaf_; false (failure noted) when it
-    * has no usable separator. */
-  bool fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel);
+  /** \brief Fits one pair with the given kernel mode into leaf_ (not when its start plane's
+    * maximum is at most skip_at_or_below: leaf_.dominated); false (failure noted) when it has
+    * no usable separator. */
+  bool fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel,
+            double skip_at_or_below = -1.0);
   /** \brief Takes the fit in leaf_ into the result; returns its contribution rho * P_leaf. */
   double record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
 
@@ -68,6 +73,9 @@ private:
   const CollisionRequest& request_;
   const RobustClassifier& classifier_;
   CollisionResult& result_;
+  bool skip_dominated_;
+  /** \brief The last best_ / rho seen and the start-plane bound it gives. */
+  double skip_bound_ = -1.0, skip_below_ = -1.0;
   /** \brief Kernel rungs deferred (defer_kernel_fits; never with per-point values, which need
     * every pair's final fit in traversal order). */
   bool lazy_kernel_ = false;

@@ -45,6 +45,9 @@ struct SeparatorModel
 struct ClassifierResult
 {
   bool ok = false;                 ///< false: inputs unusable, see message
+  /** \brief No rung was fitted: the start plane's maximum was at most the caller's
+    * skip_at_or_below (classify() with a kernel mode). */
+  bool dominated = false;
   std::string message;
   Rung rung = Rung::None;
   /** \brief Every solve of the kept rung met its tolerance: Newton |grad J| <= 1e-10
@@ -133,9 +136,18 @@ public:
   /** \brief As classify(), with another kernel mode than the parameters' for this call (the
     * random features stay this instance's). collide() fits the plane of every leaf pair
     * first and the kernel rungs only for the pairs that needsKernel() names and that can
-    * still raise the maximum. */
+    * still raise the maximum.
+    *
+    * With skip_at_or_below >= 0 (kernel Linear or Ladder), the plane Newton starts from (f = 1
+    * and -1 at the class means, METHOD.md 5.3) is assessed first. When it leaves every point
+    * on its side (its maximum P_i under 0.5) and its maximum is at most skip_at_or_below,
+    * nothing is fitted: result.dominated is set, result.probability is that plane's maximum,
+    * the rung None and the per-point arrays empty. collide() passes a bound one standard
+    * normal quantile under its maximum so far (over the pair's reach weight): a fit as a rule
+    * lowers a separable pair's maximum, and has not raised it by that much in any pair
+    * measured (docs/PERFORMANCE.md), so such a pair is not fitted. */
   bool classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result,
-                 KernelMode kernel) const;
+                 KernelMode kernel, double skip_at_or_below = -1.0) const;
 
   /** \brief Whether the Ladder goes on to a kernel rung after this plane fit (a Linear
     * classify() result): the fit is degenerate or misclassifies more than ladder_fraction of

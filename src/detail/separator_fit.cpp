@@ -6,6 +6,9 @@
 #include <pcl_probcollision/detail/linear_separator.h>
 #include <pcl_probcollision/detail/point_probabilities.h>
 #include <pcl_probcollision/detail/rff_separator.h>
+#include <pcl_probcollision/normal_distribution.h>
+
+#include <cmath>
 
 #include <algorithm>
 #include <limits>
@@ -99,6 +102,40 @@ fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
       fit);
   fit.theta = theta;
   return fit;
+}
+
+double
+meansPlaneMaximum (const SeparatorProblem& p, const MarginLoss& loss, const std::vector<bool>* uncertain)
+{
+  LinearSeparatorSolver solver (p, loss);
+  const Eigen::Vector4d theta = solver.start ();
+  const Eigen::Vector3d w = theta.head<3> ();
+  const double norm = w.norm ();
+  if (!(norm >= kCollapse) || !std::isfinite (norm))
+    return std::numeric_limits<double>::quiet_NaN ();
+  RungFit plane;
+  plane.plane_gradient = w;
+  // assessFit's P_i = Phi(-u_i / sigma_i) is increasing in k_i = -u_i / sigma_i, so the
+  // maximum needs one normal tail, at the largest k_i (its no-spread cases as +-inf and 0).
+  double largest = -std::numeric_limits<double>::infinity ();
+  bool any = false;
+  for (int pass = 0; pass < 2 && !any; ++pass)
+    for (Eigen::Index i = 0; i < p.n; ++i)
+    {
+      if (pass == 0 && uncertain && !(*uncertain)[static_cast<std::size_t> (i)])
+        continue;
+      any = true;
+      const double f = theta (0) * p.x (i) + theta (1) * p.y (i) + theta (2) * p.z (i) + theta (3);
+      const double u = p.label (i) * f / norm;
+      const double sigma = std::sqrt (quadraticForm (p, plane, i)) / norm;
+      const double k = sigma < kNoSpread ? (u < -kNoSpread ? std::numeric_limits<double>::infinity ()
+                                                            : (u <= kNoSpread ? 0.0 : -std::numeric_limits<double>::infinity ()))
+                                         : -u / sigma;
+      largest = std::max (largest, k);
+    }
+  return largest == std::numeric_limits<double>::infinity () ? 1.0
+       : largest == -std::numeric_limits<double>::infinity () ? 0.0
+       : normalCdf (largest);
 }
 
 RungFit
