@@ -801,7 +801,7 @@ PYBIND11_MODULE (_core, m)
       "exhaustive: visit every reachable leaf pair instead of stopping once P > collision_above;\n"
       "per_point: fill probabilities_a/_b; enable_timings: fill build_ms/query_ms; traversal, rho_min, seed,\n"
       "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier;\n"
-      "max_leaf_fits: at most this many leaf pairs fitted a query, nearest first (0 = no cap; result.budget_exhausted);\n"
+      "max_leaf_fits: at most this many leaf pairs tested a query, nearest first (0 = no cap; result.budget_exhausted);\n"
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
@@ -856,7 +856,7 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("expanded_k_sigma", &CollisionRequest::expanded_k_sigma)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
       .def_readwrite ("max_leaf_fits", &CollisionRequest::max_leaf_fits,
-                      "At most this many leaf pairs fitted a query, nearest first; 0 = no cap.")
+                      "At most this many leaf pairs tested (fitted, or passed over unfitted) a query, nearest first; 0 = no cap.")
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
@@ -938,7 +938,8 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("points_b", &CollisionResult::points_b)
       .def_readonly ("points_skipped_nonfinite", &CollisionResult::points_skipped_nonfinite)
       .def_readonly ("bv_tests", &CollisionResult::bv_tests)
-      .def_readonly ("leaf_pairs_tested", &CollisionResult::leaf_pairs_tested)
+      .def_readonly ("leaf_pairs_tested", &CollisionResult::leaf_pairs_tested,
+                     "Leaf pairs tested: fitted, or passed over unfitted because their start plane could not raise P.")
       .def_readonly ("kernel_leaf_pairs", &CollisionResult::kernel_leaf_pairs)
       .def_readonly ("degenerate_leaf_pairs", &CollisionResult::degenerate_leaf_pairs)
       .def_readonly ("classifier_iterations", &CollisionResult::classifier_iterations)

@@ -601,7 +601,7 @@ helpText ()
        "                  may be lower\n"
        "  -max_leaf_fits N   = "
     << D::max_leaf_fits
-    << "   at most N leaf pairs fitted a query, nearest first (0: no cap); a capped\n"
+    << "   at most N leaf pairs tested a query, nearest first (0: no cap); a capped\n"
        "                  query prints P >= and \"budget exhausted\": P is a lower bound\n"
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"

@@ -53,7 +53,7 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "exhaustive": _REQUEST.exhaustive,
     # Every reached leaf pair's plane before any kernel rung (the same verdicts, faster).
     "defer_kernel_fits": _REQUEST.defer_kernel_fits,
-    # At most this many leaf pairs fitted a query, nearest first (0: no cap).
+    # At most this many leaf pairs tested a query, nearest first (0: no cap).
     "max_leaf_fits": _REQUEST.max_leaf_fits,
     # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none).
     "noise_resolution": _MODEL.noise_resolution,
