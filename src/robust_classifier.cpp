@@ -229,37 +229,21 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   loss.huber = params_.loss == Loss::Huber;
   const double gamma = normalQuantile (params_.confidence);
 
-  // The maximum over the uncertain points (see ClassifierParams::exact_points_in_maximum), or
-  // over every point when none is uncertain; -1 (witness -1) for none.
-  const auto pointMaximum = [&] (const Eigen::ArrayXd& probability, Eigen::Index& witness) {
-    double maximum = -1.0;
-    witness = -1;
-    if (!params_.exact_points_in_maximum)
-      for (Eigen::Index i = 0; i < static_cast<Eigen::Index> (n); ++i)
-      {
-        const Eigen::Matrix3d& c = i < p.n_a ? a.covariances[i] : b.covariances[i - p.n_a];
-        if (c.trace () > 0.0 && probability (i) > maximum)
-        {
-          maximum = probability (i);
-          witness = i;
-        }
-      }
-    if (witness < 0)
-      maximum = probability.maxCoeff (&witness);
-    return maximum;
-  };
+  // The points the maximum runs over: the uncertain ones (see
+  // ClassifierParams::exact_points_in_maximum), or every point when none is uncertain.
+  thread_local std::vector<bool> uncertain;
+  uncertain.assign (n, false);
+  bool some_uncertain = false;
+  if (!params_.exact_points_in_maximum)
+    for (std::size_t i = 0; i < n; ++i)
+      some_uncertain |= (uncertain[i] = (i < na ? a.covariances[i] : b.covariances[i - na]).trace () > 0.0);
+  const std::vector<bool>* in_maximum = some_uncertain ? &uncertain : nullptr;
 
   // A pair that cannot raise the caller's maximum (skip_at_or_below, see the declaration):
   // no solve when the plane Newton would start from already leaves every point there.
   if (skip_at_or_below >= 0.0 && kernel != KernelMode::RFF)
   {
-    thread_local std::vector<bool> uncertain;
-    uncertain.resize (n);
-    bool some = false;
-    if (!params_.exact_points_in_maximum)
-      for (std::size_t i = 0; i < n; ++i)
-        some |= (uncertain[i] = (i < na ? a.covariances[i] : b.covariances[i - na]).trace () > 0.0);
-    const double p0 = detail::meansPlaneMaximum (p, loss, some ? &uncertain : nullptr);
+    const double p0 = detail::meansPlaneMaximum (p, loss, in_maximum);
     if (p0 < 0.5 && p0 <= skip_at_or_below)
     {
       result.ok = true;
@@ -322,7 +306,13 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   result.probabilities_a.assign (best.probability.data (), best.probability.data () + na);
   result.probabilities_b.assign (best.probability.data () + na, best.probability.data () + n);
   Eigen::Index witness = -1;
-  result.probability = pointMaximum (best.probability, witness);
+  result.probability = -1.0;
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index> (n); ++i)
+    if ((!in_maximum || uncertain[static_cast<std::size_t> (i)]) && best.probability (i) > result.probability)
+    {
+      result.probability = best.probability (i);
+      witness = i;
+    }
   if (best.degenerate)
     result.probability = 0.5;
   result.witness_side = witness < p.n_a ? 1 : -1;

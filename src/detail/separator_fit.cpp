@@ -8,9 +8,8 @@
 #include <pcl_probcollision/detail/rff_separator.h>
 #include <pcl_probcollision/normal_distribution.h>
 
-#include <cmath>
-
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -118,13 +117,9 @@ meansPlaneMaximum (const SeparatorProblem& p, const MarginLoss& loss, const std:
   // assessFit's P_i = Phi(-u_i / sigma_i) is increasing in k_i = -u_i / sigma_i, so the
   // maximum needs one normal tail, at the largest k_i (its no-spread cases as +-inf and 0).
   double largest = -std::numeric_limits<double>::infinity ();
-  bool any = false;
-  for (int pass = 0; pass < 2 && !any; ++pass)
-    for (Eigen::Index i = 0; i < p.n; ++i)
+  for (Eigen::Index i = 0; i < p.n; ++i)
+    if (!uncertain || (*uncertain)[static_cast<std::size_t> (i)])
     {
-      if (pass == 0 && uncertain && !(*uncertain)[static_cast<std::size_t> (i)])
-        continue;
-      any = true;
       const double f = theta (0) * p.x (i) + theta (1) * p.y (i) + theta (2) * p.z (i) + theta (3);
       const double u = p.label (i) * f / norm;
       const double sigma = std::sqrt (quadraticForm (p, plane, i)) / norm;

@@ -51,8 +51,8 @@ RungFit fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
                    const MarginLoss& loss, double gamma);
 
 /** \brief max_i P_i of the plane Newton starts from (f = 1 and -1 at the class means, METHOD.md
-  * 5.3), with assessFit()'s P_i, over the points marked in uncertain (every point when none is
-  * or uncertain is null); NaN when that start is unusable (theta = 0). No solve. */
+  * 5.3), with assessFit()'s P_i, over the points marked in uncertain (every point when it is
+  * null); NaN when that start is unusable (theta = 0). No solve. */
 double meansPlaneMaximum (const SeparatorProblem& p, const MarginLoss& loss, const std::vector<bool>* uncertain);
 
 /** \brief As fitLinear() with the first features rows of the random Fourier feature draw
