@@ -600,3 +600,40 @@ TEST (BVHTraversal, CountersAndFlags)
   bad.expanded_k_sigma = std::numeric_limits<double>::quiet_NaN ();
   EXPECT_THROW (bad.validate (), pcl::BadArgumentException);
 }
+
+// A leaf test that fits pairs after their own call (collide()'s start-plane order) shares its
+// recorded maximum, which prunes dominated pairs, and its stop, which ends the traversal as a
+// contribution above stop_probability would (not when exhaustive).
+TEST (BVHTraversal, ALeafTestsRecordedMaximumAndStopAreHonoured)
+{
+  const UncertainCloud c = shapeCloud (Shape::Box, 500, 41);
+  ProbabilisticBVH a (c), b (c);
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
+  bool stop = false;
+  std::size_t calls = 0;
+  auto setsAside = [&] (const Node&, const Node&, double) {
+    stop = ++calls == 3;  // the third call "fits" an earlier pair above the threshold
+    return 0.0;
+  };
+  TraversalParams tp;
+  tp.stop_now = &stop;
+  const TraversalResult stopped = detail::traverseHierarchies (a, b, I, tp, setsAside);
+  EXPECT_TRUE (stopped.lower_bound);
+  EXPECT_EQ (stopped.leaf_pairs_tested, 3u);
+  calls = 0;
+  stop = false;
+  tp.exhaustive = true;
+  const TraversalResult full = detail::traverseHierarchies (a, b, I, tp, setsAside);
+  EXPECT_FALSE (full.lower_bound);
+  EXPECT_GT (full.leaf_pairs_tested, 3u);
+  // A recorded maximum of 1 dominates every pair: nothing is tested.
+  const double recorded = 1.0;
+  TraversalParams pruned;
+  pruned.skip_dominated = true;
+  pruned.recorded_maximum = &recorded;
+  calls = 0;
+  const TraversalResult none = detail::traverseHierarchies (a, b, I, pruned, setsAside);
+  EXPECT_EQ (none.leaf_pairs_tested, 0u);
+  EXPECT_EQ (calls, 0u);
+  EXPECT_TRUE (none.no_leaf_tested);  // the maximum is the leaf test's to report
+}
