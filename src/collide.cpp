@@ -62,10 +62,6 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
   // need every reachable leaf pair's fit, so they keep the full traversal.
   params.skip_dominated = !request.per_point;
   detail::LeafPairTest leaf_test (a, b, T_a_b, request, *classifier, result, params.skip_dominated);
-  // The leaf test fits some pairs after their call (in the order of their start planes): the
-  // traversal prunes against its recorded maximum and stops when one of them decides.
-  params.recorded_maximum = leaf_test.recordedMaximum ();
-  params.stop_now = leaf_test.stopFlag ();
   detail::TraversalResult traversal;
   try
   {

@@ -22,14 +22,6 @@ namespace
   * paper's `max` setting: P 0.0240 -> 0.0233, a passed-over pair's fit more than one quantile
   * above its start (docs/PERFORMANCE.md). */
 constexpr double kStartPlaneMargin = 1.0;
-/** \brief Leaf pairs set aside before they are fitted in the order of their start planes'
-  * maxima. A window bounds what a query enumerates before its first fit: unbounded, a
-  * collision at 4 % noise enumerated every reachable pair (twice the pairs of the nearest-first
-  * order) before it could stop; 64 kept less of the order's gain (docs/PERFORMANCE.md). */
-constexpr std::size_t kWindow = 256;
-/** \brief A start plane at least this sure of a collision has its pair fitted at once, in
-  * traversal order, so that a query can stop there (0.9 set more pairs aside for longer). */
-constexpr double kFitAtOnce = 0.99;
 
 // Keeps the larger of a stored per-point value and a new one; NaN means "not reached yet".
 void
@@ -55,9 +47,6 @@ LeafPairTest::LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b
   // the maximum is the same; with one (P > collision_above, a lower bound either way) the
   // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
   // below the default's.
-  // Pairs fitted in the order of their start planes (a window at a time) wherever only the
-  // maximum is asked and no other rule orders the fits (a cap counts them in traversal order).
-  by_start_plane_ = skip_dominated && !request.defer_kernel_fits && request.max_leaf_fits == 0;
   lazy_kernel_ = request.defer_kernel_fits && !request.per_point && classifier.getParams ().kernel == KernelMode::Ladder;
   if (request.per_point)
   {
@@ -113,72 +102,21 @@ LeafPairTest::record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticB
 }
 
 double
-LeafPairTest::skipBelow (double rho)
-{
-  if (!skip_dominated_ || !(best_ >= 0.0) || !(rho > 0.0))
-    return -1.0;
-  const double bound = std::min (1.0, best_ / rho);
-  if (bound != skip_bound_)
-  {
-    skip_bound_ = bound;
-    skip_below_ = normalCdf (normalQuantile (bound) - kStartPlaneMargin);
-  }
-  return skip_below_;
-}
-
-void
-LeafPairTest::fitWindow ()
-{
-  std::stable_sort (window_.begin (), window_.end (),
-                    [] (const Deferred& x, const Deferred& y) { return x.key > y.key; });
-  for (const Deferred& d : window_)
-  {
-    if (stop_)
-      break;
-    if (d.rho <= best_ || (d.start < 0.5 && d.start <= skipBelow (d.rho)))
-      continue;
-    if (!fit (*d.a, *d.b, classifier_.getParams ().kernel))
-      continue;
-    --result_.leaf_pairs_tested;  // counted when it was set aside; record() counts it again
-    stop_ = record (*d.a, *d.b, d.rho) > request_.collision_above && !request_.exhaustive;
-  }
-  window_.clear ();
-}
-
-double
 LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho)
 {
-  if (by_start_plane_)
-  {
-    // The start plane's maximum first: a pair it leaves under the maximum is passed over, one
-    // it finds sure to collide is fitted now, any other waits in the window, which is fitted in
-    // the order of that maximum, largest first.
-    const KernelMode kernel = classifier_.getParams ().kernel;
-    if (!fit (leaf_a, leaf_b, kernel, std::numeric_limits<double>::infinity ()))
-      return std::numeric_limits<double>::quiet_NaN ();
-    if (leaf_.dominated)
-    {
-      const double start = leaf_.probability;
-      ++result_.leaf_pairs_tested;
-      if (start < 0.5 && start <= skipBelow (rho))
-        return start;
-      if (start < kFitAtOnce)
-      {
-        window_.push_back ({&leaf_a, &leaf_b, rho, rho * start, start});
-        if (window_.size () >= kWindow)
-          fitWindow ();
-        return 0.0;
-      }
-      --result_.leaf_pairs_tested;
-      if (!fit (leaf_a, leaf_b, kernel))
-        return std::numeric_limits<double>::quiet_NaN ();
-    }
-    record (leaf_a, leaf_b, rho);
-    return leaf_.probability;
-  }
   // A pair that cannot raise the maximum is not fitted (RobustClassifier::classify's
   // skip_at_or_below): its start plane's P stands in, kStartPlaneMargin under best_ / rho.
-  const double skip_at_or_below = skipBelow (rho);
+  double skip_at_or_below = -1.0;
+  if (skip_dominated_ && best_ >= 0.0 && rho > 0.0)
+  {
+    const double bound = std::min (1.0, best_ / rho);
+    if (bound != skip_bound_)
+    {
+      skip_bound_ = bound;
+      skip_below_ = normalCdf (normalQuantile (bound) - kStartPlaneMargin);
+    }
+    skip_at_or_below = skip_below_;
+  }
   if (!fit (leaf_a, leaf_b, lazy_kernel_ ? KernelMode::Linear : classifier_.getParams ().kernel, skip_at_or_below))
     return std::numeric_limits<double>::quiet_NaN ();
   if (leaf_.dominated)
@@ -188,7 +126,7 @@ LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const Probabilis
   }
   if (lazy_kernel_ && classifier_.needsKernel (leaf_))
   {
-    deferred_.push_back ({&leaf_a, &leaf_b, rho, rho, 0.0});
+    deferred_.push_back ({&leaf_a, &leaf_b, rho});
     return 0.0;
   }
   record (leaf_a, leaf_b, rho);
@@ -198,11 +136,6 @@ LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const Probabilis
 bool
 LeafPairTest::finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated)
 {
-  if (by_start_plane_)
-  {
-    fitWindow ();
-    return stop_;
-  }
   std::stable_sort (deferred_.begin (), deferred_.end (),
                     [] (const Deferred& x, const Deferred& y) { return x.rho > y.rho; });
   for (const Deferred& d : deferred_)

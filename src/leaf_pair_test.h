@@ -22,12 +22,7 @@ namespace detail
   * frame) and records each fit into a CollisionResult: counters, per-point values (request.
   * per_point), the running maximum and its witness (in A's frame, the hierarchies' frame).
   *
-  * Passed to traverseHierarchies() as its leaf test. When only the maximum is asked (no
-  * per-point values, cap or deferred kernel fits), each pair's start plane (RobustClassifier::
-  * classify's skip_at_or_below) is assessed first: a pair it leaves a margin under the maximum
-  * so far is passed over, one it finds nearly sure to collide is fitted at once, and any other
-  * waits in a window of kWindow pairs, fitted in the order of the start planes' maxima, so
-  * that the pair which decides a collision is met early. With request.defer_kernel_fits a pair
+  * Passed to traverseHierarchies() as its leaf test. With request.defer_kernel_fits a pair
   * whose plane asks for a kernel rung is set aside (contributing 0) and fitted in full by
   * finishDeferred(), largest reach weight first.
   */
@@ -45,18 +40,13 @@ public:
     * no usable separator (counted in failures()), 0 for a pair set aside. */
   double operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
 
-  /** \brief Fits the pairs set aside (the last window, or the deferred kernel fits, largest
-    * reach weight first), skipping those that cannot raise the maximum when skip_dominated; true
-    * when a contribution exceeded stop_probability and exhaustive is off (the maximum is then a
-    * lower bound). */
+  /** \brief Fits the pairs set aside, largest reach weight first, skipping those that cannot
+    * raise the maximum when skip_dominated; true when a contribution exceeded stop_probability
+    * and exhaustive is off (the maximum is then a lower bound). */
   bool finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated);
 
   /** \brief The largest recorded contribution rho * P_leaf (-1 before any). */
   double best () const { return best_; }
-  /** \brief For the traversal (TraversalParams::recorded_maximum, stop_now): the recorded
-    * maximum, and whether a pair fitted after its own call decided the query. */
-  const double* recordedMaximum () const { return &best_; }
-  const bool* stopFlag () const { return &stop_; }
   /** \brief Leaf pairs without a usable separator, and the first one's message. */
   std::size_t failures () const { return failures_; }
   const std::string& firstFailure () const { return failure_; }
@@ -75,15 +65,7 @@ private:
     const ProbabilisticBVH::Node* a;
     const ProbabilisticBVH::Node* b;
     double rho;
-    double key;    ///< the order of fitting, largest first
-    double start;  ///< the start plane's maximum (by_start_plane_)
   };
-  /** \brief The start-plane bound under which a pair of reach weight rho is not fitted, -1
-    * for none (kStartPlaneMargin). */
-  double skipBelow (double rho);
-  /** \brief Fits the pairs of window_ not passed over, largest start-plane maximum first;
-    * sets stop_ at a contribution above collision_above (unless exhaustive). */
-  void fitWindow ();
 
   const ProbabilisticBVH& a_;
   const ProbabilisticBVH& b_;
@@ -97,11 +79,6 @@ private:
   /** \brief Kernel rungs deferred (defer_kernel_fits; never with per-point values, which need
     * every pair's final fit in traversal order). */
   bool lazy_kernel_ = false;
-  /** \brief Pairs wait in window_ and are fitted in the order of their start planes' maxima
-    * (not with per-point values, a cap or deferred kernel fits). */
-  bool by_start_plane_ = false;
-  std::vector<Deferred> window_;
-  bool stop_ = false;
 
   std::vector<Eigen::Vector3d> means_a_, means_b_;
   std::vector<Eigen::Matrix3d> covs_a_, covs_b_;

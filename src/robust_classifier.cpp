@@ -240,12 +240,11 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   const std::vector<bool>* in_maximum = some_uncertain ? &uncertain : nullptr;
 
   // A pair that cannot raise the caller's maximum (skip_at_or_below, see the declaration):
-  // no solve when the plane Newton would start from already leaves every point there, or
-  // when only that plane's maximum is asked (+infinity).
+  // no solve when the plane Newton would start from already leaves every point there.
   if (skip_at_or_below >= 0.0 && kernel != KernelMode::RFF)
   {
     const double p0 = detail::meansPlaneMaximum (p, loss, in_maximum);
-    if (!std::isnan (p0) && (std::isinf (skip_at_or_below) || (p0 < 0.5 && p0 <= skip_at_or_below)))
+    if (p0 < 0.5 && p0 <= skip_at_or_below)
     {
       result.ok = true;
       result.dominated = true;

@@ -140,10 +140,9 @@ public:
     *
     * With skip_at_or_below >= 0 (kernel Linear or Ladder), the plane Newton starts from (f = 1
     * and -1 at the class means, METHOD.md 5.3) is assessed first. When it leaves every point
-    * on its side (its maximum P_i under 0.5) and its maximum is at most skip_at_or_below, or
-    * whenever that plane is usable with skip_at_or_below = +infinity (the plane's maximum
-    * alone is asked), nothing is fitted: result.dominated is set, result.probability is that
-    * plane's maximum, the rung None and the per-point arrays empty. collide() passes a bound one standard
+    * on its side (its maximum P_i under 0.5) and its maximum is at most skip_at_or_below,
+    * nothing is fitted: result.dominated is set, result.probability is that plane's maximum,
+    * the rung None and the per-point arrays empty. collide() passes a bound one standard
     * normal quantile under its maximum so far (over the pair's reach weight): a fit as a rule
     * lowers a separable pair's maximum, and has not raised it by that much in any pair
     * measured (docs/PERFORMANCE.md), so such a pair is not fitted. */

@@ -61,13 +61,6 @@ struct TraversalParams
   bool skip_dominated = false;
   /** \brief Stop before the leaf test that would exceed this many (0 = no cap). */
   std::size_t max_leaf_tests = 0;
-  /** \brief Optional, owned by the leaf test: the largest contribution it has recorded,
-    * including pairs it fitted after their own call (a leaf test that sets pairs aside). The
-    * traversal's maximum is at least this for the dominated-pair pruning. */
-  const double* recorded_maximum = nullptr;
-  /** \brief Optional, owned by the leaf test: set when a pair it fitted after its own call
-    * exceeded stop_probability; the traversal then stops as it would at such a pair. */
-  const bool* stop_now = nullptr;
   /** \brief Visit an opened node's children nearest the other node first (default), else in
     * storage order. Only the order of the leaf tests changes; a traversal that visits every
     * pair (the surface layer's enumeration) gains nothing from it. */
@@ -223,8 +216,6 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
     const Entry e = stack.back ();
     stack.pop_back ();
     double rho = e.rho;
-    if (params.recorded_maximum && *params.recorded_maximum > best)
-      best = *params.recorded_maximum;
     // The weight only shrinks below this pair: dominated already, no box test needed.
     if (params.skip_dominated && rho <= best)
     {
@@ -282,11 +273,6 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
       }
       ++result.leaf_pairs_tested;
       const double p = leaf_test (na, nb, rho);
-      if (params.stop_now && *params.stop_now && !params.exhaustive)
-      {
-        result.lower_bound = true;
-        break;
-      }
       if (std::isnan (p))
       {
         ++result.invalid_leaf_results;
