@@ -241,9 +241,13 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
 
   // A pair that cannot raise the caller's maximum (skip_at_or_below, see the declaration):
   // no solve when the plane Newton would start from already leaves every point there.
-  if (skip_at_or_below >= 0.0 && kernel != KernelMode::RFF)
+  // The start is computed once: the plane's fit below starts from it.
+  Eigen::Vector4d start;
+  const bool have_start = skip_at_or_below >= 0.0 && kernel != KernelMode::RFF;
+  if (have_start)
   {
-    const double p0 = detail::meansPlaneMaximum (p, loss, in_maximum);
+    start = detail::linearStart (p, loss);
+    const double p0 = detail::meansPlaneMaximum (p, start, in_maximum);
     if (p0 < 0.5 && p0 <= skip_at_or_below)
     {
       result.ok = true;
@@ -264,7 +268,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
   else
   {
-    best = detail::fitLinear (p, params_, loss, gamma);
+    best = detail::fitLinear (p, params_, loss, gamma, have_start ? &start : nullptr);
     iterations = best.iterations;
     result.rungs_tried = 1;
     if (kernel == KernelMode::Ladder)

@@ -62,8 +62,8 @@ struct CollisionRequest
     * P of those poses costs ranking accuracy (docs/PERFORMANCE.md). */
   bool defer_kernel_fits = false;
   /** \brief A cap on the separators' work: at most this many leaf pairs tested per query
-    * (CollisionResult::leaf_pairs_tested); 0 (default) = no cap. Leaf pairs are visited nearest first (detail/bvh_traversal.h), so the
-    * pairs left over are the farther ones; a query that reaches the cap stops with P the
+    * (CollisionResult::leaf_pairs_tested); 0 (default) = no cap. Leaf pairs are visited nearest
+    * first (detail/bvh_traversal.h), so the pairs left over are the farther ones; a query that reaches the cap stops with P the
     * largest so far (CollisionResult::budget_exhausted, a lower bound). It bounds the worst
     * case at high noise, where inflated boxes overlap everywhere and thousands of pairs are
     * fitted (docs/PERFORMANCE.md, issue #17). Not used by the surface layer. */

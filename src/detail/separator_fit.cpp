@@ -86,12 +86,12 @@ train (const SeparatorProblem& p, const ClassifierParams& params, double gamma, 
 
 RungFit
 fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
-           const MarginLoss& loss, double gamma)
+           const MarginLoss& loss, double gamma, const Eigen::Vector4d* start)
 {
   RungFit fit;
   fit.rung = Rung::Linear;
   LinearSeparatorSolver solver (p, loss);
-  Eigen::Vector4d theta = solver.start ();
+  Eigen::Vector4d theta = start ? *start : solver.start ();
   train (
       p, params, gamma, [&] (double g) { return solver.solve (theta, g, params.max_iterations); },
       [&] {
@@ -103,11 +103,15 @@ fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
   return fit;
 }
 
-double
-meansPlaneMaximum (const SeparatorProblem& p, const MarginLoss& loss, const std::vector<bool>* uncertain)
+Eigen::Vector4d
+linearStart (const SeparatorProblem& p, const MarginLoss& loss)
 {
-  LinearSeparatorSolver solver (p, loss);
-  const Eigen::Vector4d theta = solver.start ();
+  return LinearSeparatorSolver (p, loss).start ();
+}
+
+double
+meansPlaneMaximum (const SeparatorProblem& p, const Eigen::Vector4d& theta, const std::vector<bool>* uncertain)
+{
   const Eigen::Vector3d w = theta.head<3> ();
   const double norm = w.norm ();
   if (!(norm >= kCollapse) || !std::isfinite (norm))
