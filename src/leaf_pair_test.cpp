@@ -62,7 +62,7 @@ LeafPairTest::fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH:
 {
   const PointSetView view_a = a_.gatherPoints (leaf_a, means_a_, covs_a_);
   const PointSetView view_b = b_.gatherPoints (leaf_b, T_a_b_, means_b_, covs_b_);
-  if (classifier_.classify (view_a, view_b, leaf_, kernel, skip_at_or_below))
+  if (classifier_.classify (view_a, view_b, leaf_, kernel, skip_at_or_below, request_.per_point))
     return true;
   if (failure_.empty ())
     failure_ = leaf_.message;

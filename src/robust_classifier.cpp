@@ -193,7 +193,7 @@ RobustClassifier::needsKernel (const ClassifierResult& plane) const
 
 bool
 RobustClassifier::classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result,
-                            KernelMode kernel, double skip_at_or_below) const
+                            KernelMode kernel, double skip_at_or_below, bool point_probabilities) const
 {
   result = ClassifierResult ();
   if (a.size == 0 || b.size == 0 || !a.means || !a.covariances || !b.means || !b.covariances)
@@ -292,7 +292,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
 
   // Output (METHOD.md 6.1-6.2)
-  if (!best.theta.allFinite () || !best.probability.allFinite ())
+  if (!best.theta.allFinite () || best.z.isNaN ().any ())
   {
     // a numeric failure gives NaN and a status, never a plausible-looking number
     result.message = "[pcl_probcollision::RobustClassifier::classify] the solver produced a "
@@ -307,15 +307,29 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   result.degenerate = best.degenerate;
   result.gamma_effective = best.gamma_effective;
   result.misclassified = best.misclassified;
-  result.probabilities_a.assign (best.probability.data (), best.probability.data () + na);
-  result.probabilities_b.assign (best.probability.data () + na, best.probability.data () + n);
+  if (point_probabilities)
+  {
+    result.probabilities_a.resize (na);
+    result.probabilities_b.resize (n - na);
+    for (std::size_t i = 0; i < n; ++i)
+      (i < na ? result.probabilities_a[i] : result.probabilities_b[i - na]) = normalCdf (best.z (static_cast<Eigen::Index> (i)));
+  }
+  // The maximum and its witness, the first point that reaches it. P_i = Phi(z_i) rises with z_i,
+  // so a point whose z_i is not above every z_j before it cannot raise the maximum: a normal
+  // tail is taken only at a new largest z_i (a few per pair), not at every point.
   Eigen::Index witness = -1;
   result.probability = -1.0;
+  double largest = -std::numeric_limits<double>::infinity ();
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index> (n); ++i)
-    if ((!in_maximum || uncertain[static_cast<std::size_t> (i)]) && best.probability (i) > result.probability)
+    if ((!in_maximum || uncertain[static_cast<std::size_t> (i)]) && (witness < 0 || best.z (i) > largest))
     {
-      result.probability = best.probability (i);
-      witness = i;
+      largest = best.z (i);
+      const double p_i = normalCdf (largest);
+      if (p_i > result.probability)
+      {
+        result.probability = p_i;
+        witness = i;
+      }
     }
   if (best.degenerate)
     result.probability = 0.5;

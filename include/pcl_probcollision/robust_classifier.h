@@ -63,8 +63,10 @@ struct ClassifierResult
     * Robust training when the Standard fit penetrates (t_hat <= 0) or collapsed. */
   double gamma_effective = std::numeric_limits<double>::quiet_NaN ();
 
-  std::vector<double> probabilities_a;  ///< P_i for the points of A (label +1)
-  std::vector<double> probabilities_b;  ///< P_i for the points of B (label -1)
+  /** \brief P_i for the points of A (label +1); empty when the caller asked for none
+    * (classify()'s point_probabilities) or when no rung was fitted. */
+  std::vector<double> probabilities_a;
+  std::vector<double> probabilities_b;  ///< P_i for the points of B (label -1), likewise
 
   double probability = std::numeric_limits<double>::quiet_NaN ();  ///< max over both sides
   int witness_side = 0;            ///< +1: the maximum is a point of A; -1: of B
@@ -145,9 +147,13 @@ public:
     * the rung None and the per-point arrays empty. collide() passes a bound one standard
     * normal quantile under its maximum so far (over the pair's reach weight): a fit as a rule
     * lowers a separable pair's maximum, and has not raised it by that much in any pair
-    * measured (docs/PERFORMANCE.md), so such a pair is not fitted. */
+    * measured (docs/PERFORMANCE.md), so such a pair is not fitted.
+    *
+    * With point_probabilities false the per-point arrays stay empty and only the maximum and
+    * its witness are computed (the same values): a normal tail a new largest point instead of
+    * one a point. collide() asks for them only with CollisionRequest::per_point. */
   bool classify (const PointSetView& a, const PointSetView& b, ClassifierResult& result,
-                 KernelMode kernel, double skip_at_or_below = -1.0) const;
+                 KernelMode kernel, double skip_at_or_below = -1.0, bool point_probabilities = true) const;
 
   /** \brief Whether the Ladder goes on to a kernel rung after this plane fit (a Linear
     * classify() result): the fit is degenerate or misclassifies more than ladder_fraction of

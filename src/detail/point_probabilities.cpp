@@ -2,7 +2,7 @@
 // Per-point collision probabilities of a fitted rung (METHOD.md 6.1).
 #include <pcl_probcollision/detail/point_probabilities.h>
 
-#include <pcl_probcollision/normal_distribution.h>
+#include <limits>
 
 namespace pcl_probcollision
 {
@@ -12,7 +12,8 @@ void
 assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
 {
   const Eigen::Index n = p.n;
-  fit.probability.resize (n);
+  fit.z.resize (n);
+  constexpr double kInf = std::numeric_limits<double>::infinity ();
   fit.misclassified = 0;
   Eigen::Index collapsed = 0;
   // Point by point: no temporary arrays (this runs for every leaf pair's fit).
@@ -24,18 +25,18 @@ assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
     const double sigma = std::sqrt (quadraticForm (p, fit, i)) / norm;
     if (!(norm >= kCollapse))
     {
-      fit.probability (i) = 0.5;
+      fit.z (i) = 0.0;  // P_i = 0.5
       ++fit.misclassified;
       ++collapsed;
     }
     else if (sigma < kNoSpread)
     {
-      fit.probability (i) = u < -kNoSpread ? 1.0 : (u <= kNoSpread ? 0.5 : 0.0);
+      fit.z (i) = u < -kNoSpread ? kInf : (u <= kNoSpread ? 0.0 : -kInf);  // P_i 1, 0.5 or 0
       fit.misclassified += u < -kNoSpread;
     }
     else
     {
-      fit.probability (i) = normalCdf (-u / sigma);
+      fit.z (i) = -u / sigma;
       fit.misclassified += u < -depth_sigmas * sigma;
     }
   }

@@ -32,7 +32,9 @@ struct RungFit
   Eigen::ArrayXd f;           ///< f(x_i)
   Eigen::ArrayXd gx, gy, gz;  ///< grad f(x_i) in the unit-cube frame; empty for a plane
   Eigen::Vector3d plane_gradient = Eigen::Vector3d::Zero ();  ///< w, for a plane
-  Eigen::ArrayXd probability;  ///< P_i
+  /** \brief z_i with P_i = normalCdf (z_i) (+-inf and 0 for the cases without spread or
+    * gradient): the normal tails are taken only where they are needed. */
+  Eigen::ArrayXd z;
   std::size_t misclassified = 0;
   bool degenerate = false;
 
