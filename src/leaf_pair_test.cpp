@@ -22,6 +22,13 @@ namespace
   * paper's `max` setting: P 0.0240 -> 0.0233, a passed-over pair's fit more than one quantile
   * above its start (docs/PERFORMANCE.md). */
 constexpr double kStartPlaneMargin = 1.0;
+/** \brief A pair whose start plane leaves every point under this z (P_i = Phi(z_i) < 0.977) is
+  * set aside and fitted after the pairs above it: it rarely decides a collision (a fit as a
+  * rule lowers its start's maximum), and fitted last it is often passed over. */
+constexpr double kSetAsideBelowZ = 2.0;
+/** \brief Set-aside pairs are fitted once this many wait, so that the traversal's own pruning
+  * (reach weights under the maximum so far) does not wait for the end of the traversal. */
+constexpr std::size_t kSetAsideCap = 128;
 
 // Keeps the larger of a stored per-point value and a new one; NaN means "not reached yet".
 void
@@ -48,6 +55,11 @@ LeafPairTest::LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b
   // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
   // below the default's.
   lazy_kernel_ = request.defer_kernel_fits && !request.per_point && classifier.getParams ().kernel == KernelMode::Ladder;
+  // startPlane() mirrors classify()'s start and its pass-over test for the plane rungs and the
+  // default loss; otherwise every pair goes to classify() as it comes.
+  assess_starts_ = skip_dominated && classifier.getParams ().kernel != KernelMode::RFF &&
+                   classifier.getParams ().loss == Loss::SquaredHinge;
+  C_ = classifier.getParams ().C;
   if (request.per_point)
   {
     constexpr float kNotReached = std::numeric_limits<float>::quiet_NaN ();
@@ -71,10 +83,11 @@ LeafPairTest::fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH:
 }
 
 double
-LeafPairTest::record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho)
+LeafPairTest::record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho,
+                      bool count)
 {
   CollisionResult& result = result_;
-  ++result.leaf_pairs_tested;
+  result.leaf_pairs_tested += count ? 1 : 0;
   result.classifier_iterations += static_cast<std::size_t> (leaf_.iterations);
   result.kernel_leaf_pairs += leaf_.rung == Rung::RFF || leaf_.rung == Rung::RFFLarge ? 1 : 0;
   result.degenerate_leaf_pairs += leaf_.degenerate ? 1 : 0;
@@ -102,20 +115,51 @@ LeafPairTest::record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticB
 }
 
 double
+LeafPairTest::skipBelow (double rho)
+{
+  if (!skip_dominated_ || best_ < 0.0 || !(rho > 0.0))
+    return -1.0;
+  const double bound = std::min (1.0, best_ / rho);
+  if (bound != skip_bound_)
+  {
+    skip_bound_ = bound;
+    skip_below_ = normalCdf (normalQuantile (bound) - kStartPlaneMargin);
+  }
+  return skip_below_;
+}
+
+double
 LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho)
 {
+  // What the traversal is told besides a pair's own P_leaf: the largest fitted contribution so
+  // far, a lower bound of the final maximum, for its pruning (reach weight <= the maximum).
+  // Rounded down by two steps, so that rho times it stays under best_ (the maximum collide()
+  // reports is best_ itself).
+  const auto so_far = [&] {
+    return best_ > 0.0 && rho > 0.0 ? std::nextafter (std::nextafter (std::min (1.0, best_ / rho), 0.0), 0.0) : 0.0;
+  };
+  if (starts_stopped_)
+    return so_far ();  // a set-aside pair already decided the collision
   // A pair that cannot raise the maximum is not fitted (RobustClassifier::classify's
   // skip_at_or_below): its start plane's P stands in, kStartPlaneMargin under best_ / rho.
-  double skip_at_or_below = -1.0;
-  if (skip_dominated_ && best_ >= 0.0 && rho > 0.0)
+  const double skip_at_or_below = skipBelow (rho);
+  if (assess_starts_)
   {
-    const double bound = std::min (1.0, best_ / rho);
-    if (bound != skip_bound_)
+    const StartPlane start = startPlane (a_, leaf_a, b_, leaf_b, T_a_b_, C_);
+    if (passesOver (start, skip_at_or_below))
     {
-      skip_bound_ = bound;
-      skip_below_ = normalCdf (normalQuantile (bound) - kStartPlaneMargin);
+      ++result_.leaf_pairs_tested;  // tested, as the cap (max_leaf_fits) counts it, not fitted
+      return normalCdf (start.z);
     }
-    skip_at_or_below = skip_below_;
+    // The first pair is always fitted: the traversal's pruning needs a maximum to start from.
+    if (start.z < kSetAsideBelowZ && best_ >= 0.0)
+    {
+      ++result_.leaf_pairs_tested;
+      starts_.push_back ({&leaf_a, &leaf_b, rho, start, true});
+      if (starts_.size () >= kSetAsideCap)
+        starts_stopped_ = flushStarts (request_.collision_above, request_.exhaustive);
+      return so_far ();
+    }
   }
   if (!fit (leaf_a, leaf_b, lazy_kernel_ ? KernelMode::Linear : classifier_.getParams ().kernel, skip_at_or_below))
     return std::numeric_limits<double>::quiet_NaN ();
@@ -126,16 +170,49 @@ LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const Probabilis
   }
   if (lazy_kernel_ && classifier_.needsKernel (leaf_))
   {
-    deferred_.push_back ({&leaf_a, &leaf_b, rho});
-    return 0.0;
+    deferred_.push_back ({&leaf_a, &leaf_b, rho, StartPlane (), false});
+    return so_far ();
   }
   record (leaf_a, leaf_b, rho);
-  return leaf_.probability;
+  return std::max (leaf_.probability, so_far ());
+}
+
+bool
+LeafPairTest::flushStarts (double stop_probability, bool exhaustive)
+{
+  std::stable_sort (starts_.begin (), starts_.end (),
+                    [] (const Deferred& x, const Deferred& y) { return x.start.z > y.start.z; });
+  bool stopped = false;
+  for (const Deferred& d : starts_)
+  {
+    if (d.rho <= best_)
+      continue;  // dominated (assess_starts_ implies skip_dominated_)
+    const double skip_at_or_below = skipBelow (d.rho);
+    if (passesOver (d.start, skip_at_or_below))
+      continue;
+    if (!fit (*d.a, *d.b, lazy_kernel_ ? KernelMode::Linear : classifier_.getParams ().kernel, skip_at_or_below) ||
+        leaf_.dominated)
+      continue;
+    if (lazy_kernel_ && classifier_.needsKernel (leaf_))
+    {
+      deferred_.push_back (d);
+      continue;
+    }
+    if (record (*d.a, *d.b, d.rho, false) > stop_probability && !exhaustive)
+    {
+      stopped = true;
+      break;
+    }
+  }
+  starts_.clear ();
+  return stopped;
 }
 
 bool
 LeafPairTest::finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated)
 {
+  if (starts_stopped_ || flushStarts (stop_probability, exhaustive))
+    return true;
   std::stable_sort (deferred_.begin (), deferred_.end (),
                     [] (const Deferred& x, const Deferred& y) { return x.rho > y.rho; });
   for (const Deferred& d : deferred_)
@@ -144,7 +221,7 @@ LeafPairTest::finishDeferred (double stop_probability, bool exhaustive, bool ski
       break;  // sorted: every later pair is dominated too
     if (!fit (*d.a, *d.b, KernelMode::Ladder))
       continue;
-    if (record (*d.a, *d.b, d.rho) > stop_probability && !exhaustive)
+    if (record (*d.a, *d.b, d.rho, !d.counted) > stop_probability && !exhaustive)
       return true;
   }
   return false;

@@ -7,6 +7,7 @@
 #include <pcl_probcollision/collision_result.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/robust_classifier.h>
+#include <pcl_probcollision/detail/start_plane.h>
 
 #include <Eigen/Geometry>
 
@@ -25,6 +26,12 @@ namespace detail
   * Passed to traverseHierarchies() as its leaf test. With request.defer_kernel_fits a pair
   * whose plane asks for a kernel rung is set aside (contributing 0) and fitted in full by
   * finishDeferred(), largest reach weight first.
+  *
+  * With skip_dominated (no per-point values), each pair's start plane is first assessed from
+  * the two hierarchies' own arrays, without gathering the points (detail::startPlane()). A pair it
+  * shows dominated is passed over; a pair it shows far from reaching is set aside and fitted
+  * later, largest start first (flushStarts()), so that the maximum rises early and more pairs
+  * are passed over, and a collision stops before the pairs that cannot decide it are fitted.
   */
 class LeafPairTest
 {
@@ -52,19 +59,30 @@ public:
   const std::string& firstFailure () const { return failure_; }
 
 private:
+  /** \brief The start-plane bound of a pair of reach weight rho (RobustClassifier::classify's
+    * skip_at_or_below; -1 when none applies). */
+  double skipBelow (double rho);
+  /** \brief Fits the pairs set aside by their start planes, largest start z first; true when a
+    * contribution exceeded stop_probability and exhaustive is off. */
+  bool flushStarts (double stop_probability, bool exhaustive);
+
   /** \brief Fits one pair with the given kernel mode into leaf_ (not when its start plane's
     * maximum is at most skip_at_or_below: leaf_.dominated); false (failure noted) when it has
     * no usable separator. */
   bool fit (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, KernelMode kernel,
             double skip_at_or_below = -1.0);
-  /** \brief Takes the fit in leaf_ into the result; returns its contribution rho * P_leaf. */
-  double record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
+  /** \brief Takes the fit in leaf_ into the result (counted as a tested pair unless it was
+    * counted when set aside); returns its contribution rho * P_leaf. */
+  double record (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho,
+                 bool count = true);
 
   struct Deferred
   {
     const ProbabilisticBVH::Node* a;
     const ProbabilisticBVH::Node* b;
     double rho;
+    StartPlane start;      ///< for the pairs set aside by their start planes
+    bool counted = false;  ///< counted as tested when set aside (by its start plane)
   };
 
   const ProbabilisticBVH& a_;
@@ -87,6 +105,12 @@ private:
   std::string failure_;
   std::size_t failures_ = 0;
   std::vector<Deferred> deferred_;
+  /** \brief Start planes assessed before any gather (skip_dominated, not RFF, squared hinge). */
+  bool assess_starts_ = false;
+  double C_ = 0.0;  ///< the classifier's C, for startPlane()
+  /** \brief Pairs set aside by their start planes, and whether a flush of them stopped. */
+  std::vector<Deferred> starts_;
+  bool starts_stopped_ = false;
 };
 } // namespace detail
 } // namespace pcl_probcollision
