@@ -55,7 +55,7 @@ LeafPairTest::LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b
   // traversal may stop at a shallower pair before any kernel fit, and P is a lower bound
   // below the default's.
   lazy_kernel_ = request.defer_kernel_fits && !request.per_point && classifier.getParams ().kernel == KernelMode::Ladder;
-  // startPlane() mirrors classify()'s start and its pass-over test for the plane rungs and the
+  // detail/start_plane.h mirrors classify()'s start and its pass-over test for the plane rungs and the
   // default loss; otherwise every pair goes to classify() as it comes.
   assess_starts_ = skip_dominated && classifier.getParams ().kernel != KernelMode::RFF &&
                    classifier.getParams ().loss == Loss::SquaredHinge;
@@ -145,17 +145,17 @@ LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const Probabilis
   const double skip_at_or_below = skipBelow (rho);
   if (assess_starts_)
   {
-    const StartPlane start = startPlane (a_, leaf_a, b_, leaf_b, T_a_b_, C_);
-    if (passesOver (start, skip_at_or_below))
+    const double z = startPlaneZ (a_, leaf_a, b_, leaf_b, T_a_b_);
+    if (passesOver (a_, leaf_a, b_, leaf_b, T_a_b_, C_, z, skip_at_or_below))
     {
       ++result_.leaf_pairs_tested;  // tested, as the cap (max_leaf_fits) counts it, not fitted
-      return normalCdf (start.z);
+      return normalCdf (z);
     }
     // The first pair is always fitted: the traversal's pruning needs a maximum to start from.
-    if (start.z < kSetAsideBelowZ && best_ >= 0.0)
+    if (z < kSetAsideBelowZ && best_ >= 0.0)
     {
       ++result_.leaf_pairs_tested;
-      starts_.push_back ({&leaf_a, &leaf_b, rho, start, true});
+      starts_.push_back ({&leaf_a, &leaf_b, rho, z, true});
       if (starts_.size () >= kSetAsideCap)
         starts_stopped_ = flushStarts (request_.collision_above, request_.exhaustive);
       return so_far ();
@@ -170,7 +170,7 @@ LeafPairTest::operator() (const ProbabilisticBVH::Node& leaf_a, const Probabilis
   }
   if (lazy_kernel_ && classifier_.needsKernel (leaf_))
   {
-    deferred_.push_back ({&leaf_a, &leaf_b, rho, StartPlane (), false});
+    deferred_.push_back ({&leaf_a, &leaf_b, rho, 0.0, false});
     return so_far ();
   }
   record (leaf_a, leaf_b, rho);
@@ -181,14 +181,14 @@ bool
 LeafPairTest::flushStarts (double stop_probability, bool exhaustive)
 {
   std::stable_sort (starts_.begin (), starts_.end (),
-                    [] (const Deferred& x, const Deferred& y) { return x.start.z > y.start.z; });
+                    [] (const Deferred& x, const Deferred& y) { return x.start_z > y.start_z; });
   bool stopped = false;
   for (const Deferred& d : starts_)
   {
     if (d.rho <= best_)
       continue;  // dominated (assess_starts_ implies skip_dominated_)
     const double skip_at_or_below = skipBelow (d.rho);
-    if (passesOver (d.start, skip_at_or_below))
+    if (passesOver (a_, *d.a, b_, *d.b, T_a_b_, C_, d.start_z, skip_at_or_below))
       continue;
     if (!fit (*d.a, *d.b, lazy_kernel_ ? KernelMode::Linear : classifier_.getParams ().kernel, skip_at_or_below) ||
         leaf_.dominated)

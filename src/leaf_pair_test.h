@@ -28,7 +28,7 @@ namespace detail
   * finishDeferred(), largest reach weight first.
   *
   * With skip_dominated (no per-point values), each pair's start plane is first assessed from
-  * the two hierarchies' own arrays, without gathering the points (detail::startPlane()). A pair it
+  * the two hierarchies' own arrays, without gathering the points (detail/start_plane.h). A pair it
   * shows dominated is passed over; a pair it shows far from reaching is set aside and fitted
   * later, largest start first (flushStarts()), so that the maximum rises early and more pairs
   * are passed over, and a collision stops before the pairs that cannot decide it are fitted.
@@ -81,7 +81,7 @@ private:
     const ProbabilisticBVH::Node* a;
     const ProbabilisticBVH::Node* b;
     double rho;
-    StartPlane start;      ///< for the pairs set aside by their start planes
+    double start_z;        ///< the start plane's largest z_i (detail::startPlaneZ())
     bool counted = false;  ///< counted as tested when set aside (by its start plane)
   };
 
@@ -107,7 +107,7 @@ private:
   std::vector<Deferred> deferred_;
   /** \brief Start planes assessed before any gather (skip_dominated, not RFF, squared hinge). */
   bool assess_starts_ = false;
-  double C_ = 0.0;  ///< the classifier's C, for startPlane()
+  double C_ = 0.0;  ///< the classifier's C, for detail::passesOver()
   /** \brief Pairs set aside by their start planes, and whether a flush of them stopped. */
   std::vector<Deferred> starts_;
   bool starts_stopped_ = false;

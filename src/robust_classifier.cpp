@@ -6,6 +6,7 @@
 
 #include <pcl_probcollision/detail/point_probabilities.h>
 #include <pcl_probcollision/detail/rff_features.h>
+#include <pcl_probcollision/detail/linear_separator.h>
 #include <pcl_probcollision/detail/separator_fit.h>
 #include <pcl_probcollision/detail/separator_problem.h>
 #include <pcl_probcollision/normalization.h>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <utility>
 
 namespace pcl_probcollision
@@ -243,10 +245,13 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   // no solve when the plane Newton would start from already leaves every point there.
   // The start is computed once: the plane's fit below starts from it.
   Eigen::Vector4d start;
+  std::optional<detail::LinearSeparatorSolver> plane;  // one for the start and the fit
+  if (kernel != KernelMode::RFF)
+    plane.emplace (p, loss);
   const bool have_start = skip_at_or_below >= 0.0 && kernel != KernelMode::RFF;
   if (have_start)
   {
-    start = detail::linearStart (p, loss);
+    start = plane->start ();
     const double p0 = detail::meansPlaneMaximum (p, start, in_maximum);
     if (p0 < 0.5 && p0 <= skip_at_or_below)
     {
@@ -268,7 +273,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
   else
   {
-    best = detail::fitLinear (p, params_, loss, gamma, have_start ? &start : nullptr);
+    best = detail::fitLinear (p, params_, loss, gamma, *plane, have_start ? &start : nullptr);
     iterations = best.iterations;
     result.rungs_tried = 1;
     if (kernel == KernelMode::Ladder)

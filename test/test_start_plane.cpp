@@ -32,9 +32,9 @@ leaves (const ProbabilisticBVH& bvh)
 } // namespace
 
 // Every leaf pair of two noisy sheets (one tilted and moved, at gaps from penetrating to well
-// apart, at two noise levels): where startPlane() says the plane is usable, classify() starts
-// from the same plane (its passed-over maximum equals Phi(z)), and wherever passesOver() says
-// yes for a threshold, classify() passes the pair over at that threshold.
+// apart, at two noise levels): where startPlaneUsable() says yes, classify() starts from the
+// same plane (its passed-over maximum equals Phi(z)), and wherever passesOver() says yes for a
+// threshold, classify() passes the pair over at that threshold.
 TEST (StartPlane, AgreesWithTheClassifiersStartAndPassOver)
 {
   const ClassifierParams params;
@@ -56,27 +56,28 @@ TEST (StartPlane, AgreesWithTheClassifiersStartAndPassOver)
       for (const ProbabilisticBVH::Node* la : leaves (a))
         for (const ProbabilisticBVH::Node* lb : leaves (b))
         {
-          const StartPlane start = startPlane (a, *la, b, *lb, T, params.C);
+          const double z = startPlaneZ (a, *la, b, *lb, T);
+          const bool usable_start = startPlaneUsable (a, *la, b, *lb, T, params.C);
           const PointSetView va = a.gatherPoints (*la, ma, ca);
           const PointSetView vb = b.gatherPoints (*lb, T, mb, cb);
           ClassifierResult r;
           ASSERT_TRUE (classifier.classify (va, vb, r, KernelMode::Ladder, 1.0, false)) << r.message;
-          if (start.usable)
+          if (usable_start)
           {
             ++usable;
             // Passed over at 1.0 exactly when the plane separates every point (P under 0.5).
             if (r.dominated)
             {
               ++separable;
-              EXPECT_NEAR (r.probability, normalCdf (start.z), 1e-9 * std::max (1e-300, r.probability) + 1e-15);
+              EXPECT_NEAR (r.probability, normalCdf (z), 1e-9 * std::max (1e-300, r.probability) + 1e-15);
             }
-            else if (std::isfinite (start.z))
-              EXPECT_GE (normalCdf (start.z), 0.5 - 1e-12);
+            else if (std::isfinite (z))
+              EXPECT_GE (normalCdf (z), 0.5 - 1e-12);
           }
           for (int k = 0; k < 3; ++k)
           {
             const double threshold = k == 0 ? 1.0 : unit (rng) * (k == 1 ? 0.5 : 1e-3);
-            if (!passesOver (start, threshold))
+            if (!passesOver (a, *la, b, *lb, T, params.C, z, threshold))
             {
               ++kept;
               continue;
@@ -85,7 +86,7 @@ TEST (StartPlane, AgreesWithTheClassifiersStartAndPassOver)
             ClassifierResult at;
             ASSERT_TRUE (classifier.classify (va, vb, at, KernelMode::Ladder, threshold, false)) << at.message;
             EXPECT_TRUE (at.dominated) << "passesOver() said yes where classify() fits (threshold " << threshold
-                                       << ", z " << start.z << ")";
+                                       << ", z " << z << ")";
           }
         }
     }
@@ -101,14 +102,15 @@ TEST (StartPlane, CoincidingMeansAreNeverPassedOver)
 {
   const ProbabilisticBVH a (randomSheet (40, 0.05, 0.0, 0.002, 5));
   const ProbabilisticBVH::Node& root = a.nodes ().front ();
-  const StartPlane start = startPlane (a, root, a, root, Eigen::Isometry3d::Identity (), 1000.0);
-  EXPECT_TRUE (std::isinf (start.z) && start.z > 0.0);
-  EXPECT_FALSE (passesOver (start, 1.0));
+  const double z = startPlaneZ (a, root, a, root, Eigen::Isometry3d::Identity ());
+  EXPECT_TRUE (std::isinf (z) && z > 0.0);
+  EXPECT_FALSE (startPlaneUsable (a, root, a, root, Eigen::Isometry3d::Identity (), 1000.0));
+  EXPECT_FALSE (passesOver (a, root, a, root, Eigen::Isometry3d::Identity (), 1000.0, z, 1.0));
 }
 
 // With a small C the bisector's |w|^2 / 2 outweighs theta = 0's hinge losses when the patches lie
 // close against their width: classify() then starts from theta = 0 and fits the pair, however
-// clearly the bisector separates it, and startPlane() must not call it usable.
+// clearly the bisector separates it, and startPlaneUsable() must say no.
 TEST (StartPlane, APlaneTheClassifierWouldNotStartFromIsNotUsable)
 {
   ClassifierParams params;
@@ -119,17 +121,17 @@ TEST (StartPlane, APlaneTheClassifierWouldNotStartFromIsNotUsable)
   const Eigen::Isometry3d T (Eigen::Translation3d (0.0, 0.0, -0.05));
   const ProbabilisticBVH::Node& ra = a.nodes ()[ProbabilisticBVH::rootId ()];
   const ProbabilisticBVH::Node& rb = b.nodes ()[ProbabilisticBVH::rootId ()];
-  const StartPlane start = startPlane (a, ra, b, rb, T, params.C);
-  EXPECT_LT (normalCdf (start.z), 1e-6) << "the bisector separates the two sheets clearly";
-  EXPECT_FALSE (start.usable);
-  EXPECT_FALSE (passesOver (start, 1.0));
+  const double z = startPlaneZ (a, ra, b, rb, T);
+  EXPECT_LT (normalCdf (z), 1e-6) << "the bisector separates the two sheets clearly";
+  EXPECT_TRUE (mayPassOver (z, 1.0));
+  EXPECT_FALSE (startPlaneUsable (a, ra, b, rb, T, params.C));
+  EXPECT_FALSE (passesOver (a, ra, b, rb, T, params.C, z, 1.0));
   std::vector<Eigen::Vector3d> ma, mb;
   std::vector<Eigen::Matrix3d> ca, cb;
   ClassifierResult r;
   ASSERT_TRUE (classifier.classify (a.gatherPoints (ra, ma, ca), b.gatherPoints (rb, T, mb, cb), r, KernelMode::Ladder, 1.0));
   EXPECT_FALSE (r.dominated) << "classify() starts from theta = 0 here and fits";
   // The same sheets with the default C: the plane is usable and both pass the pair over.
-  const StartPlane usual = startPlane (a, ra, b, rb, T, ClassifierParams ().C);
-  EXPECT_TRUE (usual.usable);
-  EXPECT_TRUE (passesOver (usual, 1.0));
+  EXPECT_TRUE (startPlaneUsable (a, ra, b, rb, T, ClassifierParams ().C));
+  EXPECT_TRUE (passesOver (a, ra, b, rb, T, ClassifierParams ().C, z, 1.0));
 }

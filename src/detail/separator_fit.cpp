@@ -85,12 +85,11 @@ train (const SeparatorProblem& p, const ClassifierParams& params, double gamma, 
 } // namespace
 
 RungFit
-fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
-           const MarginLoss& loss, double gamma, const Eigen::Vector4d* start)
+fitLinear (const SeparatorProblem& p, const ClassifierParams& params, const MarginLoss& loss,
+           double gamma, LinearSeparatorSolver& solver, const Eigen::Vector4d* start)
 {
   RungFit fit;
   fit.rung = Rung::Linear;
-  LinearSeparatorSolver solver (p, loss);
   Eigen::Vector4d theta = start ? *start : solver.start ();
   train (
       p, params, gamma, [&] (double g) { return solver.solve (theta, g, params.max_iterations); },
@@ -101,12 +100,6 @@ fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
       fit);
   fit.theta = theta;
   return fit;
-}
-
-Eigen::Vector4d
-linearStart (const SeparatorProblem& p, const MarginLoss& loss)
-{
-  return LinearSeparatorSolver (p, loss).start ();
 }
 
 double

@@ -35,10 +35,12 @@ public:
 
   /** \brief The start of METHOD.md 5.3: f(m_+) = 1, f(m_-) = -1 with m_+- the class means;
     * theta = 0 when the means coincide or when that start is worse than theta = 0 (means
-    * that nearly coincide would give an enormous w). */
+    * that nearly coincide would give an enormous w). The Standard solve from it reuses its
+    * evaluation there. */
   Eigen::Vector4d
   start ()
   {
+    evaluated_ = false;
     const Eigen::Index n = p_.n, na = p_.n_a, nb = n - na;
     const Eigen::Vector3d mp (p_.x.head (na).mean (), p_.y.head (na).mean (), p_.z.head (na).mean ());
     const Eigen::Vector3d mm (p_.x.tail (nb).mean (), p_.y.tail (nb).mean (), p_.z.tail (nb).mean ());
@@ -49,8 +51,16 @@ public:
     Eigen::Vector4d theta;
     theta.head<3> () = 2.0 * d / d.squaredNorm ();
     theta (3) = -theta.head<3> ().dot (0.5 * (mp + mm));
-    if (!theta.allFinite () || objective (theta, 0.0, v_, s_) > objective (zero, 0.0, v_, s_))
+    if (!theta.allFinite ())
       return zero;
+    // theta = 0 first, so that the work arrays end with theta's evaluation
+    const double at_zero = objective (zero, 0.0, v_, s_);
+    const double at_theta = objective (theta, 0.0, v_, s_);
+    if (at_theta > at_zero)
+      return zero;
+    evaluated_ = true;
+    evaluated_theta_ = theta;
+    evaluated_value_ = at_theta;
     return theta;
   }
 
@@ -71,7 +81,10 @@ public:
   solve (Eigen::Vector4d& theta, double gamma, int max_iterations)
   {
     SolverReport report;
-    double value = objective (theta, gamma, v_, s_);
+    // The Standard solve from start()'s theta has its evaluation already (v_, s_ and J).
+    double value = evaluated_ && gamma == 0.0 && theta == evaluated_theta_ ? evaluated_value_
+                                                                          : objective (theta, gamma, v_, s_);
+    evaluated_ = false;
     for (;;)
     {
       Eigen::Vector4d gradient;
@@ -150,6 +163,10 @@ private:
   MarginLoss loss_;
   LinearPoints points_;
   Eigen::ArrayXd v_, s_, v_trial_, s_trial_;
+  /** \brief v_ and s_ hold the Standard evaluation at evaluated_theta_, whose J is evaluated_value_. */
+  bool evaluated_ = false;
+  Eigen::Vector4d evaluated_theta_ = Eigen::Vector4d::Zero ();
+  double evaluated_value_ = 0.0;
 };
 } // namespace detail
 } // namespace pcl_probcollision

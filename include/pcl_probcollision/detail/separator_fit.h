@@ -46,19 +46,18 @@ struct RungFit
   }
 };
 
+class LinearSeparatorSolver;
+
 /** \brief The plane: Standard solve, then for Robust training the re-solve with the capped
   * gamma (METHOD.md 5.2, 5.3); assessed at the end.
   * \param[in] gamma Phi^-1(confidence), the uncapped gamma
-  * \param[in] start the Newton start, linearStart (p, loss) when null (given when the caller
-  *            has it already) */
-RungFit fitLinear (const SeparatorProblem& p, const ClassifierParams& params,
-                   const MarginLoss& loss, double gamma, const Eigen::Vector4d* start = nullptr);
+  * \param[in] solver the plane's solver on p (detail/linear_separator.h), built once a problem
+  * \param[in] start the Newton start, solver.start () when null (given when the caller has it
+  *            already: the solve then reuses the solver's evaluation there) */
+RungFit fitLinear (const SeparatorProblem& p, const ClassifierParams& params, const MarginLoss& loss,
+                   double gamma, LinearSeparatorSolver& solver, const Eigen::Vector4d* start = nullptr);
 
-/** \brief The plane Newton starts from: f = 1 and -1 at the class means (METHOD.md 5.3), or
-  * theta = 0 when that start is unusable. */
-Eigen::Vector4d linearStart (const SeparatorProblem& p, const MarginLoss& loss);
-
-/** \brief max_i P_i of the plane start (linearStart()), with assessFit()'s P_i, over the points
+/** \brief max_i P_i of the plane start (LinearSeparatorSolver::start()), with assessFit()'s P_i, over the points
   * marked in uncertain (every point when it is null); NaN when start is theta = 0. No solve. */
 double meansPlaneMaximum (const SeparatorProblem& p, const Eigen::Vector4d& start, const std::vector<bool>* uncertain);
 
