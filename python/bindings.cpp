@@ -856,7 +856,7 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("expanded_k_sigma", &CollisionRequest::expanded_k_sigma)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
       .def_readwrite ("max_leaf_fits", &CollisionRequest::max_leaf_fits,
-                      "At most this many leaf pairs tested (fitted, or passed over unfitted) a query, nearest first; 0 = no cap.")
+                      "At most this many leaf pairs tested (fitted, passed over unfitted, or set aside) a query, nearest first; 0 = no cap.")
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
@@ -939,7 +939,7 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("points_skipped_nonfinite", &CollisionResult::points_skipped_nonfinite)
       .def_readonly ("bv_tests", &CollisionResult::bv_tests)
       .def_readonly ("leaf_pairs_tested", &CollisionResult::leaf_pairs_tested,
-                     "Leaf pairs tested: fitted, or passed over unfitted because their start plane could not raise P.")
+                     "Leaf pairs tested: fitted, passed over unfitted because their start plane could not raise P, or set aside by it.")
       .def_readonly ("kernel_leaf_pairs", &CollisionResult::kernel_leaf_pairs)
       .def_readonly ("degenerate_leaf_pairs", &CollisionResult::degenerate_leaf_pairs)
       .def_readonly ("classifier_iterations", &CollisionResult::classifier_iterations)

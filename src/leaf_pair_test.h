@@ -24,7 +24,7 @@ namespace detail
   * per_point), the running maximum and its witness (in A's frame, the hierarchies' frame).
   *
   * Passed to traverseHierarchies() as its leaf test. With request.defer_kernel_fits a pair
-  * whose plane asks for a kernel rung is set aside (contributing 0) and fitted in full by
+  * whose plane asks for a kernel rung is set aside (contributing nothing yet) and fitted in full by
   * finishDeferred(), largest reach weight first.
   *
   * With skip_dominated (no per-point values), each pair's start plane is first assessed from
@@ -44,7 +44,10 @@ public:
                 bool skip_dominated);
 
   /** \brief The traversal's leaf test: P_leaf of the two leaves, NaN when the classifier has
-    * no usable separator (counted in failures()), 0 for a pair set aside. */
+    * no usable separator (counted in failures()). For a pair set aside (its kernel rungs with
+    * defer_kernel_fits, or the whole pair by its start plane) it returns the largest fitted
+    * contribution so far over rho, rounded down: a lower bound of the final maximum for the
+    * traversal's pruning. */
   double operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
 
   /** \brief Fits the pairs set aside, largest reach weight first, skipping those that cannot

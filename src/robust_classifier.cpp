@@ -4,9 +4,9 @@
 // src/detail/point_probabilities.cpp, and their loops run in src/detail/kernels.cpp.
 #include <pcl_probcollision/robust_classifier.h>
 
+#include <pcl_probcollision/detail/linear_separator.h>
 #include <pcl_probcollision/detail/point_probabilities.h>
 #include <pcl_probcollision/detail/rff_features.h>
-#include <pcl_probcollision/detail/linear_separator.h>
 #include <pcl_probcollision/detail/separator_fit.h>
 #include <pcl_probcollision/detail/separator_problem.h>
 #include <pcl_probcollision/normalization.h>
@@ -273,7 +273,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   }
   else
   {
-    best = detail::fitLinear (p, params_, loss, gamma, *plane, have_start ? &start : nullptr);
+    best = detail::fitLinear (p, params_, gamma, *plane, have_start ? &start : nullptr);
     iterations = best.iterations;
     result.rungs_tried = 1;
     if (kernel == KernelMode::Ladder)

@@ -114,8 +114,10 @@ struct CollisionResult
   std::size_t points_b = 0;                  ///< finite points of B used
   std::size_t points_skipped_nonfinite = 0;  ///< NaN / Inf points skipped, both clouds
   std::size_t bv_tests = 0;                  ///< node pairs tested
-  /** \brief Leaf pairs tested: fitted, or passed over unfitted because their start plane could
-    * not raise the maximum (RobustClassifier::classify's skip_at_or_below). */
+  /** \brief Leaf pairs tested: fitted; passed over unfitted because their start plane could
+    * not raise the maximum (RobustClassifier::classify's skip_at_or_below); or set aside by
+    * their start plane to be fitted later, which a query that stops at a collision first
+    * never fits. */
   std::size_t leaf_pairs_tested = 0;
   std::size_t kernel_leaf_pairs = 0;         ///< of which needed an RFF rung
   std::size_t degenerate_leaf_pairs = 0;     ///< of which had no separating direction

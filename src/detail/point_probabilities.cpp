@@ -2,7 +2,6 @@
 // Per-point collision probabilities of a fitted rung (METHOD.md 6.1).
 #include <pcl_probcollision/detail/point_probabilities.h>
 
-#include <limits>
 
 namespace pcl_probcollision
 {
@@ -13,7 +12,6 @@ assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
 {
   const Eigen::Index n = p.n;
   fit.z.resize (n);
-  constexpr double kInf = std::numeric_limits<double>::infinity ();
   fit.misclassified = 0;
   Eigen::Index collapsed = 0;
   // Point by point: no temporary arrays (this runs for every leaf pair's fit).
@@ -29,15 +27,10 @@ assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
       ++fit.misclassified;
       ++collapsed;
     }
-    else if (sigma < kNoSpread)
-    {
-      fit.z (i) = u < -kNoSpread ? kInf : (u <= kNoSpread ? 0.0 : -kInf);  // P_i 1, 0.5 or 0
-      fit.misclassified += u < -kNoSpread;
-    }
     else
     {
-      fit.z (i) = -u / sigma;
-      fit.misclassified += u < -depth_sigmas * sigma;
+      fit.z (i) = pointZ (u, sigma);
+      fit.misclassified += sigma < kNoSpread ? u < -kNoSpread : u < -depth_sigmas * sigma;
     }
   }
   fit.degenerate = collapsed == n;

@@ -85,8 +85,8 @@ train (const SeparatorProblem& p, const ClassifierParams& params, double gamma, 
 } // namespace
 
 RungFit
-fitLinear (const SeparatorProblem& p, const ClassifierParams& params, const MarginLoss& loss,
-           double gamma, LinearSeparatorSolver& solver, const Eigen::Vector4d* start)
+fitLinear (const SeparatorProblem& p, const ClassifierParams& params, double gamma, LinearSeparatorSolver& solver,
+           const Eigen::Vector4d* start)
 {
   RungFit fit;
   fit.rung = Rung::Linear;
@@ -111,23 +111,17 @@ meansPlaneMaximum (const SeparatorProblem& p, const Eigen::Vector4d& theta, cons
     return std::numeric_limits<double>::quiet_NaN ();
   RungFit plane;
   plane.plane_gradient = w;
-  // assessFit's P_i = Phi(-u_i / sigma_i) is increasing in k_i = -u_i / sigma_i, so the
-  // maximum needs one normal tail, at the largest k_i (its no-spread cases as +-inf and 0).
+  // assessFit's P_i = Phi(z_i) rises with z_i, so the maximum needs one normal tail, at the
+  // largest z_i.
   double largest = -std::numeric_limits<double>::infinity ();
   for (Eigen::Index i = 0; i < p.n; ++i)
     if (!uncertain || (*uncertain)[static_cast<std::size_t> (i)])
     {
       const double f = theta (0) * p.x (i) + theta (1) * p.y (i) + theta (2) * p.z (i) + theta (3);
       const double u = p.label (i) * f / norm;
-      const double sigma = std::sqrt (quadraticForm (p, plane, i)) / norm;
-      const double k = sigma < kNoSpread ? (u < -kNoSpread ? std::numeric_limits<double>::infinity ()
-                                                            : (u <= kNoSpread ? 0.0 : -std::numeric_limits<double>::infinity ()))
-                                         : -u / sigma;
-      largest = std::max (largest, k);
+      largest = std::max (largest, pointZ (u, std::sqrt (quadraticForm (p, plane, i)) / norm));
     }
-  return largest == std::numeric_limits<double>::infinity () ? 1.0
-       : largest == -std::numeric_limits<double>::infinity () ? 0.0
-       : normalCdf (largest);
+  return normalCdf (largest);  // 1 and 0 at +-inf
 }
 
 RungFit

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <limits>
 
 namespace pcl_probcollision
 {
@@ -39,6 +40,18 @@ inline double
 gradientNorm (const RungFit& fit, Eigen::Index i)
 {
   return std::sqrt (fit.gx (i) * fit.gx (i) + fit.gy (i) * fit.gy (i) + fit.gz (i) * fit.gz (i));
+}
+
+/** \brief z of a point at signed distance u from the surface (positive on its own side) with
+  * standard deviation sigma along the normal, P = Phi(z): -u / sigma, or for sigma < kNoSpread
+  * +inf, 0 or -inf by the sign of u (tolerance kNoSpread), i.e. P = 1, 0.5 or 0. */
+inline double
+pointZ (double u, double sigma)
+{
+  constexpr double inf = std::numeric_limits<double>::infinity ();
+  if (sigma < kNoSpread)
+    return u < -kNoSpread ? inf : (u <= kNoSpread ? 0.0 : -inf);
+  return -u / sigma;
 }
 
 /** \brief METHOD.md 6.1 for every point, and the ladder's misclassification count: fills

@@ -10,10 +10,9 @@
 
 #include <Eigen/Core>
 
-#include <vector>
-
 #include <cstddef>
 #include <limits>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -51,11 +50,12 @@ class LinearSeparatorSolver;
 /** \brief The plane: Standard solve, then for Robust training the re-solve with the capped
   * gamma (METHOD.md 5.2, 5.3); assessed at the end.
   * \param[in] gamma Phi^-1(confidence), the uncapped gamma
-  * \param[in] solver the plane's solver on p (detail/linear_separator.h), built once a problem
+  * \param[in] solver the plane's solver on p with its loss (detail/linear_separator.h), built
+  *            once a problem
   * \param[in] start the Newton start, solver.start () when null (given when the caller has it
   *            already: the solve then reuses the solver's evaluation there) */
-RungFit fitLinear (const SeparatorProblem& p, const ClassifierParams& params, const MarginLoss& loss,
-                   double gamma, LinearSeparatorSolver& solver, const Eigen::Vector4d* start = nullptr);
+RungFit fitLinear (const SeparatorProblem& p, const ClassifierParams& params, double gamma,
+                   LinearSeparatorSolver& solver, const Eigen::Vector4d* start = nullptr);
 
 /** \brief max_i P_i of the plane start (LinearSeparatorSolver::start()), with assessFit()'s P_i, over the points
   * marked in uncertain (every point when it is null); NaN when start is theta = 0. No solve. */

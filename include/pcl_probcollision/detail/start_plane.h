@@ -8,12 +8,11 @@
 
 #include <Eigen/Geometry>
 
-
 namespace pcl_probcollision
 {
 namespace detail
 {
-/** \brief Rounding room of startPlane()'s tests against RobustClassifier::classify()'s own:
+/** \brief Rounding room of mayPassOver() and startPlaneUsable() against RobustClassifier::classify()'s own:
   * relative, far above the differences of the two computations (about 1e-14), so that the
   * tests lean to fitting. */
 constexpr double kStartSlack = 1e-7;
