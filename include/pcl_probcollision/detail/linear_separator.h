@@ -75,7 +75,8 @@ public:
 
   /** \brief Minimises J from theta (in/out).
     * Stops when |grad J| <= 1e-10 max(1, |J|) (converged), when an accepted step is shorter
-    * than 1e-12 (converged: no representable progress left), when the line search cannot
+    * than 1e-12 or the Newton step is within rounding (withinRounding(); converged: no
+    * representable progress left), when the line search cannot
     * decrease J (not converged unless the gradient test holds) or after max_iterations. */
   SolverReport
   solve (Eigen::Vector4d& theta, double gamma, int max_iterations)
@@ -109,6 +110,11 @@ public:
       const double slope = gradient.dot (step);
       if (!(slope < 0.0))
         break;
+      if (withinRounding (theta, step, slope, value))
+      {
+        report.converged = true;
+        break;
+      }
       // Armijo backtracking, c = 1e-4, halving (at most 60 times: t >= 2^-60)
       double t = 1.0, trial_value = 0.0;
       bool accepted = false;
@@ -140,6 +146,22 @@ public:
   }
 
 private:
+  /** \brief Predicted decreases of J below this share of max(1, |J|) are within J's rounding:
+    * its n terms are summed with a relative error of about n 1e-16. */
+  static constexpr double kRoundingDecrease = 1e-14;
+  /** \brief Newton steps shorter than this share of max(1, |theta|) move theta by rounding. */
+  static constexpr double kRoundingStep = 1e-7;
+  /** \brief Whether the Newton step from theta can make no representable progress: the
+    * quadratic model's decrease, -slope / 2, is within the rounding of J and the step a
+    * rounding-level move. Armijo's test then passes or fails by the rounding of J, and halving
+    * until it passes (seen down to t = 2^-31 on the Robust re-solves) would only move theta by
+    * about 1e-16, the step rule of METHOD.md 5.3 reached after dozens of evaluations. */
+  static bool
+  withinRounding (const Eigen::Vector4d& theta, const Eigen::Vector4d& step, double slope, double value)
+  {
+    return -slope <= kRoundingDecrease * std::max (1.0, std::abs (value)) &&
+           step.norm () <= kRoundingStep * std::max (1.0, theta.norm ());
+  }
   /** \brief Gradient and generalised Hessian at theta, from the v_ and s_ of theta. */
   void
   derivatives (const Eigen::Vector4d& theta, double gamma, Eigen::Vector4d& gradient,
