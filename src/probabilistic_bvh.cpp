@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/probabilistic_bvh.h>
+#include <pcl_probcollision/detail/node_kernels.h>
 #include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/exceptions.h>
@@ -58,55 +59,6 @@ BVHParams::validate () const
 
 namespace
 {
-// The table of detail::normalTailTabulated: Phi(-z_i) and the step times its derivative at
-// z_i = i / 128 on [0, kNegligibleTailZ], one zero entry past the end; built at load time, so
-// the lookup needs no guard.
-constexpr int kTailSteps = 128 * static_cast<int> (detail::kNegligibleTailZ);
-constexpr double kTailStep = detail::kNegligibleTailZ / kTailSteps;
-struct TailTable
-{
-  double f[kTailSteps + 2];
-  double df[kTailSteps + 2];
-  TailTable ()
-  {
-    for (int i = 0; i <= kTailSteps; ++i)
-    {
-      const double zi = i * kTailStep;
-      f[i] = normalCdf (-zi);
-      df[i] = -kTailStep * 0.39894228040143267794 * std::exp (-0.5 * zi * zi);
-    }
-    f[kTailSteps + 1] = df[kTailSteps + 1] = 0.0;
-  }
-};
-const TailTable kTailTable;
-
-/** \brief normalTailTabulated for z >= 0 (not NaN): cubic Hermite on the table, without a
-  * branch (z beyond the table reads its last node, Phi(-10) = 7.6e-24; a data-dependent branch
-  * here was a tenth of the build). */
-inline double
-tail (double z)
-{
-  const double x = std::min (z * (1.0 / kTailStep), static_cast<double> (kTailSteps));
-  const int i = static_cast<int> (x);
-  const double t = x - i, t2 = t * t, t3 = t2 * t;
-  return (2.0 * t3 - 3.0 * t2 + 1.0) * kTailTable.f[i] + (t3 - 2.0 * t2 + t) * kTailTable.df[i] +
-         (3.0 * t2 - 2.0 * t3) * kTailTable.f[i + 1] + (t3 - t2) * kTailTable.df[i + 1];
-}
-} // namespace
-
-namespace detail
-{
-double
-normalTailTabulated (double z)
-{
-  if (!(z >= 0.0))
-    return z < 0.0 ? 1.0 - normalTailTabulated (-z) : z;  // NaN stays NaN
-  return z < kNegligibleTailZ ? tail (z) : 0.0;
-}
-} // namespace detail
-
-namespace
-{
 // Largest accepted cloud: stored indices (with duplication) and node ranges are int32.
 constexpr std::size_t kMaxPoints = std::size_t (1) << 28;
 
@@ -159,7 +111,9 @@ struct BuildTask
 };
 
 // Split value along one projection: the mean (FCL's rule); the median when rounding leaves a
-// strict side empty; the mid-range as the last resort. Requires max > min.
+// strict side empty; the mid-range as the last resort. Requires max > min; pmin and pmax are the
+// projection's minimum and maximum, so that a value has points strictly on both sides when
+// pmin < value < pmax.
 double
 splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<double>& tmp)
 {
@@ -168,15 +122,7 @@ splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<
   for (double v : p)
     sum += v;
   double s = sum / static_cast<double> (m);
-  auto both_sides = [&] (double v) {
-    bool below = false, above = false;
-    for (double x : p)
-    {
-      below = below || x < v;
-      above = above || x > v;
-    }
-    return below && above;
-  };
+  const auto both_sides = [&] (double v) { return pmin < v && v < pmax; };
   if (both_sides (s))
     return s;
   tmp.assign (p.begin (), p.end ());
@@ -200,6 +146,8 @@ struct NodeGeometry
   std::vector<double> s[3];       // standard deviations sqrt(a_k^T Sigma a_k)
   Eigen::Vector3d lo, hi;         // inflated extents in box coordinates about mean
   Eigen::Vector3d s_max;          // the largest s per axis
+  Eigen::Vector3d q_min, q_max;   // the range of q per axis
+  std::vector<double> outside;    // the points' outside probabilities (nodeLeakage's scratch)
 };
 
 /** \brief The points the build reads: means, the packed covariances the hierarchy keeps, and
@@ -250,74 +198,33 @@ computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, doubl
     g.q[k].resize (m);
     g.s[k].resize (m);
   }
-  g.lo.setConstant (std::numeric_limits<double>::infinity ());
-  g.hi.setConstant (-std::numeric_limits<double>::infinity ());
-  g.s_max.setZero ();
-  const Eigen::Matrix3d At = g.axes.transpose ();
-  for (std::size_t i = 0; i < m; ++i)
-  {
-    const int j = points[i];
-    const Eigen::Vector3d q = At * (cloud.means[j] - mean);
-    for (int k = 0; k < 3; ++k)
-    {
-      // The variance along box axis a from the six distinct entries (a generic 3 x 3 product
-      // per point and node was a tenth of the build).
-      const double var = cloud.covariances[j].quadratic (g.axes.col (k));
-      const double sd = std::sqrt (std::max (0.0, var));
-      g.q[k][i] = q (k);
-      g.s[k][i] = sd;
-      g.lo (k) = std::min (g.lo (k), q (k) - k_sigma * sd);
-      g.hi (k) = std::max (g.hi (k), q (k) + k_sigma * sd);
-      g.s_max (k) = std::max (g.s_max (k), sd);
-    }
-  }
+  detail::NodeExtents out;
+  static_assert (sizeof (Eigen::Vector3d) == 3 * sizeof (double), "means are packed x, y, z");
+  detail::nodeProjections (m, points.data (), cloud.means.data ()->data (), cloud.covariances.data (), g.mean, g.axes,
+                           k_sigma, g.q[0].data (), g.q[1].data (), g.q[2].data (), g.s[0].data (), g.s[1].data (),
+                           g.s[2].data (), out);
+  g.lo = Eigen::Vector3d (out.lo);
+  g.hi = Eigen::Vector3d (out.hi);
+  g.s_max = Eigen::Vector3d (out.s_max);
+  g.q_min = Eigen::Vector3d (out.q_min);
+  g.q_max = Eigen::Vector3d (out.q_max);
 }
 
-/** \brief P_x of point i (METHOD.md 8.4) with the tabulated tail: per box axis the outside
-  * probability 1 - P_slab = Phi(-z_lo) + Phi(-z_hi), z the distances to the two faces in the
-  * point's standard deviations, combined by `bound`. MinSlab (the maximum) skips the axes that
-  * cannot attain it: with d_k = min(z_lo, z_hi) >= 0 (the point is inside its box), axis k's
-  * outside probability lies in [Phi(-d_k), 2 Phi(-d_k)], and Phi(-d - 1) < Phi(-d) / 2 for
-  * d >= 0, so an axis with d_k >= min_j d_j + 1 is strictly below the maximum (most points sit
-  * deep inside along two axes). */
+/** \brief P_leak of the node (METHOD.md 8.4): the (area-weighted) mean of its points' P_x
+  * (detail::nodeOutside()), summed in point order. */
 double
-pointOutside (const NodeGeometry& g, std::size_t i, detail::LeakageBound bound)
-{
-  // s = 0 gives infinite distances, i.e. outside probability 0 on that axis.
-  double z_lo[3], z_hi[3], d[3];
-  double d_min = std::numeric_limits<double>::infinity ();
-  for (int k = 0; k < 3; ++k)
-  {
-    const double s = g.s[k][i];
-    if (s > 0.0)
-    {
-      const double inv = 1.0 / s;
-      z_lo[k] = std::max (0.0, g.q[k][i] - g.lo (k)) * inv;
-      z_hi[k] = std::max (0.0, g.hi (k) - g.q[k][i]) * inv;
-    }
-    else
-      z_lo[k] = z_hi[k] = std::numeric_limits<double>::infinity ();
-    d[k] = std::min (z_lo[k], z_hi[k]);
-    d_min = std::min (d_min, d[k]);
-  }
-  double out[3] = {0.0, 0.0, 0.0};
-  const bool min_slab = bound == detail::LeakageBound::MinSlab;
-  for (int k = 0; k < 3; ++k)
-    if (!(d[k] >= d_min + 1.0) || (!min_slab && std::isfinite (d[k])))
-      out[k] = std::min (1.0, tail (z_lo[k]) + tail (z_hi[k]));
-  return detail::combineSlabs (out[0], out[1], out[2], bound);
-}
-
-double
-nodeLeakage (const BuildPoints& cloud, const std::vector<int>& points, const NodeGeometry& g,
-             detail::LeakageBound bound)
+nodeLeakage (const BuildPoints& cloud, const std::vector<int>& points, NodeGeometry& g, detail::LeakageBound bound)
 {
   const std::size_t m = points.size ();
+  g.outside.resize (m);
+  const double* q[3] = {g.q[0].data (), g.q[1].data (), g.q[2].data ()};
+  const double* s[3] = {g.s[0].data (), g.s[1].data (), g.s[2].data ()};
+  detail::nodeOutside (m, q, s, g.lo.data (), g.hi.data (), bound, g.outside.data ());
   const bool weighted = !cloud.area_weights.empty ();
   double sum_w = 0.0, sum_wp = 0.0, sum_p = 0.0;
   for (std::size_t i = 0; i < m; ++i)
   {
-    const double p = pointOutside (g, i, bound);
+    const double p = g.outside[i];
     sum_p += p;
     if (weighted)
     {
@@ -353,8 +260,7 @@ splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
 {
   const std::vector<double>& p = g.q[0];
   const std::size_t m = points.size ();
-  const auto mm = std::minmax_element (p.begin (), p.end ());
-  const double pmin = *mm.first, pmax = *mm.second;
+  const double pmin = g.q_min (0), pmax = g.q_max (0);
   if (!(pmax > pmin))
     return false;
   const double L = pmax - pmin;
@@ -412,9 +318,8 @@ splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsil
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k)
   {
-    const auto mm = std::minmax_element (g.q[k].begin (), g.q[k].end ());
-    lo[k] = *mm.first;
-    hi[k] = *mm.second;
+    lo[k] = g.q_min (k);
+    hi[k] = g.q_max (k);
     L[k] = hi[k] - lo[k];
   }
   // An axis whose extent is at the rounding level of the longest one (collinear or coplanar
@@ -480,9 +385,7 @@ splitOctree (const std::vector<int>& points, const NodeGeometry& g, double epsil
 bool
 withinNoise (const NodeGeometry& g, double noise_stop, std::vector<double>& tmp)
 {
-  const std::vector<double>& p = g.q[0];
-  const auto mm = std::minmax_element (p.begin (), p.end ());
-  const double L = *mm.second - *mm.first;
+  const double L = g.q_max (0) - g.q_min (0);
   tmp.assign (g.s[0].begin (), g.s[0].end ());
   const std::size_t mid = tmp.size () / 2;
   std::nth_element (tmp.begin (), tmp.begin () + mid, tmp.end ());

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // detail/leakage.h: the probability that a Gaussian point lies outside a box (METHOD.md 8.4,
-// 11.7), its tabulated normal tail, and the leakage a hierarchy node stores (the area-weighted
-// mean over its points). Oracles: closed forms in Phi from std::erfc.
+// 11.7), its tabulated normal tail, the leakage a hierarchy node stores (the area-weighted
+// mean over its points) and the build's per-point passes that compute it (detail/node_kernels.h).
+// Oracles: closed forms in Phi from std::erfc.
 #include <pcl_probcollision/detail/leakage.h>
+#include <pcl_probcollision/detail/node_kernels.h>
 #include <pcl_probcollision/detail/obb.h>
 #include <pcl_probcollision/normal_distribution.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
@@ -123,4 +125,82 @@ TEST (Leakage, AreaWeightsWeightTheMean)
   c.area_weights = {0.0, 0.0};  // no area information: equal weights
   ProbabilisticBVH zero (c);
   EXPECT_FLOAT_EQ (zero.node (0).leakage, static_cast<float> (0.5 * p_noisy));
+}
+
+TEST (Leakage, NodeKernelsMatchTheirDefinitions)
+{
+  // detail::nodeProjections and nodeOutside (the build's vectorised per-point passes, in the
+  // clone this machine runs) against their definitions point by point: 1,003 points (not a
+  // multiple of the lanes), every eleventh with a zero covariance, some repeated.
+  std::mt19937_64 rng (17);
+  std::normal_distribution<double> g;
+  const std::size_t m = 1003;
+  std::vector<Eigen::Vector3d> means;
+  std::vector<PackedCovariance> covariances;
+  std::vector<int> points;
+  for (std::size_t i = 0; i < m; ++i)
+  {
+    means.push_back (i % 13 == 5 ? means.back () : Eigen::Vector3d (g (rng), 0.3 * g (rng), 0.01 * g (rng)));
+    Eigen::Matrix3d a;
+    for (int r = 0; r < 9; ++r)
+      a (r / 3, r % 3) = 0.01 * g (rng);
+    covariances.emplace_back (i % 11 == 0 ? Eigen::Matrix3d::Zero () : Eigen::Matrix3d (a * a.transpose ()));
+    points.push_back (static_cast<int> (i));
+  }
+  std::shuffle (points.begin (), points.end (), rng);
+  const Eigen::Vector3d mean (0.1, -0.2, 0.05);
+  const Eigen::Matrix3d axes = Eigen::Quaterniond (0.9, 0.2, -0.3, 0.1).normalized ().toRotationMatrix ();
+  const double k_sigma = 1.5;
+  std::vector<double> q[3], s[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    q[k].resize (m);
+    s[k].resize (m);
+  }
+  detail::NodeExtents e;
+  detail::nodeProjections (m, points.data (), means.data ()->data (), covariances.data (), mean, axes, k_sigma,
+                           q[0].data (), q[1].data (), q[2].data (), s[0].data (), s[1].data (), s[2].data (), e);
+  for (int k = 0; k < 3; ++k)
+  {
+    double lo = std::numeric_limits<double>::infinity (), hi = -lo, q_min = lo, q_max = -lo, s_max = 0.0;
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      const std::size_t p = static_cast<std::size_t> (points[i]);
+      EXPECT_NEAR (q[k][i], axes.col (k).dot (means[p] - mean), 1e-14);
+      EXPECT_EQ (s[k][i], std::sqrt (std::max (0.0, covariances[p].quadratic (axes.col (k)))));
+      lo = std::min (lo, q[k][i] - k_sigma * s[k][i]);
+      hi = std::max (hi, q[k][i] + k_sigma * s[k][i]);
+      q_min = std::min (q_min, q[k][i]);
+      q_max = std::max (q_max, q[k][i]);
+      s_max = std::max (s_max, s[k][i]);
+    }
+    EXPECT_EQ (e.lo[k], lo);
+    EXPECT_EQ (e.hi[k], hi);
+    EXPECT_EQ (e.q_min[k], q_min);
+    EXPECT_EQ (e.q_max[k], q_max);
+    EXPECT_EQ (e.s_max[k], s_max);
+    EXPECT_GT (s_max, 0.0);
+  }
+  // P_x per point: per axis Phi(-z_lo) + Phi(-z_hi) from erfc, the maximum over the axes
+  // (MinSlab) or their sum (UnionBound); the table's tails are within 1e-11 of erfc's.
+  const double* qp[3] = {q[0].data (), q[1].data (), q[2].data ()};
+  const double* sp[3] = {s[0].data (), s[1].data (), s[2].data ()};
+  for (const auto bound : {detail::LeakageBound::MinSlab, detail::LeakageBound::UnionBound})
+  {
+    std::vector<double> out (m);
+    detail::nodeOutside (m, qp, sp, e.lo, e.hi, bound, out.data ());
+    std::size_t exact = 0;
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      double axis[3];
+      for (int k = 0; k < 3; ++k)
+        axis[k] = s[k][i] > 0.0 ? std::min (1.0, Phi (-(q[k][i] - e.lo[k]) / s[k][i]) + Phi (-(e.hi[k] - q[k][i]) / s[k][i]))
+                                : 0.0;
+      const double expected = bound == detail::LeakageBound::MinSlab ? std::max ({axis[0], axis[1], axis[2]})
+                                                                     : std::min (1.0, axis[0] + axis[1] + axis[2]);
+      EXPECT_NEAR (out[i], expected, 1e-10) << "point " << i;
+      exact += out[i] == 0.0;
+    }
+    EXPECT_GE (exact, m / 11);  // the points without a deviation: P_x = 0
+  }
 }

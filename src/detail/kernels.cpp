@@ -2,29 +2,17 @@
 // The hot loops of the classifier, declared in detail/kernels.h (METHOD.md 5.3, 5.5). Plain
 // loops over fixed blocks of 8 or 16 so that GCC's -O2 vectoriser (very-cheap cost model: no
 // epilogues) takes them, and separate accumulators per lane so that no reassociation is needed.
-// Every exported kernel is compiled once per instruction set (target_clones) and its helpers
+// Every exported kernel is compiled once per instruction set (simd_clones.h) and its helpers
 // are always inlined into it, so each clone vectorises them for its own set: keep the helpers
 // in this TU.
 #include <pcl_probcollision/detail/kernels.h>
+
+#include "simd_clones.h"
 
 #include <Eigen/Core>
 
 #include <cmath>
 #include <cstddef>
-
-#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12 && defined(__x86_64__) && defined(__linux__)
-#define PCL_PROBCOLLISION_CLONES \
-  __attribute__ ((target_clones ("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define PCL_PROBCOLLISION_CLONES
-#endif
-#if defined(__GNUC__)
-#define PCL_PROBCOLLISION_ALWAYS_INLINE inline __attribute__ ((always_inline))
-#define PCL_PROBCOLLISION_LAMBDA_INLINE __attribute__ ((always_inline))
-#else
-#define PCL_PROBCOLLISION_ALWAYS_INLINE inline
-#define PCL_PROBCOLLISION_LAMBDA_INLINE
-#endif
 
 namespace pcl_probcollision
 {
