@@ -8,7 +8,6 @@
 #include <pcl_probcollision/detail/kernels.h>
 #include <pcl_probcollision/detail/separator_problem.h>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <cmath>
@@ -99,14 +98,12 @@ public:
       if (report.iterations >= max_iterations)
         break;
       // Cholesky of H, with lambda I (1e-10, x10) when it fails
-      Eigen::LLT<Eigen::Matrix4d> llt (hessian);
-      double lambda = 1e-10;
-      while (llt.info () != Eigen::Success && lambda < 1e10)
-      {
-        llt.compute (hessian + lambda * Eigen::Matrix4d::Identity ());
-        lambda *= 10.0;
-      }
-      const Eigen::Vector4d step = llt.solve (-gradient);
+      Eigen::Vector4d step;
+      bool factored = choleskySolve (hessian, -gradient, step);
+      for (double lambda = 1e-10; !factored && lambda < 1e10; lambda *= 10.0)
+        factored = choleskySolve (hessian + lambda * Eigen::Matrix4d::Identity (), -gradient, step);
+      if (!factored)
+        break;
       const double slope = gradient.dot (step);
       if (!(slope < 0.0))
         break;
@@ -146,6 +143,47 @@ public:
   }
 
 private:
+  /** \brief x = H^-1 rhs by the Cholesky factor of the symmetric H, written out for 4 x 4 (Eigen's
+    * LLT, with its two triangular solves, was about 4 % of a query); false when H is not
+    * positive definite (a pivot <= 0 or not finite). */
+  static bool
+  choleskySolve (const Eigen::Matrix4d& H, const Eigen::Vector4d& rhs, Eigen::Vector4d& x)
+  {
+    double L[4][4];
+    for (int j = 0; j < 4; ++j)
+    {
+      double d = H (j, j);
+      for (int k = 0; k < j; ++k)
+        d -= L[j][k] * L[j][k];
+      if (!(d > 0.0))
+        return false;
+      L[j][j] = std::sqrt (d);
+      const double inv = 1.0 / L[j][j];
+      for (int i = j + 1; i < 4; ++i)
+      {
+        double v = H (i, j);
+        for (int k = 0; k < j; ++k)
+          v -= L[i][k] * L[j][k];
+        L[i][j] = v * inv;
+      }
+    }
+    double y[4];
+    for (int i = 0; i < 4; ++i)
+    {
+      double v = rhs (i);
+      for (int k = 0; k < i; ++k)
+        v -= L[i][k] * y[k];
+      y[i] = v / L[i][i];
+    }
+    for (int i = 3; i >= 0; --i)
+    {
+      double v = y[i];
+      for (int k = i + 1; k < 4; ++k)
+        v -= L[k][i] * x (k);
+      x (i) = v / L[i][i];
+    }
+    return x.allFinite ();
+  }
   /** \brief Predicted decreases of J below this share of max(1, |J|) are within J's rounding:
     * its n terms are summed with a relative error of about n 1e-16. */
   static constexpr double kRoundingDecrease = 1e-14;
