@@ -217,9 +217,8 @@ nodeLeakage (const BuildPoints& cloud, const std::vector<int>& points, NodeGeome
 {
   const std::size_t m = points.size ();
   g.outside.resize (m);
-  const double* q[3] = {g.q[0].data (), g.q[1].data (), g.q[2].data ()};
-  const double* s[3] = {g.s[0].data (), g.s[1].data (), g.s[2].data ()};
-  detail::nodeOutside (m, q, s, g.lo.data (), g.hi.data (), bound, g.outside.data ());
+  detail::nodeOutside (m, g.q[0].data (), g.q[1].data (), g.q[2].data (), g.s[0].data (), g.s[1].data (),
+                       g.s[2].data (), g.lo.data (), g.hi.data (), bound, g.outside.data ());
   const bool weighted = !cloud.area_weights.empty ();
   double sum_w = 0.0, sum_wp = 0.0, sum_p = 0.0;
   for (std::size_t i = 0; i < m; ++i)

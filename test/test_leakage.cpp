@@ -183,12 +183,11 @@ TEST (Leakage, NodeKernelsMatchTheirDefinitions)
   }
   // P_x per point: per axis Phi(-z_lo) + Phi(-z_hi) from erfc, the maximum over the axes
   // (MinSlab) or their sum (UnionBound); the table's tails are within 1e-11 of erfc's.
-  const double* qp[3] = {q[0].data (), q[1].data (), q[2].data ()};
-  const double* sp[3] = {s[0].data (), s[1].data (), s[2].data ()};
   for (const auto bound : {detail::LeakageBound::MinSlab, detail::LeakageBound::UnionBound})
   {
     std::vector<double> out (m);
-    detail::nodeOutside (m, qp, sp, e.lo, e.hi, bound, out.data ());
+    detail::nodeOutside (m, q[0].data (), q[1].data (), q[2].data (), s[0].data (), s[1].data (), s[2].data (), e.lo,
+                         e.hi, bound, out.data ());
     std::size_t exact = 0;
     for (std::size_t i = 0; i < m; ++i)
     {

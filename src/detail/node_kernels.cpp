@@ -210,16 +210,10 @@ nodeProjections (std::size_t m, const int* __restrict points, const double* __re
 }
 
 PCL_PROBCOLLISION_CLONES void
-nodeOutside (std::size_t m, const double* const q[3], const double* const s[3], const double* lo, const double* hi,
-             LeakageBound bound, double* __restrict out)
+nodeOutside (std::size_t m, const double* __restrict q0, const double* __restrict q1, const double* __restrict q2,
+             const double* __restrict s0, const double* __restrict s1, const double* __restrict s2, const double* lo,
+             const double* hi, LeakageBound bound, double* __restrict out)
 {
-  // loads only: restrict copies are enough (the writes go to the restrict parameter out)
-  const double* __restrict q0 = q[0];
-  const double* __restrict q1 = q[1];
-  const double* __restrict q2 = q[2];
-  const double* __restrict s0 = s[0];
-  const double* __restrict s1 = s[1];
-  const double* __restrict s2 = s[2];
   const double* __restrict f = kTailTable.f;
   const double* __restrict df = kTailTable.df;
   const double l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};

@@ -35,14 +35,15 @@ void nodeProjections (std::size_t m, const int* points, const double* means,
                       const Eigen::Matrix3d& axes, double k_sigma, double* q0, double* q1, double* q2,
                       double* s0, double* s1, double* s2, NodeExtents& out);
 
-/** \brief out[i] = P_x of point i of a node (METHOD.md 8.4) from nodeProjections()'s q and s,
-  * for the box [lo, hi] in box coordinates: per axis the outside probability Phi(-z_lo) +
+/** \brief out[i] = P_x of point i of a node (METHOD.md 8.4) from nodeProjections()'s arrays qk and
+  * sk, for the box [lo, hi] in box coordinates: per axis the outside probability Phi(-z_lo) +
   * Phi(-z_hi) with the tabulated tail (normalTailTabulated()), z the distances to the two faces
   * in the point's deviations, combined by bound. MinSlab (the maximum) leaves out the axes that
   * cannot attain it: with d_k = min(z_lo, z_hi) (the point is inside its box), axis k's outside
   * probability lies in [Phi(-d_k), 2 Phi(-d_k)], and Phi(-d - 1) < Phi(-d) / 2 for d >= 0, so
   * an axis with d_k >= min_j d_j + 1 is strictly below the maximum. */
-void nodeOutside (std::size_t m, const double* const q[3], const double* const s[3], const double* lo,
-                  const double* hi, LeakageBound bound, double* out);
+void nodeOutside (std::size_t m, const double* q0, const double* q1, const double* q2, const double* s0,
+                  const double* s1, const double* s2, const double* lo, const double* hi, LeakageBound bound,
+                  double* out);
 } // namespace detail
 } // namespace pcl_probcollision
