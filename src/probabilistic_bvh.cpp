@@ -147,7 +147,7 @@ struct NodeGeometry
   Eigen::Vector3d lo, hi;         // inflated extents in box coordinates about mean
   Eigen::Vector3d s_max;          // the largest s per axis
   Eigen::Vector3d q_min, q_max;   // the range of q per axis
-  std::vector<double> outside;    // the points' outside probabilities (nodeLeakage's scratch)
+  std::vector<double> outside;    // a block of the points' outside probabilities (nodeLeakage's scratch)
 };
 
 /** \brief The points the build reads: means, the packed covariances the hierarchy keeps, and
@@ -210,26 +210,35 @@ computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, doubl
   g.q_max = Eigen::Vector3d (out.q_max);
 }
 
+/** \brief Points whose outside probabilities nodeLeakage() computes at a time: the sums stay in
+  * point order, and no array of a large node's size is needed for them. */
+constexpr std::size_t kOutsideBlock = 4096;
+
 /** \brief P_leak of the node (METHOD.md 8.4): the (area-weighted) mean of its points' P_x
   * (detail::nodeOutside()), summed in point order. */
 double
 nodeLeakage (const BuildPoints& cloud, const std::vector<int>& points, NodeGeometry& g, detail::LeakageBound bound)
 {
   const std::size_t m = points.size ();
-  g.outside.resize (m);
-  detail::nodeOutside (m, g.q[0].data (), g.q[1].data (), g.q[2].data (), g.s[0].data (), g.s[1].data (),
-                       g.s[2].data (), g.lo.data (), g.hi.data (), bound, g.outside.data ());
+  g.outside.resize (std::min (m, kOutsideBlock));
   const bool weighted = !cloud.area_weights.empty ();
   double sum_w = 0.0, sum_wp = 0.0, sum_p = 0.0;
-  for (std::size_t i = 0; i < m; ++i)
+  for (std::size_t first = 0; first < m; first += kOutsideBlock)
   {
-    const double p = g.outside[i];
-    sum_p += p;
-    if (weighted)
+    const std::size_t count = std::min (kOutsideBlock, m - first);
+    detail::nodeOutside (count, g.q[0].data () + first, g.q[1].data () + first, g.q[2].data () + first,
+                         g.s[0].data () + first, g.s[1].data () + first, g.s[2].data () + first, g.lo.data (),
+                         g.hi.data (), bound, g.outside.data ());
+    for (std::size_t i = 0; i < count; ++i)
     {
-      const double w = cloud.area_weights[points[i]];
-      sum_w += w;
-      sum_wp += w * p;
+      const double p = g.outside[i];
+      sum_p += p;
+      if (weighted)
+      {
+        const double w = cloud.area_weights[points[first + i]];
+        sum_w += w;
+        sum_wp += w * p;
+      }
     }
   }
   // All-zero weights in a node carry no area information: fall back to equal weights.
