@@ -143,7 +143,7 @@ pointOutside (double q0, double q1, double q2, double s0, double s1, double s2, 
   const double o0 = axisOutside<min_slab> (l0, h0, d_min, f, df);
   const double o1 = axisOutside<min_slab> (l1, h1, d_min, f, df);
   const double o2 = axisOutside<min_slab> (l2, h2, d_min, f, df);
-  return min_slab ? std::max (o0, std::max (o1, o2)) : std::min (1.0, o0 + o1 + o2);
+  return combineSlabs (o0, o1, o2, min_slab ? LeakageBound::MinSlab : LeakageBound::UnionBound);
 }
 } // namespace
 

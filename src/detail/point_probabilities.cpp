@@ -2,7 +2,6 @@
 // Per-point collision probabilities of a fitted rung (METHOD.md 6.1).
 #include <pcl_probcollision/detail/point_probabilities.h>
 
-
 namespace pcl_probcollision
 {
 namespace detail

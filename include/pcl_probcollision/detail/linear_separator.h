@@ -97,11 +97,11 @@ public:
       }
       if (report.iterations >= max_iterations)
         break;
-      // Cholesky of H, with lambda I (1e-10, x10) when it fails
+      // L D L^T of H, with lambda I (1e-10, x10) when H is not positive definite
       Eigen::Vector4d step;
-      bool factored = choleskySolve (hessian, -gradient, step);
+      bool factored = ldltSolve (hessian, -gradient, step);
       for (double lambda = 1e-10; !factored && lambda < 1e10; lambda *= 10.0)
-        factored = choleskySolve (hessian + lambda * Eigen::Matrix4d::Identity (), -gradient, step);
+        factored = ldltSolve (hessian + lambda * Eigen::Matrix4d::Identity (), -gradient, step);
       if (!factored)
         break;
       const double slope = gradient.dot (step);
@@ -145,11 +145,11 @@ public:
 private:
   /** \brief x = H^-1 rhs for the symmetric 4 x 4 H by its factorisation L D L^T (L unit lower
     * triangular), written out: the pivots' reciprocals are its only divisions and it takes no
-    * square root (Eigen's LLT, with its two triangular solves, was about 4 % of a query, and a
-    * Cholesky factor written out 5 %: a chain of a dozen divisions). False when H is not
-    * positive definite (a pivot <= 0 or not finite). */
+    * square root (Eigen's LLT and its triangular solves, a chain of divisions and roots on every
+    * Newton step, were about 4 % of a query). False when H is not positive definite (a pivot
+    * <= 0 or not finite). */
   static bool
-  choleskySolve (const Eigen::Matrix4d& H, const Eigen::Vector4d& rhs, Eigen::Vector4d& x)
+  ldltSolve (const Eigen::Matrix4d& H, const Eigen::Vector4d& rhs, Eigen::Vector4d& x)
   {
     double L[4][4], d[4], inv[4];
     for (int j = 0; j < 4; ++j)
