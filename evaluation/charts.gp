@@ -6,7 +6,8 @@
 # reads  dir/{summary,queries,flips,model_size,reliability}.csv   (comma separated, header line)
 # writes out/accuracy_vs_time.png, free_probability_vs_distance.png, flip_rate_vs_noise.png,
 #        model_size_vs_accuracy.png, reliability.png, rescan_flips.png,
-#        reliability_grid.png, signed_distance_vs_exact.png, hidden_collisions.png
+#        reliability_grid.png, signed_distance_vs_exact.png, hidden_collisions.png,
+#        model_size_by_noise.png
 #                                                                     (out defaults to dir)
 #
 # Optional variables, given with -e before the script, e.g. -e "dir='x'; noise=1":
@@ -22,6 +23,8 @@
 #   noiseunit what noise_pct measures, for axis labels (default "% of the piano's bounding-box diagonal")
 #   relband   band of chart 5: 'near_sigma' (|d| <= 2.8 sigma_eff, default), 'near_contact' or 'all'
 #   gridwl    workloads of chart 7, one row each (default 'W1 W1-sparse W2 W3')
+#   sizesettings  settings of ours in chart 10 (default 'classifier cloudmerge2 merge2 surface
+#             surface-cloudmerge2'; those without rows are left out)
 #   dwl, dlevels, dsetting  rows (default 'W1 W1-sparse'), noise levels (default: those up to 1 %
 #             with a distance) and setting of ours (default 'surface') of chart 8
 # Columns are found by header name, so the order of the columns does not matter. A chart whose
@@ -579,6 +582,60 @@ if (!readable("summary.csv")) {
            lw 2 pt 7 dt 1 lc rgb colour(i) title "dense: " . word(hseries, i), \
          for [i = 1:words(hseries)] "< " . cmd9("W1-sparse", word(hseries, i)) using 1:2 with linespoints \
            lw 2 pt 6 dt 2 lc rgb colour(i) title "sparse: " . word(hseries, i)
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (10) Model size and work against accuracy at every noise level (issue #17, item 1): for each
+# setting of sizesettings, one line through its noise levels, hierarchy nodes (left) and leaf
+# pairs tested per query (right) against the ROC AUC over all queries, each point
+# labelled with its noise level. A setting whose resolution follows the noise keeps its line
+# from running right as the noise grows. Workload wl, model_size.csv.
+
+if (!exists("sizesettings")) sizesettings = "classifier cloudmerge2 merge2 surface surface-cloudmerge2"
+size_noise_prog(s) = sprintf("%s && %s == \"%s\" && num(%s) && num(%s) && num(%s) && %s > 0 && %s > 0 { print %s, %s, %s, %s }", \
+  is_wl, col("setting"), s, col("noise_pct"), col("nodes"), col("leaf_pairs_mean"), col("nodes"), col("leaf_pairs_mean"), \
+  col("noise_pct"), col("nodes"), col("leaf_pairs_mean"), col("auc"))
+# Columns: noise, nodes, leaf pairs per query, AUC; in noise order.
+cmd10(s) = select("model_size.csv", noise, size_noise_prog(s)) . " | sort -g -k1,1"
+
+if (!readable("model_size.csv")) {
+  print skip("model_size_by_noise.png", "no model_size.csv")
+} else {
+  sseries = ""
+  do for [s in sizesettings] {
+    if (count(cmd10(s)) > 0) { sseries = sseries . " " . s }
+  }
+  if (words(sseries) == 0) {
+    print skip("model_size_by_noise.png", sprintf("no %s rows of %s", wl, sizesettings))
+  } else {
+    reset
+    if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
+      set terminal pngcairo size 1400,620 noenhanced font "DejaVu Sans,11"
+    } else {
+      set terminal png size 1400,620 noenhanced
+    }
+    set output png("model_size_by_noise.png")
+    set multiplot layout 1,2 title sprintf("%s: model size and leaf pairs tested against ROC AUC at every noise level (labels: noise, %% of the diagonal)", wlname)
+    set logscale x
+    set format x "%g"
+    set ylabel "ROC AUC over all queries"
+    set grid
+    set key bottom left
+    set offsets graph 0.05, graph 0.1, graph 0.05, graph 0.05
+    set xlabel "hierarchy nodes, both clouds (log scale)"
+    plot for [i = 1:words(sseries)] "< " . cmd10(word(sseries, i)) using 2:4 with linespoints \
+           lw 2 pt 7 ps 1.2 lc rgb colour(i) title word(sseries, i), \
+         for [i = 1:words(sseries)] "< " . cmd10(word(sseries, i)) using 2:4:(sprintf(" %g", $1)) with labels \
+           left offset 0.3, 0.3 font ",8" tc rgb colour(i) notitle
+    set xlabel "leaf pairs tested per query, mean (log scale)"
+    set key off
+    plot for [i = 1:words(sseries)] "< " . cmd10(word(sseries, i)) using 3:4 with linespoints \
+           lw 2 pt 7 ps 1.2 lc rgb colour(i) title word(sseries, i), \
+         for [i = 1:words(sseries)] "< " . cmd10(word(sseries, i)) using 3:4:(sprintf(" %g", $1)) with labels \
+           left offset 0.3, 0.3 font ",8" tc rgb colour(i) notitle
+    unset multiplot
     unset output
   }
 }
