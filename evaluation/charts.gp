@@ -7,7 +7,7 @@
 # writes out/accuracy_vs_time.png, free_probability_vs_distance.png, flip_rate_vs_noise.png,
 #        model_size_vs_accuracy.png, reliability.png, rescan_flips.png,
 #        reliability_grid.png, signed_distance_vs_exact.png, hidden_collisions.png,
-#        model_size_by_noise.png
+#        model_size_by_noise.png, query_time_by_noise.png
 #                                                                     (out defaults to dir)
 #
 # Optional variables, given with -e before the script, e.g. -e "dir='x'; noise=1":
@@ -25,6 +25,8 @@
 #   gridwl    workloads of chart 7, one row each (default 'W1 W1-sparse W2 W3')
 #   sizesettings  settings of ours in chart 10 (default 'classifier cloudmerge2 merge2 surface
 #             surface-cloudmerge2'; those without rows are left out)
+#   timesettings  method:setting series of chart 11 (default 'ours:classifier ours:cloudmerge2
+#             ours:ladder ours:surface octomap_2x:mesh')
 #   dwl, dlevels, dsetting  rows (default 'W1 W1-sparse'), noise levels (default: those up to 1 %
 #             with a distance) and setting of ours (default 'surface') of chart 8
 # Columns are found by header name, so the order of the columns does not matter. A chart whose
@@ -635,6 +637,65 @@ if (!readable("model_size.csv")) {
            lw 2 pt 7 ps 1.2 lc rgb colour(i) title word(sseries, i), \
          for [i = 1:words(sseries)] "< " . cmd10(word(sseries, i)) using 3:4:(sprintf(" %g", $1)) with labels \
            left offset 0.3, 0.3 font ",8" tc rgb colour(i) notitle
+    unset multiplot
+    unset output
+  }
+}
+
+# ---------------------------------------------------------------------------------------------
+# (11) Query time against the noise level (issue #17's speed targets): median (solid) and max
+# (dashed) query time per setting, the dense room left and the sparse one right (workloads
+# W1 and W1-sparse), with the targets: the max at most 5 ms at 2 and 4 %, and the median at
+# 2-4 % no higher than at 0.5 % (dotted, the first setting's median at 0.5 %, in its colour).
+
+if (!exists("timesettings")) timesettings = "ours:classifier ours:cloudmerge2 ours:ladder ours:surface octomap_2x:mesh"
+time_prog(w, s, what) = sprintf("$c[\"workload\"] == \"%s\" && %s \":\" %s == \"%s\" && num(%s) && num(%s) && %s > 0 && %s > 0 { print %s, %s / 1000 }", \
+  w, col("method"), col("setting"), s, col("noise_pct"), col(what), col("noise_pct"), col(what), col("noise_pct"), col(what))
+cmd11(w, s, what) = select("summary.csv", noise, time_prog(w, s, what)) . " | sort -g -k1,1"
+median_at(w, s) = system(cmd11(w, s, "median_us") . " | awk -F'\t' '$1 == 0.5 { print $2; exit }'")
+
+if (!readable("summary.csv")) {
+  print skip("query_time_by_noise.png", "no summary.csv")
+} else {
+  tseries = ""
+  do for [s in timesettings] {
+    if (count(cmd11("W1", s, "median_us")) + count(cmd11("W1-sparse", s, "median_us")) > 0) { tseries = tseries . " " . s }
+  }
+  if (words(tseries) == 0) {
+    print skip("query_time_by_noise.png", "no W1 rows of " . timesettings)
+  } else {
+    reset
+    if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
+      set terminal pngcairo size 1400,740 noenhanced font "DejaVu Sans,11"
+    } else {
+      set terminal png size 1400,740 noenhanced
+    }
+    set output png("query_time_by_noise.png")
+    set multiplot layout 1,2 title "Query time against the noise level (one thread; solid: median, dashed: max; dotted: issue #17's targets)"
+    tlevels = system(select("summary.csv", noise, sprintf("%s ~ /^W1/ && num(%s) && %s > 0 { print %s }", \
+                     col("workload"), col("noise_pct"), col("noise_pct"), col("noise_pct"))) . " | sort -gu | tr '\\n' ' '")
+    set logscale xy
+    set format y "%g"
+    set xtics ()
+    do for [lv in tlevels] {
+      set xtics add (lv lv + 0)
+    }
+    set xrange [(word(tlevels, 1) + 0) / 1.4 : (word(tlevels, words(tlevels)) + 0) * 1.4]
+    set xlabel sprintf("noise σ (%s; log scale)", noiseunit)
+    set ylabel "query time (ms, log scale)"
+    set grid
+    do for [w in "W1 W1-sparse"] {
+      set title (w eq "W1") ? "dense room (W1)" : "sparse room (W1-sparse)"
+      m05 = median_at(w, word(tseries, 1))
+      set key below horizontal maxrows 4 font ",9"  # both panels, so that their plot areas match
+      plot (x >= 2 ? 5 : NaN) with lines dt 3 lw 2 lc rgb "#555555" title "target: max 5 ms", \
+           (strlen(m05) > 0 && x >= 2 ? m05 + 0 : NaN) with lines dt 3 lw 2 lc rgb colour(1) \
+             title "target: median at 0.5 %", \
+           for [i = 1:words(tseries)] "< " . cmd11(w, word(tseries, i), "median_us") using 1:2 with linespoints \
+             lw 2 pt 7 dt 1 lc rgb colour(i) title word(tseries, i), \
+           for [i = 1:words(tseries)] "< " . cmd11(w, word(tseries, i), "max_us") using 1:2 with linespoints \
+             lw 1 pt 6 dt 2 lc rgb colour(i) notitle
+    }
     unset multiplot
     unset output
   }

@@ -116,7 +116,8 @@ for f in queries.csv summary.csv reliability.csv flips.csv model_size.csv summar
          densities.csv targets.csv targets.md reliability.md \
          accuracy_vs_time.png free_probability_vs_distance.png flip_rate_vs_noise.png \
          model_size_vs_accuracy.png reliability.png rescan_flips.png reliability_grid.png \
-         signed_distance_vs_exact.png hidden_collisions.png model_size_by_noise.png; do
+         signed_distance_vs_exact.png hidden_collisions.png model_size_by_noise.png \
+         query_time_by_noise.png; do
   [ -s "$out/$f" ] || { echo "evaluate.sh: $out/$f missing or empty" >&2; exit 1; }
 done
 echo "evaluate.sh: results in $out"
