@@ -115,7 +115,9 @@ faceDistances (double q, double s, double lo, double hi, double& z_lo, double& z
   z_hi = s > 0.0 ? above : inf;
 }
 
-/** \brief An axis's outside probability, or 0 where the bound leaves it out (nodeOutside()). */
+/** \brief An axis's outside probability, or 0 where the bound leaves it out (nodeOutside()):
+  * MinSlab an axis that cannot attain the maximum, UnionBound one without deviation (d = +inf;
+  * d is never NaN, faceDistances() sees to that). */
 template <bool min_slab>
 PCL_PROBCOLLISION_ALWAYS_INLINE double
 axisOutside (double z_lo, double z_hi, double d_min, const double* __restrict f, const double* __restrict df)
@@ -124,7 +126,7 @@ axisOutside (double z_lo, double z_hi, double d_min, const double* __restrict f,
   const double both = std::min (1.0, tail (z_lo, f, df) + tail (z_hi, f, df));
   if (min_slab)
     return d >= d_min + 1.0 ? 0.0 : both;
-  return d >= d_min + 1.0 && !(std::abs (d) <= std::numeric_limits<double>::max ()) ? 0.0 : both;
+  return d <= std::numeric_limits<double>::max () ? both : 0.0;
 }
 
 /** \brief P_x of a point from its projections and deviations on the three axes (nodeOutside()). */
