@@ -8,6 +8,10 @@
 #include <pcl_probcollision/detail/input_checks.h>
 
 #include <pcl/exceptions.h>
+// The base class's one out-of-line member (FilterIndices::applyFilter(PointCloud &)) is
+// instantiated with ours, so no binary needs libpcl_filters and libpcl_sample_consensus at run
+// time: loading them was 13-14 ms of every process start (docs/PERFORMANCE.md, `-threads`).
+#include <pcl/filters/impl/filter_indices.hpp>
 
 #include <chrono>
 #include <cmath>
