@@ -189,8 +189,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
 bool
 RobustClassifier::needsKernel (const ClassifierResult& plane) const
 {
-  return needsEscalation (plane.degenerate, plane.misclassified, params_.ladder_fraction,
-                          plane.probabilities_a.size () + plane.probabilities_b.size ());
+  return needsEscalation (plane.degenerate, plane.misclassified, params_.ladder_fraction, plane.points);
 }
 
 bool
@@ -312,6 +311,7 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
   result.degenerate = best.degenerate;
   result.gamma_effective = best.gamma_effective;
   result.misclassified = best.misclassified;
+  result.points = n;
   if (point_probabilities)
   {
     result.probabilities_a.resize (na);

@@ -1089,3 +1089,38 @@ TEST (RobustClassifier, AFitDoesNotRaiseASeparableStartPlanesMaximum)
             << " of them, by at most " << largest_rise << " (" << largest_quantiles << " quantiles above 1e-6)\n";
   EXPECT_GT (separable, 800u) << "too few separable pairs to say anything";
 }
+
+// The ladder rule after a plane fit (needsKernel, used by defer_kernel_fits) reads the fitted
+// point count, not the per-point arrays, which are filled only when asked: 1 of 40 points
+// misclassified sends the ladder on at ladder_fraction 0, not at 0.2, either way.
+TEST (RobustClassifier, NeedsKernelCountsThePointsWithoutPerPointArrays)
+{
+  std::vector<Eigen::Vector3d> ma, mb;
+  std::vector<Eigen::Matrix3d> ca, cb;
+  const Eigen::Matrix3d c = 1e-4 * Eigen::Matrix3d::Identity ();
+  for (int i = 0; i < 20; ++i)
+  {
+    ma.emplace_back (0.1 * (i % 5), 0.1 * (i / 5), 1.0);
+    mb.emplace_back (0.1 * (i % 5), 0.1 * (i / 5), 0.0);
+    ca.push_back (c);
+    cb.push_back (c);
+  }
+  mb[0] = Eigen::Vector3d (0.2, 0.2, 2.0);  // one point of B deep on A's side
+  const PointSetView a (ma, ca), b (mb, cb);
+  for (const double fraction : {0.0, 0.2})
+  {
+    ClassifierParams params;
+    params.kernel = KernelMode::Ladder;
+    params.ladder_fraction = fraction;
+    const RobustClassifier classifier (params);
+    for (const bool per_point : {true, false})
+    {
+      ClassifierResult r;
+      ASSERT_TRUE (classifier.classify (a, b, r, KernelMode::Linear, -1.0, per_point)) << r.message;
+      EXPECT_EQ (r.misclassified, 1u);
+      EXPECT_EQ (r.points, 40u);
+      EXPECT_EQ (r.probabilities_a.size () + r.probabilities_b.size (), per_point ? 40u : 0u);
+      EXPECT_EQ (classifier.needsKernel (r), fraction == 0.0) << "ladder_fraction " << fraction << ", per_point " << per_point;
+    }
+  }
+}

@@ -72,7 +72,9 @@ TEST (StartPlane, AgreesWithTheClassifiersStartAndPassOver)
               EXPECT_NEAR (r.probability, normalCdf (z), 1e-9 * std::max (1e-300, r.probability) + 1e-15);
             }
             else if (std::isfinite (z))
+            {
               EXPECT_GE (normalCdf (z), 0.5 - 1e-12);
+            }
           }
           for (int k = 0; k < 3; ++k)
           {

@@ -82,6 +82,9 @@ struct ClassifierResult
     * their own standard deviation along the gradient (any wrong-side point when that standard
     * deviation is zero), plus points where the gradient collapsed (|grad f| < 1e-8). */
   std::size_t misclassified = 0;
+  /** \brief Points of both sides that were fitted (the ladder rule's n; the per-point arrays
+    * are filled only when asked). */
+  std::size_t points = 0;
   /** \brief Number of rungs fitted (1 unless the Ladder escalated). */
   int rungs_tried = 0;
   /** \brief The fitted function, for RobustClassifier::evaluate(). */
