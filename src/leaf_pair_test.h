@@ -37,21 +37,24 @@ class LeafPairTest
 {
 public:
   /** \brief result's per-point arrays are sized here when request.per_point. With
-    * skip_dominated (the traversal's), a pair whose start plane cannot raise the maximum is
-    * not fitted (RobustClassifier::classify's skip_at_or_below). */
+    * skip_dominated (the traversal's), a pair whose start plane stays a normal quantile under
+    * what it would have to reach is not fitted (RobustClassifier::classify's skip_at_or_below;
+    * kStartPlaneMargin). */
   LeafPairTest (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b,
                 const CollisionRequest& request, const RobustClassifier& classifier, CollisionResult& result,
                 bool skip_dominated);
 
-  /** \brief The traversal's leaf test: P_leaf of the two leaves, NaN when the classifier has
+  /** \brief The traversal's leaf test: P_leaf of the two leaves (for a pair passed over, its
+    * start plane's maximum, which stays under the maximum so far), NaN when the classifier has
     * no usable separator (counted in failures()). For a pair set aside (its kernel rungs with
     * defer_kernel_fits, or the whole pair by its start plane) it returns the largest fitted
     * contribution so far over rho, rounded down: a lower bound of the final maximum for the
     * traversal's pruning. */
   double operator() (const ProbabilisticBVH::Node& leaf_a, const ProbabilisticBVH::Node& leaf_b, double rho);
 
-  /** \brief Fits the pairs set aside, largest reach weight first, skipping those that cannot
-    * raise the maximum when skip_dominated; true when a contribution exceeded stop_probability
+  /** \brief Fits the pairs set aside: those set aside by their start plane first (largest
+    * start z first, flushStarts()), then those whose kernel rungs were deferred, largest reach
+    * weight first, skipping those that cannot raise the maximum when skip_dominated; true when a contribution exceeded stop_probability
     * and exhaustive is off (the maximum is then a lower bound). */
   bool finishDeferred (double stop_probability, bool exhaustive, bool skip_dominated);
 
