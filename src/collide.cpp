@@ -264,6 +264,10 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   const bool surface = request.surface && !a.surface ().empty () && !b.surface ().empty ();
   // Whose answer stands: the surface layer's (alone or pooled) or the separators'.
   bool from_surface = surface, pooled = surface && request.surface_pooled;
+  // Whether the surface layer reached a leaf pair (its reach is spatial: boxes grown by the noise
+  // and a spacing), for a distance asked beyond it; the separators' weighted traversal can fit a
+  // pair of disjoint boxes at any separation, so their no_leaf_tested does not say "far".
+  bool surface_ran = false, surface_reached = false;
   if (surface && request.surface_ladder)
   {
     // The ladder (CollisionRequest::surface_ladder): the separators first; the surface layer
@@ -279,6 +283,8 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
     {
       if (!collideSurface (a, b, T_local, request, result))
         return false;
+      surface_ran = true;
+      surface_reached = !result.no_leaf_tested;
       pooled = separators.probability < request.free_below;
       if (pooled)
         pool (result, separators, request);
@@ -305,6 +311,8 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
     if (surface ? !collideSurface (a, b, T_local, request, result)
                 : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
       return false;
+    surface_ran = surface;
+    surface_reached = surface && !result.no_leaf_tested;
     if (pooled)
     {
       CollisionResult separators;
@@ -324,8 +332,10 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
     result.verdict = verdictFor (result.probability, request);
   }
 
-  // Beyond reach, a distance when asked (CollisionRequest::distance).
-  if (request.distance && result.no_leaf_tested && std::isnan (result.signed_distance))
+  // Beyond reach, a distance when asked (CollisionRequest::distance): beyond the surface layer's
+  // reach where it ran in full, else where the separators reached no leaf pair.
+  const bool beyond_reach = surface_ran ? !surface_reached : result.no_leaf_tested;
+  if (request.distance && beyond_reach && std::isnan (result.signed_distance))
     sampleDistance (a, b, T_local, result);
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.
   if (result.witness_side != 0)

@@ -1155,6 +1155,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   params.exhaustive = true;
   params.skip_dominated = false;
   params.nearest_first = false;  // every pair is enumerated: the order is of no use here
+  params.max_leaf_tests = 0;      // the separators' cap (max_leaf_fits) is not this layer's
   params.box_margin = std::max (a.surface ().medianSpacing (), b.surface ().medianSpacing ());
   auto& pairs = scratch.pairs;
   pairs.clear ();

@@ -393,6 +393,64 @@ TEST (SurfaceLayer, AnAskedDistanceIsNeverTheFirstDecidingPoint)
   EXPECT_LT (with_distance.signed_distance, -0.005);
 }
 
+// The separators' cap on leaf-pair fits (max_leaf_fits) is theirs: the surface layer still
+// enumerates every pair within reach, so the table 2 cm into the slab reads the same collision
+// with a cap of one pair as without one (found in review: it read free, P 1e-5, unflagged).
+TEST (SurfaceLayer, TheSeparatorsCapDoesNotCutTheSurfaceLayer)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto block = buildCloudModel (slab (0.1, 0.05, 0.01), withSurface ());
+  CollisionRequest uncapped = surfaceRequest ();
+  CollisionResult free_run;
+  ASSERT_TRUE (collide (*block, *table, shift (0.0, 0.0, 0.02), uncapped, free_run)) << free_run.message;
+  ASSERT_EQ (free_run.verdict, Verdict::InCollision);
+  for (const std::size_t cap : {std::size_t (1), std::size_t (3)})
+  {
+    CollisionRequest capped = uncapped;
+    capped.max_leaf_fits = cap;
+    CollisionResult r;
+    ASSERT_TRUE (collide (*block, *table, shift (0.0, 0.0, 0.02), capped, r)) << r.message;
+    EXPECT_EQ (r.verdict, Verdict::InCollision) << cap;
+    EXPECT_EQ (r.probability, free_run.probability) << cap;
+    EXPECT_EQ (r.signed_distance, free_run.signed_distance) << cap;
+    EXPECT_EQ (r.leaf_pairs_tested, free_run.leaf_pairs_tested) << cap;
+  }
+}
+
+// A distance asked for far apart is the nearest samples' whichever way the pair is answered:
+// two 3 cm patches 5 m apart are single leaves, whose pair the separators' weighted traversal
+// still fits (it is not "no leaf tested" for them), but the surface layer reaches nothing, so
+// the pool and the ladder give the distance as the surface layer alone does (found in review:
+// NaN).
+TEST (SurfaceLayer, AnAskedDistanceFarApartIsGivenPooledAndLaddered)
+{
+  const auto a = buildCloudModel (sheet (0.03, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto b = buildCloudModel (sheet (0.03, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  CollisionRequest alone;
+  alone.surface = true;
+  alone.distance = true;
+  CollisionRequest pooled = alone;
+  pooled.surface_pooled = true;
+  CollisionRequest ladder = alone;
+  ladder.surface_ladder = true;
+  for (const double x : {0.5, 5.0})
+  {
+    CollisionResult r_alone, r_pooled, r_ladder;
+    ASSERT_TRUE (collide (*a, *b, shift (x, 0, 0), alone, r_alone)) << r_alone.message;
+    ASSERT_TRUE (collide (*a, *b, shift (x, 0, 0), pooled, r_pooled)) << r_pooled.message;
+    ASSERT_TRUE (collide (*a, *b, shift (x, 0, 0), ladder, r_ladder)) << r_ladder.message;
+    ASSERT_TRUE (r_alone.sample_distance) << x;
+    EXPECT_NEAR (r_alone.signed_distance, x - 0.03, 0.005) << x;
+    for (const CollisionResult* r : {&r_pooled, &r_ladder})
+    {
+      EXPECT_TRUE (r->sample_distance) << x;
+      EXPECT_EQ (r->signed_distance, r_alone.signed_distance) << x;
+      EXPECT_EQ (r->signed_distance_std, r_alone.signed_distance_std) << x;
+      EXPECT_EQ (r->verdict, Verdict::Free) << x;
+    }
+  }
+}
+
 // A table without a viewpoint (its sensor origin within it) is oriented by propagation, which
 // cannot say which side is solid: a ball 10 mm above it and one 10 mm below read free alike.
 // Through its middle, the ball reads collision (its points on both sides of the table).

@@ -107,9 +107,10 @@ struct CollisionRequest
     * default is the model's raw P, P = Phi(-signed_distance / signed_distance_std). Per-point
     * values, signed_distance and its std are never mapped. */
   bool surface_calibrated = false;
-  /** \brief A distance at any separation, as FCL's distance request gives: where the query
-    * reached no leaf pair (CollisionResult::no_leaf_tested: the objects lie beyond the reach of
-    * either layer, and neither inside the other), signed_distance is the distance between the
+  /** \brief A distance at any separation, as FCL's distance request gives: beyond the reach of
+    * the surface layer where it runs (alone, pooled or as the ladder's rung: no leaf pair within
+    * its grown boxes, and neither object inside the other), else where the separators reached no
+    * leaf pair (CollisionResult::no_leaf_tested), signed_distance is the distance between the
     * two clouds' nearest samples, and its std their covariances' along the line between them
     * with 0.29 of each one's spacing for where the surfaces pass between samples
     * (CollisionResult::sample_distance, nearest_point_a / nearest_point_b). Near contact the
