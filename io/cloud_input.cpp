@@ -131,6 +131,21 @@ bool
 readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std::string& error)
 {
   pcl::PCLPointCloud2& blob = file.blob;
+  // PCL's readers are given regular files only: on a directory PCDReader::readHeader never
+  // returns (found in review, through Python's read_cloud).
+  std::error_code ec;
+  const auto status = std::filesystem::status (path, ec);
+  if (ec || !std::filesystem::exists (status))
+  {
+    error = "cannot read '" + path + "': No such file or directory";
+    return false;
+  }
+  if (!std::filesystem::is_regular_file (status))
+  {
+    error = "cannot read '" + path + "': " +
+            (std::filesystem::is_directory (status) ? std::string ("is a directory") : std::string ("not a regular file"));
+    return false;
+  }
   const bool ply = isPly (path);
   const char* format = ply ? "PLY" : "PCD";
   if (ply)

@@ -25,6 +25,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <memory>
@@ -212,17 +213,30 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name);
 }
 
+/** FileNotFoundError for a missing path, IsADirectoryError for a directory, ValueError for
+  * another kind of file: what Python's open() raises, before any reader sees the path. */
+void
+requireRegularFile (const std::filesystem::path& path)
+{
+  std::error_code ec;
+  const auto status = std::filesystem::status (path, ec);
+  if (std::filesystem::is_regular_file (status))
+    return;
+  const bool directory = std::filesystem::is_directory (status);
+  if (!directory && std::filesystem::exists (status))
+    throw py::value_error ("path: '" + path.string () + "' is not a regular file");
+  PyObject* type = directory ? PyExc_IsADirectoryError : PyExc_FileNotFoundError;
+  py::object err = py::reinterpret_borrow<py::object> (type) (directory ? 21 : 2,
+                                                                std::string (directory ? "Is a directory" : "No such file"),
+                                                                path.string ());
+  PyErr_SetObject (type, err.ptr ());
+  throw py::error_already_set ();
+}
+
 std::shared_ptr<const CloudModel>
 loadModel (const std::filesystem::path& path, const py::object& params_obj, const py::object& name_obj)
 {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file (path, ec))
-  {
-    py::object err = py::module_::import ("builtins").attr ("FileNotFoundError") (
-        2, std::string ("No such file"), path.string ());
-    PyErr_SetObject (PyExc_FileNotFoundError, err.ptr ());
-    throw py::error_already_set ();
-  }
+  requireRegularFile (path);
   std::string ext = path.extension ().string ();
   for (char& ch : ext)
     ch = static_cast<char> (std::tolower (static_cast<unsigned char> (ch)));
@@ -268,7 +282,8 @@ toPose (const py::object& obj, const char* arg)
     if (seq.size () != 2)
       throw py::value_error (expected + ", got a sequence of " + std::to_string (seq.size ()));
     auto R = py::array_t<double, py::array::forcecast>::ensure (seq[0]);
-    auto t = py::array_t<double, py::array::forcecast>::ensure (seq[1]);
+    // C order: t may be a (3,), (3, 1) or (1, 3) view of a larger array (a column of a 4x4).
+    auto t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (seq[1]);
     if (!R || !t)
     {
       PyErr_Clear ();
@@ -281,7 +296,7 @@ toPose (const py::object& obj, const char* arg)
     {
       for (int j = 0; j < 3; ++j)
         m (i, j) = r (i, j);
-      m (i, 3) = t.data ()[i * (t.strides (t.ndim () - 1) / static_cast<py::ssize_t> (sizeof (double)))];
+      m (i, 3) = t.data ()[i];
     }
   }
   else
@@ -456,6 +471,7 @@ viewpointOf (const pcl::PointCloud<PointT>& cloud)
 py::tuple
 readCloud (const std::filesystem::path& path)
 {
+  requireRegularFile (path);
   pcl::PointCloud<pcl::PointXYZ> cloud;
   std::string error;
   bool loaded = false;
@@ -474,6 +490,7 @@ readCloud (const std::filesystem::path& path)
 py::tuple
 readCloudWithNormals (const std::filesystem::path& path)
 {
+  requireRegularFile (path);
   pcl::PointCloud<pcl::PointNormal> cloud;
   bool has_normals = false;
   std::string error;
@@ -502,7 +519,13 @@ pcl_probcollision::io::TriangleMesh
 meshOf (const py::object& vertices_obj, const py::object& triangles_obj)
 {
   auto V = py::array_t<double, py::array::forcecast>::ensure (vertices_obj);
-  auto F = py::array_t<int, py::array::forcecast>::ensure (triangles_obj);
+  // Indices must be integers: a cast to int would truncate 1.9 to 1 and wrap 2^32 + 2 to 2
+  // (found in review); read as 64-bit, so that the range check below sees the real value.
+  const py::array raw = py::array::ensure (triangles_obj);
+  if (raw && raw.size () > 0 && raw.dtype ().kind () != 'i' && raw.dtype ().kind () != 'u')
+    throw py::type_error ("triangles: expected integer vertex indices, got dtype " +
+                          py::str (raw.dtype ()).cast<std::string> ());
+  auto F = py::array_t<std::int64_t, py::array::forcecast>::ensure (triangles_obj);
   if (!V || !F)
   {
     PyErr_Clear ();
@@ -520,7 +543,7 @@ meshOf (const py::object& vertices_obj, const py::object& triangles_obj)
     for (int d = 0; d < 3; ++d)
       if (f (i, d) < 0 || f (i, d) >= v.shape (0))
         throw py::value_error ("triangles: row " + std::to_string (i) + " refers to a missing vertex");
-    mesh.triangles.push_back ({f (i, 0), f (i, 1), f (i, 2)});
+    mesh.triangles.push_back ({static_cast<int> (f (i, 0)), static_cast<int> (f (i, 1)), static_cast<int> (f (i, 2))});
   }
   return mesh;
 }
@@ -1066,14 +1089,17 @@ PYBIND11_MODULE (_core, m)
          "    orientations (surface_orientation is then PointNormals); any length is accepted (the surface model\n"
          "    normalizes them), and a point whose normal is NaN or 0 is oriented from its neighbours. Without\n"
          "    params.surface the normals are not read (they change nothing else in the model).\n"
-         "FileNotFoundError for a missing file, ValueError for a file PCL cannot read or one with only some of the\n"
+         "FileNotFoundError for a missing file, IsADirectoryError for a directory, ValueError for a file PCL cannot\n"
+         "    read or one with only some of the\n"
          "    normal fields (with params.surface).");
-  m.def ("collide", &collideOne, py::arg ("a"), py::arg ("b"), py::arg ("pose"), py::arg ("request") = py::none (),
+  // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).
+  m.def ("collide", &collideOne, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("pose"),
+         py::arg ("request") = py::none (),
          "Probability that the objects of models a and b collide, b placed in a's frame by pose = T_a_b\n"
          "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide().\n\n"
          "request: CollisionRequest (None = CollisionRequest()). Returns a CollisionResult.\n"
          "ValueError (with the C++ message) for a non-rigid or non-finite pose or an invalid request.");
-  m.def ("collide_batch", &collideMany, py::arg ("a"), py::arg ("b"), py::arg ("poses"),
+  m.def ("collide_batch", &collideMany, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("poses"),
          py::arg ("request") = py::none (), py::arg ("threads") = 0,
          "collide() for each pose of an (M, 4, 4) array, on `threads` threads (0 = all cores), GIL released.\n\n"
          "Returns a list of M CollisionResult in pose order, each equal to collide(a, b, poses[i], request)\n"

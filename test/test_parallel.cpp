@@ -17,6 +17,8 @@ TEST (Parallel, ThreadCountReadsZeroAsEveryCore)
   EXPECT_GE (threadCount (0), 1u);
   EXPECT_EQ (threadCount (1), 1u);
   EXPECT_EQ (threadCount (3), 3u);
+  EXPECT_EQ (threadCount (1024), 1024u);
+  EXPECT_EQ (threadCount (2147483647), 1024u);  // capped: per-worker scratch is allocated up front
 }
 
 TEST (Parallel, EveryItemRunsOnceOnAWorkerInRange)

@@ -346,8 +346,8 @@ parseCommandLine (const std::vector<std::string>& args)
     {
       if (!parseInt (v, o.threads))
         return usage (bad + "is not an integer");
-      if (o.threads < 0)
-        return usage (bad + "must be >= 0 (0: one per hardware thread)");
+      if (o.threads < 0 || o.threads > 1024)
+        return usage (bad + "must be in [0, 1024] (0: one per hardware thread)");
     }
     else if (a == "-sigma")
     {

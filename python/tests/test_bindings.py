@@ -158,6 +158,25 @@ def test_pose_as_rotation_and_translation(table, gripper_patch):
     assert r.probability > 0
     same_result(r, pc.collide(table, gripper_patch, (T[:3, :3], T[:3, 3])))
     same_result(r, pc.collide(table, gripper_patch, (T[:3, :3].tolist(), list(T[:3, 3]))))
+    # t as a column or a row view of T: read in its own order, not by the last axis' stride
+    same_result(r, pc.collide(table, gripper_patch, (T[:3, :3], T[:3, 3:4])))
+    same_result(r, pc.collide(table, gripper_patch, (T[:3, :3], T[:3, 3:4].T)))
+
+
+def test_none_is_not_a_model(table):
+    with pytest.raises(TypeError):
+        pc.collide(table, None, np.eye(4))
+    with pytest.raises(TypeError):
+        pc.collide_batch(None, table, np.eye(4)[None])
+
+
+def test_triangle_indices_must_be_integers():
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    assert len(pc.sample_mesh(V, np.array([[0, 1, 2]], np.uint8), 0.1)) > 0
+    with pytest.raises(TypeError, match="integer"):
+        pc.sample_mesh(V, [[0, 1, 1.9]], 0.1)
+    with pytest.raises(ValueError, match="missing vertex"):
+        pc.sample_mesh(V, np.array([[0, 1, 2**32 + 2]], np.int64), 0.1)
 
 
 def test_pose_means_T_a_b(table, gripper_patch):
@@ -653,8 +672,14 @@ def test_bad_poses_in_a_batch():
 def test_bad_files(tmp_path):
     with pytest.raises(FileNotFoundError):
         pc.load_model(tmp_path / "missing.pcd")
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(IsADirectoryError):
         pc.load_model(tmp_path)  # a directory is not a file
+    # The readers check the path before PCL sees it (on a directory its reader never returned).
+    for read in (pc.read_cloud, pc._core.read_cloud_with_normals):
+        with pytest.raises(IsADirectoryError):
+            read(tmp_path)
+        with pytest.raises(FileNotFoundError):
+            read(tmp_path / "missing.pcd")
     not_pcd = tmp_path / "cloud.xyz"
     not_pcd.write_text("0 0 0\n")
     with pytest.raises(ValueError, match=r"\.pcd"):

@@ -232,6 +232,7 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-o", "out.ply"}, "-o");
   expectUsageError ({"-threads", "-1"}, "-threads");
   expectUsageError ({"-threads", "two"}, "-threads");
+  expectUsageError ({"-threads", "2147483647"}, "-threads");  // not a bad_alloc (found in review)
   expectUsageError ({"-max_leaf_fits", "-1"}, "-max_leaf_fits");
   expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
   expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");

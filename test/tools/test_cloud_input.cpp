@@ -164,6 +164,26 @@ TEST_F (CloudInput, NormalsWithoutXyzAreRejected)
   EXPECT_NE (error.find ("'x'"), std::string::npos) << error;
 }
 
+// Only regular files reach PCL's readers: on a directory PCDReader::readHeader never returned
+// (found in review through Python's read_cloud); a missing file names itself too.
+TEST_F (CloudInput, DirectoriesAndMissingFilesAreRejectedBeforeReading)
+{
+  fs::create_directories (dir_ / "cloud.pcd");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::PointCloud<pcl::PointNormal> with_normals;
+  bool has_normals = false;
+  std::string error;
+  EXPECT_FALSE (loadCloud (path ("cloud.pcd"), cloud, error));
+  EXPECT_NE (error.find ("is a directory"), std::string::npos) << error;
+  error.clear ();
+  EXPECT_FALSE (loadCloudWithNormals (path ("cloud.pcd"), with_normals, has_normals, error));
+  EXPECT_NE (error.find ("is a directory"), std::string::npos) << error;
+  error.clear ();
+  EXPECT_FALSE (loadCloud (path ("missing.pcd"), cloud, error));
+  EXPECT_NE (error.find ("missing.pcd"), std::string::npos) << error;
+  EXPECT_NE (error.find ("No such file"), std::string::npos) << error;
+}
+
 // A face-less PLY: nx ny nz (the usual PLY names, which PCL's reader maps to normal_x ...) and
 // normal_x normal_y normal_z both give the normals; ascii and binary.
 TEST_F (CloudInput, PlyNormals)
