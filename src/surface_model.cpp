@@ -440,8 +440,11 @@ openingOf (const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3f& no
     bb *= sign / norm;
   }
   const Eigen::Vector3d bisector = static_cast<double> (reach) * (ba * u + bb * v);
+  // cos(theta / 2) from cos(theta): the root's sign is the half angle's, negative past 180
+  // degrees (a sheet's corner, open 270 degrees, has an open cone of +-135 degrees, not +-45).
+  const double half_cosine = std::sqrt (0.5 * (1.0 + cosine));
   return {static_cast<float> (bisector.x ()), static_cast<float> (bisector.y ()), static_cast<float> (bisector.z ()),
-          static_cast<float> (std::sqrt (0.5 * (1.0 + cosine)))};
+          static_cast<float> (widest < 2.0 ? half_cosine : -half_cosine)};
 }
 } // namespace
 
