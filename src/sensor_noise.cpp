@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/sensor_noise.h>
+#include <pcl_probcollision/detail/input_checks.h>
 
 #include <pcl/exceptions.h>
 
@@ -50,6 +51,12 @@ SensorNoiseModel
 SensorNoiseModel::isotropic (double sigma)
 {
   requireNonNegative (sigma, "isotropic sigma");
+  // Beyond the coordinate range a deviation means nothing, and its variance would overflow the
+  // single-precision covariances, every point then read as non-finite (found in review).
+  if (!(sigma <= detail::kMaxCoordinate))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::SensorNoiseModel] isotropic sigma = "
+                             << sigma << " must be at most 1e15, the supported coordinate range");
   SensorNoiseModel m;
   m.type_ = Type::Isotropic;
   m.sigma_ = sigma;

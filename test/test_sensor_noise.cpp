@@ -115,6 +115,8 @@ TEST (SensorNoiseModel, BadParametersThrowNamingTheParameter)
 {
   EXPECT_THROW (SensorNoiseModel::isotropic (-1.0), pcl::BadArgumentException);
   EXPECT_THROW (SensorNoiseModel::isotropic (std::nan ("")), pcl::BadArgumentException);
+  EXPECT_THROW (SensorNoiseModel::isotropic (1e20), pcl::BadArgumentException);  // beyond the coordinate range
+  EXPECT_NO_THROW (SensorNoiseModel::isotropic (1e15));
   SensorNoiseModel::StereoParams stereo;
   stereo.baseline = 0.0;
   try

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "cli_options.h"
 
+#include <pcl_probcollision/detail/input_checks.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -133,6 +135,21 @@ inputKindOf (const std::string& path)
   return InputKind::Unsupported;
 }
 
+namespace
+{
+/** \brief Why a pose's translation is out of the library's range (detail::kMaxCoordinate, the
+  * bound collide() enforces), so that the command line refuses it where it is read; empty if
+  * none. Finite angles always give a rotation. */
+std::string
+translationRangeError (const Pose& pose)
+{
+  for (int i = 0; i < 3; ++i)
+    if (!(std::abs (pose[static_cast<std::size_t> (i)]) <= pcl_probcollision::detail::kMaxCoordinate))
+      return "translation beyond the supported range of +-1e15";
+  return std::string ();
+}
+} // namespace
+
 int
 parsePoseLine (const std::string& line, Pose& pose, std::string& error)
 {
@@ -183,7 +200,8 @@ parsePoseLine (const std::string& line, Pose& pose, std::string& error)
       return -1;
     }
   }
-  return 1;
+  error = translationRangeError (pose);
+  return error.empty () ? 1 : -1;
 }
 
 bool
@@ -317,12 +335,15 @@ parseCommandLine (const std::vector<std::string>& args)
     const std::string v = inline_value ? arg.substr (eq + 1) : args[++i];
     const std::string bad = "option " + a + ": '" + v + "' ";
 
+    // A noise deviation: >= 0 and within the coordinate range (SensorNoiseModel::isotropic's rule).
     auto nonNegative = [&] (std::optional<double>& out) -> std::optional<ParseResult> {
       double d = 0.0;
       if (!parseDouble (v, d))
         return usage (bad + "is not a number");
       if (d < 0.0)
         return usage (bad + "must be >= 0");
+      if (!(d <= pcl_probcollision::detail::kMaxCoordinate))
+        return usage (bad + "must be at most 1e15, the supported coordinate range");
       out = d;
       return std::nullopt;
     };
@@ -334,6 +355,8 @@ parseCommandLine (const std::vector<std::string>& args)
         return usage (bad + "must be six comma-separated numbers tx,ty,tz,roll,pitch,yaw");
       Pose p{};
       std::copy (vals.begin (), vals.end (), p.begin ());
+      if (const std::string why = translationRangeError (p); !why.empty ())
+        return usage (bad + "has a " + why);
       o.pose = p;
     }
     else if (a == "-poses")

@@ -413,3 +413,21 @@ def test_cli_errors_match_pcd_collision(tmp_path):
     usage = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, str(bad), "--scheduler", "local:1",
                             "-sigma", "1O"], capture_output=True, text=True, timeout=60)
     assert usage.returncode == 2 and "option -sigma: '1O' is not a number" in usage.stderr
+    # Runtime failures are exit 1 as in pcd_collision, not usage errors: a number too large for a
+    # double in a poses file, and a one-point cloud, which gives a mesh no sample spacing.
+    huge = tmp_path / "huge.txt"
+    huge.write_text("0 0 0 0 0 1e999\n")
+    far = tmp_path / "far.txt"
+    far.write_text("# a comment\n0 0 0 0 0 0\n1e16 0 0 0 0 0\n")
+    one = tmp_path / "one.pcd"
+    one.write_text("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                   "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n0 0 0\n")
+    ok = tmp_path / "ok.txt"
+    ok.write_text("0 0 0 0 0 0\n")
+    for inputs, poses in ((args, huge), (args, far), ([str(DATA / "gripper.obj"), str(one)], ok)):
+        cpp = subprocess.run([_pcd_collision(), *inputs, "-poses", str(poses), "-json"], capture_output=True, text=True)
+        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *inputs, str(poses), "--scheduler", "local:1"],
+                            capture_output=True, text=True, timeout=120)
+        assert (py.returncode, py.stdout) == (cpp.returncode, "") == (1, ""), (py.stderr, cpp.stderr)
+        if poses is not ok:  # refused with its line, before any query, in the same words
+            assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1]

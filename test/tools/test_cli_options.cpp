@@ -233,6 +233,8 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-threads", "-1"}, "-threads");
   expectUsageError ({"-threads", "two"}, "-threads");
   expectUsageError ({"-threads", "2147483647"}, "-threads");  // not a bad_alloc (found in review)
+  expectUsageError ({"-pose", "1e300,0,0,0,0,0"}, "-pose");  // the library's +-1e15, refused where it is read
+  expectUsageError ({"-sigma", "1e20"}, "-sigma");  // its variance overflowed: "no finite point" (found in review)
   expectUsageError ({"-max_leaf_fits", "-1"}, "-max_leaf_fits");
   expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
   expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");
@@ -385,6 +387,11 @@ TEST (CliOptions, PoseFiles)
   std::istringstream bad ("0 0 0.1 0 0 0\n\n0 0 0.2 0 0\n");
   EXPECT_FALSE (parsePoses (bad, "p.txt", poses, e));
   EXPECT_EQ (e.rfind ("p.txt:3: ", 0), 0u) << e;
+  // out of the library's range: refused with its line before any query (found in review: the
+  // query failed later, naming a 0-based pose index and no file)
+  std::istringstream far ("# c\n0 0 0 0 0 0\n1e16 0 0 0 0 0\n");
+  EXPECT_FALSE (parsePoses (far, "p.txt", poses, e));
+  EXPECT_EQ (e.rfind ("p.txt:3: translation beyond", 0), 0u) << e;
   std::istringstream empty ("# nothing\n\n");
   EXPECT_FALSE (parsePoses (empty, "p.txt", poses, e));
   EXPECT_NE (e.find ("no pose"), std::string::npos) << e;

@@ -11,7 +11,8 @@ import time
 
 import numpy as np
 
-from . import collide_poses, connect, prepare_input
+from .. import _core as core
+from . import collide_poses, connect, prepare_input, resolve_options
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
@@ -167,6 +168,12 @@ def read_poses(path):
             bad = [t for t in tokens if not _FLOAT.match(t)]
             if bad:
                 why = f"'{bad[0]}' is not a number"
+            else:
+                huge = [t for t in tokens if not math.isfinite(float(t))]  # 1e999 matches _FLOAT
+                if huge:
+                    why = f"'{huge[0]}' is not a finite number"
+                elif any(abs(float(t)) > core.MAX_COORDINATE for t in tokens[:3]):
+                    why = "translation beyond the supported range of +-1e15"
         if why is not None:
             raise Failure(f"{path}:{number}: {why}")
         if tokens:
@@ -274,6 +281,10 @@ def main(argv):
     try:
         positional, options, own = parse(argv)
         path_a, path_b, poses_path = positional
+        try:  # option values pcd_collision refuses are usage errors (exit 2), found before any work
+            resolve_options(options)
+        except (TypeError, ValueError) as e:
+            raise Usage(str(e)) from None
         pose_rows = read_poses(poses_path)  # a malformed file fails before the (slow) loading
         try:
             # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
@@ -291,7 +302,9 @@ def main(argv):
         try:
             r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], **options)
         except (TypeError, ValueError) as e:
-            raise Usage(str(e)) from None
+            # the options passed above: what fails here is the data (a cloud without a spacing, a
+            # pose out of range), a runtime failure as in pcd_collision (exit 1)
+            raise Failure(str(e)) from None
         bad = np.flatnonzero(r.status != 0)
         if bad.size:
             raise Failure(f"pose {bad[0]}: query failed")
