@@ -208,6 +208,8 @@ class CloudModel:
     def surface_hidden_from_viewpoint(self) -> float: ...
     def __len__(self) -> int: ...
 
+MAX_COORDINATE: float  # the library's coordinate and pose-translation bound (1e15)
+
 def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDArray[np.floating]] = None,
                 params: Optional[CloudModelParams] = None, name: str = "cloud",
                 viewpoint: Optional[npt.ArrayLike] = None,
