@@ -820,3 +820,40 @@ TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotTriggerIt)
   EXPECT_EQ (buildCloudModel (*a, wholeCloud (0.005, 2.0))->mergedSamples (), 0u);
   EXPECT_GT (buildCloudModel (*a, merging (0.005, 2.0))->mergedSamples (), 200u);
 }
+
+// Given covariances must be covariances: a negative-definite one is refused naming its point
+// (found in review: -1e-6 I was accepted and read as a sure collision); a NaN one marks a missing
+// value and drops its point; singular ones (a flat disc, zero) are covariances.
+TEST (CloudModel, GivenCovariancesMustBePositiveSemiDefinite)
+{
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (int i = 0; i < 50; ++i)
+    cloud.push_back (pcl::PointXYZ (0.01f * static_cast<float> (i % 10), 0.01f * static_cast<float> (i / 10), 0.0f));
+  const auto withCovariance = [&] (const Eigen::Matrix3d& c, int bad_point) {
+    pcl::PointCloud<Covariance> covs;
+    for (int i = 0; i < 50; ++i)
+      covs.push_back (i == bad_point ? Covariance (c) : Covariance (1e-6 * Eigen::Matrix3d::Identity ()));
+    return covs;
+  };
+  const auto build = [&] (const pcl::PointCloud<Covariance>& covs) {
+    return buildCloudModel (cloud, CloudModelParams (), nullptr, &covs, "given");
+  };
+  EXPECT_NO_THROW (build (withCovariance (Eigen::Vector3d (1e-6, 1e-6, 0.0).asDiagonal ().toDenseMatrix (), 7)));
+  EXPECT_NO_THROW (build (withCovariance (Eigen::Matrix3d::Zero (), 7)));
+  EXPECT_EQ (build (withCovariance (Eigen::Matrix3d::Constant (std::nan ("")), 7))->size (), 49u);
+  Eigen::Matrix3d indefinite = 1e-6 * Eigen::Matrix3d::Identity ();
+  indefinite (0, 1) = indefinite (1, 0) = 2e-6;
+  for (const Eigen::Matrix3d& bad : {Eigen::Matrix3d (-1e-6 * Eigen::Matrix3d::Identity ()), indefinite})
+  {
+    try
+    {
+      build (withCovariance (bad, 7));
+      FAIL () << "accepted\n" << bad;
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find ("given covariance of point 7 is not positive semi-definite"), std::string::npos)
+          << e.what ();
+    }
+  }
+}

@@ -71,6 +71,30 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     max_abs = std::max (max_abs, m);
   }
 
+  // Given covariances must be covariances: positive semi-definite within rounding (a NaN one marks
+  // a missing value and drops its point; a negative one is an error, found in review: -1e-6 I read
+  // as a sure collision). Principal minors, in double, against the matrix's own scale.
+  if (covariances)
+    for (std::size_t j = 0; j < n; ++j)
+    {
+      const Covariance& c = (*covariances)[at (j)];
+      if (!c.isFinite ())
+        continue;
+      const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
+      const double scale = std::max ({std::abs (xx), std::abs (yy), std::abs (zz), std::abs (xy), std::abs (xz), std::abs (yz)});
+      const double tol = 1e-6 * scale;
+      const double minor_xy = xx * yy - xy * xy, minor_xz = xx * zz - xz * xz, minor_yz = yy * zz - yz * yz;
+      const double det = xx * minor_yz - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+      if (xx < -tol || yy < -tol || zz < -tol || minor_xy < -tol * scale || minor_xz < -tol * scale ||
+          minor_yz < -tol * scale || det < -tol * scale * scale)
+      {
+        err.precision (9);
+        err << name << " covariance of point " << at (j) << " is not positive semi-definite (xx " << xx << ", yy " << yy
+            << ", zz " << zz << ", xy " << xy << ", xz " << xz << ", yz " << yz << ")";
+        throw pcl::BadArgumentException (err.str ());
+      }
+    }
+
   // Samples closer than their noise, merged (CloudModelParams::noise_resolution): the model of
   // the merged cloud, mapped back to every sample of this one; null when no two samples merge.
   // gate_k as detail::mergeByNoise takes it.
