@@ -58,6 +58,21 @@ typeName (const py::handle& h)
   return py::str (py::type::handle_of (h).attr ("__name__"));
 }
 
+/** obj as T, or TypeError naming the argument (pybind11's own cast error is a RuntimeError). */
+template <typename T>
+T
+castArgument (const py::object& obj, const char* name, const char* type)
+{
+  try
+  {
+    return obj.cast<T> ();
+  }
+  catch (const py::cast_error&)
+  {
+    throw py::type_error (std::string (name) + ": expected " + type + " or None, got " + typeName (obj));
+  }
+}
+
 /** The array behind a float32 / float64 argument of the given rank and trailing dims, or
   * TypeError / ValueError naming the argument. */
 py::array
@@ -170,7 +185,7 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
     else
       fillCovariances<double> (c, covs);
   }
-  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
+  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : castArgument<CloudModelParams> (params_obj, "params", "CloudModelParams");
   if (!viewpoint.is_none ())
   {
     // PCD's VIEWPOINT: tx ty tz qw qx qy qz, the sensor pose the depth noise models use.
@@ -243,7 +258,7 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
     ch = static_cast<char> (std::tolower (static_cast<unsigned char> (ch)));
   if (ext != ".pcd")
     throw py::value_error ("path: only .pcd files are read, got '" + path.string () + "'");
-  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : params_obj.cast<CloudModelParams> ();
+  const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : castArgument<CloudModelParams> (params_obj, "params", "CloudModelParams");
   const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
 
   // io::loadCloud is pcd_collision's reader: every check a file of unknown origin needs (PCL
@@ -325,7 +340,7 @@ toPose (const py::object& obj, const char* arg)
 CollisionRequest
 requestOf (const py::object& obj)
 {
-  CollisionRequest request = obj.is_none () ? CollisionRequest () : obj.cast<CollisionRequest> ();
+  CollisionRequest request = obj.is_none () ? CollisionRequest () : castArgument<CollisionRequest> (obj, "request", "CollisionRequest");
   request.validate ();
   return request;
 }
@@ -1144,9 +1159,16 @@ PYBIND11_MODULE (_core, m)
          [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
            const auto mesh = meshOf (vertices, triangles);
            pcl::PointCloud<pcl::PointXYZ> cloud;
+           if (!(spacing > 0.0) || !std::isfinite (spacing))
+             throw py::value_error ("spacing: must be finite and > 0, got " + py::str (py::float_ (spacing)).cast<std::string> ());
+           try
            {
              py::gil_scoped_release release;
              cloud = pcl_probcollision::io::sampleMesh (mesh, spacing, seed);
+           }
+           catch (const std::runtime_error& e)  // more samples than the sampler allows
+           {
+             throw py::value_error (std::string ("spacing: ") + e.what ());
            }
            return cloudArray (cloud);
          },
@@ -1156,9 +1178,16 @@ PYBIND11_MODULE (_core, m)
          [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
            const auto mesh = meshOf (vertices, triangles);
            pcl::PointCloud<pcl::PointNormal> cloud;
+           if (!(spacing > 0.0) || !std::isfinite (spacing))
+             throw py::value_error ("spacing: must be finite and > 0, got " + py::str (py::float_ (spacing)).cast<std::string> ());
+           try
            {
              py::gil_scoped_release release;
              cloud = pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed);
+           }
+           catch (const std::runtime_error& e)  // more samples than the sampler allows
+           {
+             throw py::value_error (std::string ("spacing: ") + e.what ());
            }
            py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
            py::array_t<float> normals ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});

@@ -739,3 +739,20 @@ def test_noise_stop_keeps_nodes_within_the_noise_whole(table_points, gripper_pat
     stopped_params.noise_stop = -1.0
     with pytest.raises(ValueError, match="noise_stop"):
         pc.build_model(table_points, params=stopped_params)
+
+
+def test_wrong_argument_types_and_values_are_typeerror_and_valueerror():
+    # pybind11's own cast failure is a RuntimeError; the README promises TypeError / ValueError.
+    a = pc.build_model(np.random.default_rng(2).random((30, 3)))
+    with pytest.raises(TypeError, match="params: expected CloudModelParams"):
+        pc.build_model(np.random.default_rng(2).random((30, 3)), params=5)
+    with pytest.raises(TypeError, match="request: expected CollisionRequest"):
+        pc.collide(a, a, np.eye(4), request="x")
+    with pytest.raises(TypeError, match="request: expected CollisionRequest"):
+        pc.collide_batch(a, a, np.eye(4)[None], request=5)
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    for spacing in (0.0, float("nan"), 1e-9):
+        with pytest.raises(ValueError, match="spacing"):
+            pc.sample_mesh(V, [[0, 1, 2]], spacing)
+        with pytest.raises(ValueError, match="spacing"):
+            pc.sample_mesh_with_normals(V, [[0, 1, 2]], spacing)
