@@ -881,6 +881,8 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
       // does not divide by zero.
       const double a = static_cast<double> (spacing_[s]) * spacing_[s];
       const double r2 = u.squaredNorm () + 0.25 * a;
+      if (!(r2 > 0.0))
+        continue;  // a sample of no area (a duplicate's spacing is 0) exactly at q: 0, not 0 / 0
       w += a * normals_[s].cast<double> ().dot (u) / (r2 * std::sqrt (r2));
     }
   }

@@ -129,6 +129,26 @@ shift (double x, double y, double z)
 }
 } // namespace
 
+// A query exactly on a sample of no area (a point repeated past k times, spacing 0) is finite: the sample
+// adds nothing instead of 0 / 0 (found in review: NaN, which the inside test read as inside).
+TEST (SurfaceModel, TheWindingNumberOnADuplicatedSampleIsFinite)
+{
+  auto cloud = xyz (sphere (800, 0.1, Eigen::Vector3d (1, 2, 3)));
+  for (int copy = 0; copy < 12; ++copy)  // more copies than k neighbours: a k-th neighbour at 0
+    cloud.push_back (cloud[0]);
+  const auto model = buildCloudModel (cloud, withSurface ());
+  const SurfaceModel& s = model->surface ();
+  const auto& means = model->hierarchy ().means ();
+  std::size_t zero = means.size ();
+  for (std::size_t i = 0; i < means.size () && zero == means.size (); ++i)
+    if (s.spacing ()[i] == 0.0f && !s.normals ()[i].isZero ())
+      zero = i;
+  ASSERT_LT (zero, means.size ()) << "no sample of zero spacing: the case is not exercised";
+  const double w = s.windingNumber (model->hierarchy (), means[zero]);
+  EXPECT_TRUE (std::isfinite (w)) << w;
+  EXPECT_NEAR (w, 0.5, 0.3);  // on the surface: about half
+}
+
 TEST (SurfaceModel, PropagationOrientsAClosedSurfaceOutward)
 {
   // The sphere off the origin: PCL's default sensor_origin_ (0, 0, 0) lies outside it, but is
