@@ -699,7 +699,9 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
 
   // Stability by re-scan (issue 16): near-band poses; each re-scan samples both meshes anew
   // (new sample positions, same counts) and draws new noise; ours: the shared build's settings
-  // on one build, the 2-sigma collision map on the same re-scanned room.
+  // on one build, the 2-sigma collision map on the same re-scanned room. By area alone: the main
+  // clouds keep every mesh vertex, which would sit at the same place in every re-scan (57 % of
+  // the sparse room's points, 13 % of the dense room's, 6.5 % of the piano's; found in review).
   {
     const std::vector<std::size_t> scan_poses = spreadNearSigma (cell, o.rescan_poses ? o.rescan_poses : o.quick ? 20 : 100);
     const int rescans = o.rescans ? o.rescans : o.quick ? 8 : 10;
@@ -716,9 +718,9 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const std::uint64_t scan_noise = streamSeed (sample_seed, static_cast<std::uint64_t> (pct * 100));
       Outward rob_out, env_out;
       const CloudXYZ::ConstPtr rob_r =
-        addNoise (*sampleCount (w.rob_mesh, den.rob_points, sample_seed, &rob_out), sigma, scan_noise);
+        addNoise (*sampleCount (w.rob_mesh, den.rob_points, sample_seed, &rob_out, false), sigma, scan_noise);
       const CloudXYZ::ConstPtr env_r =
-        addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1, &env_out), sigma, scan_noise + 1);
+        addNoise (*sampleCount (w.env_mesh, den.env_points, sample_seed + 1, &env_out, false), sigma, scan_noise + 1);
       BuildRow unused;
       const ScanSides sides {&rob_out, &env_out};
       if (!shared.settings.empty ())
@@ -1112,7 +1114,8 @@ issue16Targets (const Options& o, const std::vector<Summary>& summaries, const R
              "no signed_distance in the results (surface layer absent or off)");
       else
         add ("+-2 std distance interval covers the truth", scope,
-             fmtFixed (s->sd_near_sigma.coverage) + " of " + std::to_string (s->sd_near_sigma.count), ">= 0.90",
+             fmtFixed (s->sd_near_sigma.coverage) + " of " + std::to_string (s->sd_near_sigma.total) +
+                 " (a distance for " + std::to_string (s->sd_near_sigma.count) + ")", ">= 0.90",
              atLeast (s->sd_near_sigma.coverage, 0.9));
     }
   // Reliability, both densities, 0.25-2 %, near band.

@@ -244,8 +244,11 @@ signedDistanceErrors (const std::vector<double>& estimate, const std::vector<dou
     covered += (std::isfinite (std[i]) && e <= k * std[i]) ? 1 : 0;
   }
   out.count = errors.size ();
+  out.total = estimate.size ();
   out.median_abs_error = percentile (errors, 50.0);
-  out.coverage = out.count > 0 ? static_cast<double> (covered) / static_cast<double> (out.count) : kNaN;
+  // Over all pairs: a pose answered without a distance (the ladder's separators) covers nothing
+  // (found in review: counted over the poses with one, the ladder's 0.45-0.60 read 0.87-0.94).
+  out.coverage = out.count > 0 ? static_cast<double> (covered) / static_cast<double> (out.total) : kNaN;
   return out;
 }
 

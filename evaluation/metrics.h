@@ -110,12 +110,16 @@ bool reliabilityBinWithin (const ReliabilityBin& bin, double floor = 0.1, double
 /** \brief Error of a signed-distance estimate against the truth. */
 struct DistanceErrors
 {
-  std::size_t count = 0;           ///< pairs with a finite estimate (the others are skipped)
+  std::size_t count = 0;           ///< pairs with a finite estimate (the median skips the others)
+  std::size_t total = 0;           ///< all pairs
   double median_abs_error = 0.0;   ///< median |estimate - truth| / scale; NaN when count is 0
-  double coverage = 0.0;           ///< share with |estimate - truth| <= k std (a NaN std never covers); NaN when count is 0
+  /** \brief Share of all pairs with |estimate - truth| <= k std: a pair without an estimate, or
+    * with a NaN std, is not covered (an answer without an interval covers nothing); NaN when no
+    * pair has an estimate (not measured). */
+  double coverage = 0.0;
 };
 
-/** \brief Errors of `estimate` (NaN = not computed, skipped) with standard deviations `std`
+/** \brief Errors of `estimate` (NaN = not computed: skipped by the median, uncovered) with standard deviations `std`
   * against `truth`, in units of `scale` (per pair, e.g. sigma_eff); coverage of the +-k std
   * interval. Throws std::invalid_argument when the sizes differ. */
 DistanceErrors signedDistanceErrors (const std::vector<double>& estimate, const std::vector<double>& std,

@@ -244,13 +244,14 @@ TEST (ReliabilityCheck, TenPointsOrTwoStandardErrorsWhicheverIsWider)
 
 TEST (SignedDistanceErrors, MedianInScaleUnitsAndCoverage)
 {
-  // Errors 1, 3, 0.5 (scale 1, 1, 0.5 -> 1, 3, 1); the NaN estimate is skipped.
+  // Errors 1, 3, 0.5 (scale 1, 1, 0.5 -> 1, 3, 1); the NaN estimate is skipped by the median.
   const auto e = ev::signedDistanceErrors ({1.0, -2.0, 0.5, kNaN}, {1.0, 1.0, kNaN, 1.0}, {0.0, 1.0, 0.0, 0.0},
                                            {1.0, 1.0, 0.5, 1.0});
   EXPECT_EQ (e.count, 3u);
+  EXPECT_EQ (e.total, 4u);
   EXPECT_DOUBLE_EQ (e.median_abs_error, 1.0);
-  // Covered: |1| <= 2; not |3| > 2; not a NaN std.
-  EXPECT_DOUBLE_EQ (e.coverage, 1.0 / 3.0);
+  // Covered: |1| <= 2; not |3| > 2; not a NaN std; not the pose without an estimate.
+  EXPECT_DOUBLE_EQ (e.coverage, 1.0 / 4.0);
   const auto none = ev::signedDistanceErrors ({kNaN}, {1.0}, {0.0}, {1.0});
   EXPECT_EQ (none.count, 0u);
   EXPECT_TRUE (std::isnan (none.median_abs_error));

@@ -160,9 +160,11 @@ void evaluateScenes (const std::string& data_dir, const std::vector<double>& clo
                      int& right, int& total);
 
 /** \brief The mesh sampled uniformly by area plus every vertex, aiming at `target` points in all
-  * (pcl_probcollision::io::sampleMesh; deterministic for a seed). With outward, also each
-  * sample's face normal (the same points). */
-CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed, Outward* outward = nullptr);
+  * (pcl_probcollision::io::sampleMesh; deterministic for a seed); without `vertices`, by area
+  * alone (every position new for a new seed: the re-scans). With outward, also each sample's
+  * face normal (the same points). */
+CloudXYZ::Ptr sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed, Outward* outward = nullptr,
+                           bool vertices = true);
 
 /** \brief Gaussian noise of standard deviation sigma on every coordinate (deterministic). */
 CloudXYZ::Ptr addNoise (const CloudXYZ& clean, double sigma, std::uint64_t seed);
