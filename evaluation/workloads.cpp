@@ -236,27 +236,22 @@ buildOurs (const CloudXYZ::ConstPtr& robot, const CloudXYZ::ConstPtr& env, doubl
 CloudXYZ::Ptr
 sampleCount (const TriangleMesh& mesh, std::size_t target, std::uint64_t seed, Outward* outward, bool vertices)
 {
-  // sampleMesh keeps every vertex (first, one per vertex a triangle uses): aim the area samples at
-  // what the vertices leave, or, without them, at the whole target.
-  std::vector<char> used (mesh.vertices.size (), 0);
-  for (const auto& t : mesh.triangles)
-    for (const int i : t)
-      used[static_cast<std::size_t> (i)] = 1;
-  const auto n_vertices = static_cast<std::size_t> (std::count (used.begin (), used.end (), 1));
+  // sampleMesh keeps every vertex: aim the area samples at what the vertices leave (without
+  // them, at the whole target).
   const double area_points =
       vertices ? std::max (0.5 * target, static_cast<double> (target) - mesh.vertices.size ()) : static_cast<double> (target);
   const double spacing = std::sqrt (pcl_probcollision::io::meshArea (mesh) / area_points);
-  const pcl::PointCloud<pcl::PointNormal> with = pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed);
-  const std::size_t first = vertices ? 0 : std::min (n_vertices, with.size ());
+  const pcl::PointCloud<pcl::PointNormal> with =
+      pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed, pcl_probcollision::io::kMaxMeshSamples, vertices);
   CloudXYZ::Ptr cloud (new CloudXYZ);
-  cloud->resize (with.size () - first);
+  cloud->resize (with.size ());
   if (outward)
-    outward->resize (with.size () - first);
-  for (std::size_t i = first; i < with.size (); ++i)
+    outward->resize (with.size ());
+  for (std::size_t i = 0; i < with.size (); ++i)
   {
-    (*cloud)[i - first].getVector3fMap () = with[i].getVector3fMap ();
+    (*cloud)[i].getVector3fMap () = with[i].getVector3fMap ();
     if (outward)
-      (*outward)[i - first] = with[i].getNormalVector3fMap ();
+      (*outward)[i] = with[i].getNormalVector3fMap ();
   }
   return cloud;
 }

@@ -57,7 +57,8 @@ meshDiagonal (const TriangleMesh& mesh)
 }
 
 pcl::PointCloud<pcl::PointNormal>
-sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points)
+sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t seed, std::size_t max_points,
+                       bool vertices)
 {
   if (!(spacing > 0.0) || !std::isfinite (spacing))
     throw std::runtime_error ("mesh sample spacing must be finite and > 0");
@@ -96,7 +97,7 @@ sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t s
   for (const auto& t : mesh.triangles)
     for (const int i : t)
       used[static_cast<std::size_t> (i)] = 1;
-  for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
+  for (std::size_t i = 0; vertices && i < mesh.vertices.size (); ++i)
     if (used[i])
       cloud.push_back (point (vertex (mesh, static_cast<int> (i)), vertex_normal[i]));
 

@@ -16,19 +16,24 @@
 
 namespace pcl_probcollision::io
 {
+/** \brief The samplers' default bound on the points produced. */
+constexpr std::size_t kMaxMeshSamples = 20000000;
+
 /** \brief Samples the surface: each triangle gets floor(area / spacing^2 + u) points (u uniform
   * in [0, 1)), uniform over the triangle, and every vertex used by a triangle is added once;
   * the expected density is one sample per spacing^2 of area. Deterministic for a given seed
   * (std::mt19937_64 and its raw bits only, so identical across standard libraries).
   * Throws std::runtime_error when more than max_points would be produced. */
 pcl::PointCloud<pcl::PointXYZ> sampleMesh (const TriangleMesh& mesh, double spacing, std::uint64_t seed,
-                                           std::size_t max_points = 20000000);
+                                           std::size_t max_points = kMaxMeshSamples);
 
 /** \brief sampleMesh's points (the same, for the same arguments) with outward normals: a
   * sample's is its triangle's, a vertex's the area-weighted mean of its triangles' (faces
-  * wound counter-clockwise seen from outside). CloudModelParams' Auto orientation takes them. */
+  * wound counter-clockwise seen from outside). CloudModelParams' Auto orientation takes them.
+  * Without `vertices`, the area samples alone (the same ones: the vertices draw nothing), so
+  * that every position is new for a new seed. */
 pcl::PointCloud<pcl::PointNormal> sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t seed,
-                                                         std::size_t max_points = 20000000);
+                                                         std::size_t max_points = kMaxMeshSamples, bool vertices = true);
 
 /** \brief Total triangle area. */
 double meshArea (const TriangleMesh& mesh);

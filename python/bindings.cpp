@@ -1159,14 +1159,12 @@ PYBIND11_MODULE (_core, m)
          [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
            const auto mesh = meshOf (vertices, triangles);
            pcl::PointCloud<pcl::PointXYZ> cloud;
-           if (!(spacing > 0.0) || !std::isfinite (spacing))
-             throw py::value_error ("spacing: must be finite and > 0, got " + py::str (py::float_ (spacing)).cast<std::string> ());
            try
            {
              py::gil_scoped_release release;
              cloud = pcl_probcollision::io::sampleMesh (mesh, spacing, seed);
            }
-           catch (const std::runtime_error& e)  // more samples than the sampler allows
+           catch (const std::runtime_error& e)  // the sampler's spacing checks: a ValueError here
            {
              throw py::value_error (std::string ("spacing: ") + e.what ());
            }
@@ -1178,14 +1176,12 @@ PYBIND11_MODULE (_core, m)
          [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
            const auto mesh = meshOf (vertices, triangles);
            pcl::PointCloud<pcl::PointNormal> cloud;
-           if (!(spacing > 0.0) || !std::isfinite (spacing))
-             throw py::value_error ("spacing: must be finite and > 0, got " + py::str (py::float_ (spacing)).cast<std::string> ());
            try
            {
              py::gil_scoped_release release;
              cloud = pcl_probcollision::io::sampleMeshWithNormals (mesh, spacing, seed);
            }
-           catch (const std::runtime_error& e)  // more samples than the sampler allows
+           catch (const std::runtime_error& e)  // the sampler's spacing checks: a ValueError here
            {
              throw py::value_error (std::string ("spacing: ") + e.what ());
            }

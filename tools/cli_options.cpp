@@ -2,6 +2,7 @@
 #include "cli_options.h"
 
 #include <pcl_probcollision/detail/input_checks.h>
+#include <pcl_probcollision/detail/parallel.h>
 
 #include <algorithm>
 #include <cctype>
@@ -369,8 +370,9 @@ parseCommandLine (const std::vector<std::string>& args)
     {
       if (!parseInt (v, o.threads))
         return usage (bad + "is not an integer");
-      if (o.threads < 0 || o.threads > 1024)
-        return usage (bad + "must be in [0, 1024] (0: one per hardware thread)");
+      if (o.threads < 0 || o.threads > pcl_probcollision::detail::kMaxThreads)
+        return usage (bad + "must be in [0, " + std::to_string (pcl_probcollision::detail::kMaxThreads) +
+                      "] (0: one per hardware thread)");
     }
     else if (a == "-sigma")
     {

@@ -103,3 +103,27 @@ TEST (MedianSpacing, AModelThatCannotTellSaysSo)
   ASSERT_GT (model->mergedSamples (), 0u);
   EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));
 }
+
+// Without vertices the sampler gives its area samples alone, the same ones: the evaluation's
+// re-scans use it so that no sample sits at the same place in every re-scan.
+TEST (MeshSampling, WithoutVerticesGivesTheSameAreaSamples)
+{
+  pcl_probcollision::io::TriangleMesh mesh;
+  mesh.vertices = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {1.0, 1.0, 0.0}, {5.0, 5.0, 5.0}};  // the last unused
+  mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
+  const auto with = pcl_probcollision::io::sampleMeshWithNormals (mesh, 0.05, 7);
+  const auto without = pcl_probcollision::io::sampleMeshWithNormals (mesh, 0.05, 7, pcl_probcollision::io::kMaxMeshSamples, false);
+  ASSERT_EQ (with.size (), without.size () + 4u);  // the four used vertices come first
+  ASSERT_GT (without.size (), 300u);
+  for (std::size_t i = 0; i < without.size (); ++i)
+  {
+    EXPECT_EQ (with[i + 4].getVector3fMap (), without[i].getVector3fMap ()) << i;
+    EXPECT_EQ (with[i + 4].getNormalVector3fMap (), without[i].getNormalVector3fMap ()) << i;
+  }
+  const auto other = pcl_probcollision::io::sampleMeshWithNormals (mesh, 0.05, 8, pcl_probcollision::io::kMaxMeshSamples, false);
+  std::size_t shared = 0;
+  for (const auto& p : other)
+    for (const auto& q : without)
+      shared += p.getVector3fMap () == q.getVector3fMap () ? 1 : 0;
+  EXPECT_EQ (shared, 0u);  // another seed: every position new
+}

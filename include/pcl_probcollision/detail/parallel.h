@@ -14,16 +14,17 @@ namespace pcl_probcollision
 {
 namespace detail
 {
-/** \brief The number of threads a `threads` setting asks for: itself when > 0 (at most 1,024),
-  * else one per hardware thread (at least one). The one reading of the library's "0 = every
-  * core". */
+/** \brief The most threads a `threads` setting starts: per-worker scratch is allocated up front,
+  * and a count like INT_MAX asked for gigabytes of it (found in review). The answers do not
+  * depend on the count, so the cap changes nothing but the speed of an absurd request. */
+constexpr int kMaxThreads = 1024;
+
+/** \brief The number of threads a `threads` setting asks for: itself when > 0 (at most
+  * kMaxThreads), else one per hardware thread (at least one). The one reading of the library's
+  * "0 = every core". */
 inline std::size_t
 threadCount (int threads)
 {
-  // Workers beyond kMaxThreads are not started: per-worker scratch is allocated up front, and a
-  // count like INT_MAX asked for gigabytes of it (found in review). The answers do not depend on
-  // the count, so the cap changes nothing but the speed of an absurd request.
-  constexpr int kMaxThreads = 1024;
   return threads > 0 ? static_cast<std::size_t> (std::min (threads, kMaxThreads))
                      : std::max (1u, std::thread::hardware_concurrency ());
 }
