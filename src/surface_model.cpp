@@ -355,6 +355,134 @@ pseudoAngle (double x, double y)
   return x < 0.0 ? 2.0 - y / (-x - y) : 3.0 + x / std::max (x - y, 1e-300);
 }
 
+/** \brief The surface area sample i stands for (SurfaceModel::areas): its Voronoi cell among
+  * its neighbours, in its tangent plane, cut by the ellipse of their spread there (two
+  * deviations along each axis about their mean: the disc of radius r_k on a uniformly filled
+  * disc, about the strip itself across a strip narrower than the neighbourhood). Barill et al.
+  * (2018) weigh their dipoles by the same kind of tangent-plane Voronoi area. On uniformly random
+  * samples (k = 10) these sum to 0.95 of a plane's area and 0.98 of a strip's, on a square
+  * lattice to 1.00; the squared spacings to 0.76, 0.83 and 0.99 (a randomly sampled closed
+  * sphere's winding number read 0.77 at its centre). Neighbours are input indices (-1: none). */
+double
+neighbourhoodArea (const std::vector<Eigen::Vector3d>& points, std::size_t i, const int* neighbours, std::size_t k,
+                   const Eigen::Vector3f& normal)
+{
+  // The neighbourhood's mean and spread relative to the sample (a duplicate adds exactly 0).
+  const Eigen::Vector3d& p = points[i];
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero ();
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero ();
+  double count = 1.0;
+  for (std::size_t j = 0; j < k; ++j)
+  {
+    const int t = neighbours[j];
+    if (t < 0 || static_cast<std::size_t> (t) >= points.size ())
+      continue;
+    const Eigen::Vector3d d = points[static_cast<std::size_t> (t)] - p;
+    mean += d;
+    second += d * d.transpose ();
+    count += 1.0;
+  }
+  mean /= count;
+  const Eigen::Matrix3d spread = second / count - mean * mean.transpose ();
+  // The plane: the sample's normal's (a fit to the same neighbours, or a mesh face's), else
+  // the neighbours' two larger spreads.
+  Eigen::Vector3d e_u, e_v;
+  if (!normal.isZero ())
+  {
+    const Eigen::Vector3d n = normal.cast<double> ();
+    e_u = n.unitOrthogonal ();
+    e_v = n.cross (e_u);
+  }
+  else
+  {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect (spread, Eigen::ComputeEigenvectors);
+    e_u = solver.eigenvectors ().col (2);
+    e_v = solver.eigenvectors ().col (1);
+  }
+  // The spread in the plane and its axes (a symmetric 2 x 2 in closed form).
+  const double suu = e_u.dot (spread * e_u), svv = e_v.dot (spread * e_v), suv = e_u.dot (spread * e_v);
+  const double mid = 0.5 * (suu + svv), radius = std::hypot (0.5 * (suu - svv), suv);
+  const double l_major = mid + radius, l_minor = mid - radius;
+  if (!(l_minor > 1e-12 * l_major))
+    return 0.0;  // collinear (up to rounding) or coincident neighbours: no area
+  // The major axis's direction in (u, v): of the two forms of the eigenvector, the longer
+  // (either can vanish); any direction when the spread is round.
+  const Eigen::Vector2d form_a (l_major - svv, suv), form_b (suv, l_major - suu);
+  Eigen::Vector2d major = form_a.squaredNorm () >= form_b.squaredNorm () ? form_a : form_b;
+  major = major.squaredNorm () > 0.0 ? Eigen::Vector2d (major.normalized ()) : Eigen::Vector2d (1.0, 0.0);
+  const Eigen::Vector2d minor (-major.y (), major.x ());
+  // The ellipse as a polygon of kSides vertices with the ellipse's area.
+  constexpr int kSides = 8;
+  static const std::array<Eigen::Vector2d, kSides> unit = [] {
+    std::array<Eigen::Vector2d, kSides> u;
+    const double fit = std::sqrt (2.0 * kPi / (kSides * std::sin (2.0 * kPi / kSides)));
+    for (int j = 0; j < kSides; ++j)
+      u[static_cast<std::size_t> (j)] = fit * Eigen::Vector2d (std::cos (2.0 * kPi * j / kSides), std::sin (2.0 * kPi * j / kSides));
+    return u;
+  }();
+  const Eigen::Vector2d centre (mean.dot (e_u), mean.dot (e_v));
+  const double a = 2.0 * std::sqrt (l_major), b = 2.0 * std::sqrt (l_minor);
+  // A convex polygon gains at most one vertex a cut: kSides + k vertices at most.
+  constexpr std::size_t kOnStack = 64;
+  std::array<Eigen::Vector2d, kOnStack> stack_a, stack_b;
+  std::vector<Eigen::Vector2d> heap_a, heap_b;
+  Eigen::Vector2d *polygon = stack_a.data (), *cut = stack_b.data ();
+  if (kSides + k > kOnStack)
+  {
+    heap_a.resize (kSides + k);
+    heap_b.resize (kSides + k);
+    polygon = heap_a.data ();
+    cut = heap_b.data ();
+  }
+  std::size_t size = kSides;
+  double reach2 = 0.0;  // the largest squared distance of a vertex from the sample
+  for (std::size_t j = 0; j < size; ++j)
+  {
+    polygon[j] = centre + (a * unit[j].x ()) * major + (b * unit[j].y ()) * minor;
+    reach2 = std::max (reach2, polygon[j].squaredNorm ());
+  }
+  for (std::size_t j = 0; j < k && size >= 3; ++j)
+  {
+    const int t = neighbours[j];
+    if (t < 0 || static_cast<std::size_t> (t) >= points.size ())
+      continue;
+    const Eigen::Vector3d d = points[static_cast<std::size_t> (t)] - p;
+    const Eigen::Vector2d v (d.dot (e_u), d.dot (e_v));
+    const double half = 0.5 * v.squaredNorm ();
+    // No bisector in the plane (a duplicate, or straight across it), or one farther from the
+    // sample than every vertex (x . v <= |x| |v|): nothing to cut. Past the first few cuts most
+    // neighbours are skipped on this test alone.
+    if (!(half > 0.0) || half * half >= reach2 * v.squaredNorm ())
+      continue;
+    // Keep x . v <= |v|^2 / 2, the side of the bisector nearer to the sample.
+    std::size_t kept = 0;
+    for (std::size_t m = 0; m < size; ++m)
+    {
+      const Eigen::Vector2d& x = polygon[m];
+      const Eigen::Vector2d& y = polygon[m + 1 < size ? m + 1 : 0];
+      const double fx = x.dot (v) - half, fy = y.dot (v) - half;
+      if (fx <= 0.0)
+        cut[kept++] = x;
+      if ((fx < 0.0 && fy > 0.0) || (fx > 0.0 && fy < 0.0))
+        cut[kept++] = x + (fx / (fx - fy)) * (y - x);
+    }
+    std::swap (polygon, cut);
+    size = kept;
+    reach2 = 0.0;
+    for (std::size_t m = 0; m < size; ++m)
+      reach2 = std::max (reach2, polygon[m].squaredNorm ());
+  }
+  double twice = 0.0;
+  for (std::size_t m = 0; m < size; ++m)
+  {
+    const Eigen::Vector2d& x = polygon[m];
+    const Eigen::Vector2d& y = polygon[m + 1 < size ? m + 1 : 0];
+    twice += x.x () * y.y () - x.y () * y.x ();
+  }
+  return size >= 3 ? 0.5 * std::abs (twice) : 0.0;
+}
+
 /** \brief SurfaceModel::openings for point i: the widest angle between its neighbours in the
   * plane of its (unoriented) normal; `reach` the distance to its k-th neighbour. */
 Eigen::Vector4f
@@ -467,6 +595,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     v = norm > 0.0f && std::isfinite (norm) ? Eigen::Vector3f (v / norm) : Eigen::Vector3f::Zero ();
   }
   spacing_.resize (n);
+  areas_.resize (n);
   std::vector<Eigen::Vector4f> open (n, Eigen::Vector4f::Zero ());
   const double scale = std::sqrt (kPi / in.k);
   const std::size_t k = static_cast<std::size_t> (in.k);
@@ -475,6 +604,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     if (!std::isfinite (in.radii[i]))
     {
       spacing_[i] = 0.0f;
+      areas_[i] = 0.0f;
       return;
     }
     double s = in.radii[i] * scale;
@@ -505,6 +635,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       const double area = 4.0 * kPi * std::sqrt (std::max (0.0, l[1]) * std::max (0.0, l[2]));
       s = std::min (s, std::sqrt (area / static_cast<double> (count)));
     }
+    areas_[i] = static_cast<float> (count >= 3 ? neighbourhoodArea (points, i, &in.neighbours[i * k], k, normals_[i]) : s * s);
     spacing_[i] = static_cast<float> (s);
     open[i] = openingOf (points, normals_[i], i, &in.neighbours[i * k], k, in.radii[i]);
   });
@@ -649,8 +780,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       if (component[i] > 0)
       {
         const std::size_t c = static_cast<std::size_t> (component[i]);
-        const double area = static_cast<double> (spacing_[i]) * spacing_[i];
-        volume[c] += area * normals_[i].cast<double> ().dot (points[i] - part_centroid[c]);
+        volume[c] += static_cast<double> (areas_[i]) * normals_[i].cast<double> ().dot (points[i] - part_centroid[c]);
       }
     for (std::size_t i = 0; i < n; ++i)
       if (component[i] > 0 && volume[static_cast<std::size_t> (component[i])] < 0.0)
@@ -733,7 +863,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       for (std::size_t j = begin_of (node); j < end_of (node); ++j)
         if (const std::size_t i = countedPoint (j); i < n)
         {
-          const double a = static_cast<double> (spacing_[i]) * spacing_[i];
+          const double a = areas_[i];
           d.area += a;
           d.center += a * points[i];
           d.moment += a * normals_[i].cast<double> ();
@@ -879,7 +1009,7 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
       const Eigen::Vector3d u = points[s] - q;
       // Each sample is a disc of radius ~ s_i / 2: regularised so that a query on a sample
       // does not divide by zero.
-      const double a = static_cast<double> (spacing_[s]) * spacing_[s];
+      const double a = areas_[s];
       const double r2 = u.squaredNorm () + 0.25 * a;
       if (!(r2 > 0.0))
         continue;  // a sample of no area (a duplicate's spacing is 0) exactly at q: 0, not 0 / 0
@@ -892,7 +1022,7 @@ SurfaceModel::windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d&
 std::size_t
 SurfaceModel::bytes () const
 {
-  return normals_.capacity () * sizeof (Eigen::Vector3f) + spacing_.capacity () * sizeof (float) +
+  return normals_.capacity () * sizeof (Eigen::Vector3f) + (spacing_.capacity () + areas_.capacity ()) * sizeof (float) +
          open_words_.capacity () * sizeof (OpenWord) + open_values_.capacity () * sizeof (Eigen::Vector4f) +
          owned_.capacity () * sizeof (std::uint64_t) + dipoles_.capacity () * sizeof (Dipole);
 }

@@ -1208,6 +1208,8 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   if (deep.found)
   {
     answerDeep (deep, a, b, answer);
+    // In decision mode deepInside stops at the first node inside: its depth is a bound.
+    answer.stopped_early = answer.stopped_early || may_stop;
     return answer;
   }
   answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;

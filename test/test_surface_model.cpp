@@ -185,7 +185,7 @@ TEST (SurfaceModel, SinglePrecisionDipolesBoundTheirSamples)
   Eigen::Vector3d moment = Eigen::Vector3d::Zero ();
   for (std::size_t i = 0; i < points.size (); ++i)
   {
-    const double a = static_cast<double> (s.spacing ()[i]) * s.spacing ()[i];
+    const double a = s.areas ()[i];
     area += s.normals ()[i].isZero () ? 0.0 : a;
     moment += a * s.normals ()[i].cast<double> ();
   }
@@ -774,6 +774,44 @@ TEST (SurfaceModel, ClosedObjectsCheckTheirPropagatedOrientation)
   EXPECT_TRUE (given->surface ().insideKnown ());
 }
 
+// Uniformly random samples (not a lattice): the sample areas add up to about the surface's
+// area, on a plane and on a sphere, so that a declared closed sphere checks out (its winding
+// number at the centre about 1). Weighted by the squared spacings instead, the plane read 0.77
+// m^2, the sphere's centre 0.76, and `closed_objects` refused the sphere (found in review).
+TEST (SurfaceModel, RandomSamplesAddUpToTheirSurfacesArea)
+{
+  std::mt19937 rng (17);
+  std::uniform_real_distribution<double> unit (-0.5, 0.5);
+  pcl::PointCloud<pcl::PointXYZ> plane;
+  for (int i = 0; i < 4000; ++i)
+  {
+    const Eigen::Vector3d u = draw3 (unit, rng);
+    plane.push_back (pcl::PointXYZ (static_cast<float> (u.x ()), static_cast<float> (u.y ()), 0.0f));
+  }
+  const auto flat = buildCloudModel (plane, withSurface ());
+  EXPECT_GT (flat->surface ().area (), 0.85) << "of 1 m^2";
+  EXPECT_LT (flat->surface ().area (), 1.1) << "of 1 m^2";
+
+  std::normal_distribution<double> normal;
+  pcl::PointCloud<pcl::PointXYZ> ball;
+  const Eigen::Vector3d centre (1, 2, 3);
+  for (int i = 0; i < 2000; ++i)
+  {
+    const Eigen::Vector3d u = draw3 (normal, rng).normalized ();
+    const Eigen::Vector3f p = (centre + 0.1 * u).cast<float> ();
+    ball.push_back (pcl::PointXYZ (p.x (), p.y (), p.z ()));
+  }
+  const auto sphere_model = buildCloudModel (ball, closedObjects (withSurface ()));
+  const SurfaceModel& s = sphere_model->surface ();
+  ASSERT_EQ (s.orientation (), NormalOrientation::Propagate);
+  const double area = 4.0 * M_PI * 0.01;
+  EXPECT_GT (s.area (), 0.85 * area);
+  EXPECT_LT (s.area (), 1.1 * area);
+  const Eigen::Vector3d local_centre = centre - sphere_model->origin ();  // the model's local frame
+  EXPECT_GT (s.windingNumber (sphere_model->hierarchy (), local_centre), 0.85);
+  EXPECT_TRUE (s.insideKnown ()) << "closed share " << s.closedShare () << ", solid share " << s.solidShare ();
+}
+
 // A small box wholly inside a big noisy box sampled without normals, deeper than any point's
 // reach of its surface: declared closed objects, the winding number finds it (collision, about
 // as deep as it lies), with the surface layer and with the ladder; undeclared, the propagated
@@ -793,6 +831,16 @@ TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
   EXPECT_EQ (inside.verdict, Verdict::InCollision) << "P " << inside.probability;
   EXPECT_LT (inside.signed_distance, -0.1) << inside.signed_distance;  // the nearest face is 0.16 away
   EXPECT_FALSE (inside.unobserved);
+  EXPECT_FALSE (inside.lower_bound);
+  // In decision mode the first node found inside decides: its depth is a bound, and says so
+  // (found in review: lower_bound was false).
+  CollisionRequest decision = surfaceRequest ();
+  decision.exhaustive = false;
+  CollisionResult decided;
+  ASSERT_TRUE (collide (*small, *declared, shift (0.05, -0.02, 0.01), decision, decided));
+  EXPECT_EQ (decided.verdict, Verdict::InCollision) << "P " << decided.probability;
+  EXPECT_TRUE (decided.lower_bound);
+  EXPECT_LE (decided.signed_distance, 0.0);
   ASSERT_TRUE (collide (*small, *undeclared, shift (0.05, -0.02, 0.01), surfaceRequest (), two_sided));
   EXPECT_EQ (two_sided.verdict, Verdict::Free) << "P " << two_sided.probability;
   ASSERT_TRUE (collide (*small, *declared, shift (0.5, 0.0, 0.0), surfaceRequest (), outside));

@@ -23,8 +23,13 @@ namespace pcl_probcollision
   * surface of the nearest samples' oriented planes, far from it from the winding number.
   *
   * Spacing: s_i = r_i sqrt(pi / k), r_i the distance to the k-th neighbour, is the side of the
-  * square each sample stands for on a uniformly sampled surface (k samples in pi r_i^2); its
-  * area a_i = s_i^2 weights the winding number.
+  * square each sample stands for on a uniformly sampled surface (k samples in pi r_i^2), at most
+  * the square root of the neighbours' spread's area over k + 1 (a strip narrower than the
+  * neighbourhood). It sets the surface layer's reaches (bridged holes, edges, joined points).
+  * Area: a_i, the sample's Voronoi cell in its tangent plane (areas()), weighs the winding
+  * number. On a lattice a_i is about s_i^2; on uniformly random samples s_i^2 reads about 0.76
+  * of a_i (the spread of a few random neighbours), which is why the two are kept apart: the
+  * winding number needs the true area, the reaches were chosen with s_i.
   */
 class SurfaceModel
 {
@@ -81,6 +86,10 @@ public:
   const std::vector<Eigen::Vector3f>& normals () const { return normals_; }
   /** \brief Local sample spacing s_i of each point (data units). */
   const std::vector<float>& spacing () const { return spacing_; }
+  /** \brief The surface area a_i each point stands for (data units squared): its Voronoi cell
+    * among its neighbours in its tangent plane, within their spread; the winding number's
+    * weights. 0 for a point repeated past k times or whose neighbours lie on a line. */
+  const std::vector<float>& areas () const { return areas_; }
   /** \brief Where the neighbours of point i leave the surface open (the point lies on its
     * edge): xyz the bisector, in the tangent plane, of the widest angle between its neighbours
     * seen from it, of length the distance to its k-th neighbour (how far they show the surface
@@ -150,8 +159,8 @@ public:
   /** \brief Points whose orientation came from propagation alone in Viewpoint mode (grazing
     * or out of the sensor's sight) or from a given normal's neighbours in PointNormals mode. */
   std::size_t propagatedPoints () const { return propagated_; }
-  /** \brief Area of the oriented surface: the sum of s_i^2 over the oriented samples (the root
-    * dipole's, in double). */
+  /** \brief Area of the oriented surface: the sum of areas() over the oriented samples (the
+    * root dipole's, in double). */
   double area () const { return area_; }
   /** \brief Per hierarchy node, its dipole. */
   const std::vector<Dipole>& dipoles () const { return dipoles_; }
@@ -193,6 +202,7 @@ private:
 
   std::vector<Eigen::Vector3f> normals_;
   std::vector<float> spacing_;
+  std::vector<float> areas_;
   std::vector<OpenWord> open_words_;
   std::vector<Eigen::Vector4f> open_values_;
   std::vector<std::uint64_t> owned_;
