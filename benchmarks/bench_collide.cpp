@@ -78,7 +78,12 @@ workload ()
     std::uniform_real_distribution<double> u (0.0, 1.0);
     for (int i = 0; i < 500; ++i)
     {
-      const Eigen::Vector3d t = w.room_lo + (w.room_hi - w.room_lo).cwiseProduct (Eigen::Vector3d (u (rng), u (rng), u (rng)));
+      // One draw a statement: the order of a call's arguments is unspecified (g++ and clang
+      // differ), and with it the workload.
+      const double x = u (rng);
+      const double y = u (rng);
+      const double z = u (rng);
+      const Eigen::Vector3d t = w.room_lo + (w.room_hi - w.room_lo).cwiseProduct (Eigen::Vector3d (x, y, z));
       const Eigen::Quaterniond q = Eigen::Quaterniond::UnitRandom ();
       w.poses.push_back (Eigen::Translation3d (t) * q);
     }

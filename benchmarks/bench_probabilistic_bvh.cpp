@@ -8,6 +8,7 @@
 // rotation and the centres 1 m +/- 2 cm apart (gap in [-2, 2] cm: near contact).
 #include <pcl_probcollision/detail/bvh_traversal.h>
 #include <pcl_probcollision/probabilistic_bvh.h>
+#include "../test/seeded_draws.h"
 
 #include <benchmark/benchmark.h>
 
@@ -20,6 +21,7 @@
 #include <vector>
 
 using namespace pcl_probcollision;
+using pcl_probcollision_test::draw3;  // one draw a statement: the same workload with every compiler
 
 namespace
 {
@@ -36,7 +38,7 @@ sphereCloud (std::size_t n, std::uint64_t seed)
   c.covariances.reserve (n);
   for (std::size_t i = 0; i < n; ++i)
   {
-    const Eigen::Vector3d d = Eigen::Vector3d (g (rng), g (rng), g (rng)).normalized ();
+    const Eigen::Vector3d d = draw3 (g, rng).normalized ();
     c.means.push_back ((radius + 0.001 * g (rng)) * d);
     const Eigen::Matrix3d P = Eigen::Matrix3d::Identity () - d * d.transpose ();
     c.covariances.push_back (tangential * tangential * P + normal * normal * d * d.transpose ());
@@ -89,8 +91,10 @@ struct TraversalFixture
     for (int i = 0; i < 1000; ++i)
     {
       Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
-      T.linear () = Eigen::Quaterniond (g (rng), g (rng), g (rng), g (rng)).normalized ().toRotationMatrix ();
-      const Eigen::Vector3d dir = Eigen::Vector3d (g (rng), g (rng), g (rng)).normalized ();
+      const double qw = g (rng);
+      const Eigen::Vector3d qv = draw3 (g, rng);
+      T.linear () = Eigen::Quaterniond (qw, qv.x (), qv.y (), qv.z ()).normalized ().toRotationMatrix ();
+      const Eigen::Vector3d dir = draw3 (g, rng).normalized ();
       T.translation () = (1.0 + gap (rng)) * dir;
       poses.push_back (T);
     }
