@@ -14,6 +14,7 @@
 #include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/sensor_noise.h>
 #include <pcl_probcollision/detail/input_checks.h>
+#include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/common/io.h>
 #include <pcl/exceptions.h>
@@ -1109,6 +1110,7 @@ PYBIND11_MODULE (_core, m)
          "    read or one with only some of the\n"
          "    normal fields (with params.surface).");
   m.attr ("MAX_COORDINATE") = detail::kMaxCoordinate;  // the library's coordinate and translation bound
+  m.attr ("MAX_THREADS") = detail::kMaxThreads;         // the library's cap on a thread count
   // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).
   m.def ("collide", &collideOne, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("pose"),
          py::arg ("request") = py::none (),

@@ -63,6 +63,10 @@ parseDouble (const std::string& text, double& value)
 {
   if (text.empty () || std::isspace (static_cast<unsigned char> (text[0])))
     return false;
+  // Decimal numbers only, as the Dask command line reads them: strtod would also take hex
+  // floats (0x1p3), "inf" and "nan".
+  if (text.find_first_not_of ("0123456789+-.eE") != std::string::npos)
+    return false;
   errno = 0;
   char* end = nullptr;
   const double v = std::strtod (text.c_str (), &end);

@@ -209,6 +209,7 @@ class CloudModel:
     def __len__(self) -> int: ...
 
 MAX_COORDINATE: float  # the library's coordinate and pose-translation bound (1e15)
+MAX_THREADS: int  # the library's cap on a thread count (1024; pcd_collision -threads refuses more)
 
 def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDArray[np.floating]] = None,
                 params: Optional[CloudModelParams] = None, name: str = "cloud",

@@ -621,9 +621,12 @@ GOOD = patch(5)
     (GOOD, np.zeros((len(GOOD), 3, 3), dtype=np.int64), TypeError, "covariances"),
     (GOOD, np.tile([[1e-4, 1e-5, 0], [0, 1e-4, 0], [0, 0, 1e-4]], (len(GOOD), 1, 1)), ValueError, "symmetric"),
 ])
-def test_bad_points(points, covariances, exc, words):
+def test_bad_points(points, covariances, exc, words, capfd):
     with pytest.raises(exc, match=words):
         pc.build_model(points, covariances)
+    # The error is the exception alone: nothing printed besides (an empty array printed PCL's
+    # "input_ is empty!" on stderr).
+    assert capfd.readouterr().err == ""
 
 
 def test_bad_params_and_request():

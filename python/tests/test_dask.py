@@ -431,3 +431,27 @@ def test_cli_errors_match_pcd_collision(tmp_path):
         assert (py.returncode, py.stdout) == (cpp.returncode, "") == (1, ""), (py.stderr, cpp.stderr)
         if poses is not ok:  # refused with its line, before any query, in the same words
             assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1]
+
+
+def test_cli_reads_options_as_pcd_collision_does(tmp_path):
+    """One dash for pcd_collision's options and two for this command's own (found in review: any
+    number of dashes was taken, `--sigma` too), decimal numbers only in both (pcd_collision took
+    hex floats), and pcd_collision's -threads, checked against the library's cap."""
+    from pcl_probcollision.dask import cli
+    poses = tmp_path / "p.txt"
+    poses.write_text("0 0 0 0 0 0\n")
+    args = [str(DATA / "gripper.obj"), str(DATA / "table_mug.pcd"), str(poses)]
+    _, options, own = cli.parse(args + ["--scheduler", "local:1", "-threads", "2", "-sigma=0.01"])
+    assert (options["threads"], options["sigma"], own["scheduler"]) == (2, 0.01, "local:1")
+    for bad in (["--sigma", "0.01"], ["-scheduler", "local:1"], ["-sigma", "0x1p-3"]):
+        with pytest.raises(cli.Usage):
+            cli.parse(args + ["--scheduler", "local:1"] + bad)
+    with pytest.raises(ValueError, match="threads"):
+        pcd.resolve_options({"threads": pc._core.MAX_THREADS + 1})
+    # Both command lines refuse the same malformed values as usage errors (exit 2), before any work.
+    for flag, value in (("-sigma", "0x1p-3"), ("-threads", "1025")):
+        cpp = subprocess.run([_pcd_collision(), *args[:2], "-poses", str(poses), flag, value], capture_output=True, text=True)
+        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, "--scheduler", "local:1", flag, value],
+                            capture_output=True, text=True, timeout=60)
+        assert (cpp.returncode, py.returncode) == (2, 2), (flag, cpp.stderr, py.stderr)
+        assert flag in cpp.stderr and flag.lstrip("-") in py.stderr, (cpp.stderr, py.stderr)

@@ -209,6 +209,7 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-sigma", "nan"}, "-sigma");
   expectUsageError ({"-sigma", "inf"}, "-sigma");
   expectUsageError ({"-sigma", "1e999"}, "-sigma");
+  expectUsageError ({"-sigma", "0x1p-3"}, "-sigma");  // decimal only, as the Dask command line
   expectUsageError ({"-sigma_a", "-0.1"}, "-sigma_a");
   expectUsageError ({"-k", "1O"}, "-k");
   expectUsageError ({"-k", "0"}, "-k");
@@ -374,6 +375,7 @@ TEST (CliOptions, PoseLines)
   EXPECT_EQ (parsePoseLine ("1 2 3 4 5 six", p, e), -1);
   EXPECT_NE (e.find ("six"), std::string::npos) << e;
   EXPECT_EQ (parsePoseLine ("1 2 3 4 5 nan", p, e), -1);
+  EXPECT_EQ (parsePoseLine ("0x1p3 0 0 0 0 0", p, e), -1);
 }
 
 TEST (CliOptions, PoseFiles)

@@ -55,11 +55,13 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   // Finite but absurd coordinates overflow the float arithmetic of the k-d tree (FLANN's middle
   // split computes (min + max) / 2 = inf; found by fuzz/fuzz_collide): refuse them by name.
   float max_abs = 0.0f;
+  std::size_t finite_points = 0;
   for (std::size_t j = 0; j < n; ++j)
   {
     const PointT& p = cloud[at (j)];
     if (!pcl::isXYZFinite (p))
       continue;
+    ++finite_points;
     const float m = std::max ({std::abs (p.x), std::abs (p.y), std::abs (p.z)});
     if (!(m <= static_cast<float> (detail::kMaxCoordinate)))
     {
@@ -69,6 +71,13 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       throw pcl::BadArgumentException (err.str ());
     }
     max_abs = std::max (max_abs, m);
+  }
+  // Refused here, before the estimation, whose PCL base class would also print "input_ is
+  // empty!" on stderr for an empty cloud.
+  if (finite_points == 0)
+  {
+    err << name << " cloud has no finite point (" << n << " given, " << n << " non-finite)";
+    throw pcl::BadArgumentException (err.str ());
   }
 
   // Given covariances must be covariances: positive semi-definite within rounding (a NaN one marks

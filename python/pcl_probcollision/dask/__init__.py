@@ -160,8 +160,8 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
         raise ValueError(f"option split: expected pca or octree, got {o['split']!r}")
     if o["mesh_density"] is not None and not (float(o["mesh_density"]) > 0.0):
         raise ValueError(f"option mesh_density: must be > 0, got {o['mesh_density']}")
-    if int(o["threads"]) < 0:
-        raise ValueError(f"option threads: must be >= 0, got {o['threads']}")
+    if not 0 <= int(o["threads"]) <= core.MAX_THREADS:  # pcd_collision -threads' range
+        raise ValueError(f"option threads: must be in [0, {core.MAX_THREADS}], got {o['threads']}")
     if int(o["max_leaf_fits"]) < 0:
         raise ValueError(f"option max_leaf_fits: must be >= 0, got {o['max_leaf_fits']}")
     model_params(o, "a", exact=False).validate()

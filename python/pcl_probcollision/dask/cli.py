@@ -23,6 +23,8 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
                                  single-threaded worker processes (default N = cores)
   --timeout S                    seconds to reach the scheduler (default 10)
   --chunk-size N                 poses per task (default: about 8 tasks per worker thread)
+  -threads N                     threads of each task's batch (default 1: the workers give the
+                                 parallelism; 0: one per core of the worker's machine)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
   -measured -deterministic -stochastic -seed -exhaustive -defer_kernel_fits -max_leaf_fits
   -noise_resolution -noise_resolution_gate -noise_stop -surface -surface_pooled -surface_ladder -surface_calibrated -distance -ignore_normals -closed -closed_a
@@ -35,7 +37,8 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
           "split": str, "mesh_density": float, "max_leaf_fits": "u64", "noise_resolution": float,
-          "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str, "orientation_b": str}
+          "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str, "orientation_b": str,
+          "threads": int}
 _SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kernel_fits", "surface", "surface_pooled",
            "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b", "json",
            "v")
@@ -91,6 +94,10 @@ def parse(argv):
         if arg in ("-h", "--help"):
             raise SystemExit(print(USAGE, end="") or 0)
         name, eq, value = arg.lstrip("-").partition("=")
+        dashes = len(arg) - len(arg.lstrip("-"))
+        # pcd_collision's options take one dash, as there; this command's own take two.
+        if dashes != (2 if name in _OWN else 1):
+            raise Usage(f"unknown option '{arg.partition('=')[0]}'")
         if name in ("pose", "poses", "o"):
             raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
         if name in seen:
