@@ -64,7 +64,7 @@ parseDouble (const std::string& text, double& value)
   if (text.empty () || std::isspace (static_cast<unsigned char> (text[0])))
     return false;
   // Decimal numbers only, as the Dask command line reads them: strtod would also take hex
-  // floats (0x1p3), "inf" and "nan".
+  // floats (0x1p3); "inf" and "nan" are refused below anyway.
   if (text.find_first_not_of ("0123456789+-.eE") != std::string::npos)
     return false;
   errno = 0;

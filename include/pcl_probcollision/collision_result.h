@@ -78,7 +78,9 @@ struct CollisionResult
   Eigen::Vector3d nearest_point_a = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d nearest_point_b = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
-    * InCollision and final, unless budget_exhausted). */
+    * InCollision and final, unless budget_exhausted, or pooled: CollisionRequest::surface_pooled
+    * averages a stopped answer with the other's, which can read contact), and signed_distance is
+    * the first deciding point's, not the deepest. */
   bool lower_bound = false;
   /** \brief True when the query stopped at CollisionRequest::max_leaf_fits with leaf pairs
     * left unfitted: P (and lower_bound) is the largest over the pairs fitted, nearest first; the

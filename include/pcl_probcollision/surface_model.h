@@ -88,7 +88,8 @@ public:
   const std::vector<float>& spacing () const { return spacing_; }
   /** \brief The surface area a_i each point stands for (data units squared): its Voronoi cell
     * among its neighbours in its tangent plane, within their spread; the winding number's
-    * weights. 0 for a point repeated past k times or whose neighbours lie on a line. */
+    * weights. Exact copies of a point share its cell; 0 for a point repeated past k times or
+    * whose neighbours lie on a line; s_i^2 for a point with fewer than two neighbours. */
   const std::vector<float>& areas () const { return areas_; }
   /** \brief Where the neighbours of point i leave the surface open (the point lies on its
     * edge): xyz the bisector, in the tangent plane, of the widest angle between its neighbours

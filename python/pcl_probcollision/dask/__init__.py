@@ -96,8 +96,9 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "epsilon": _MODEL.epsilon,
     "split": _MODEL.split,
     "mesh_density": None,
-    # Not a pcd_collision flag: collide_batch threads per task. 1 = Dask's worker threads give the
-    # parallelism (one task per core); 0 = all cores of the worker machine.
+    # collide_batch threads per task (pcd_collision's -threads). 1 = Dask's worker threads give the
+    # parallelism (one task per core); 0 = all cores of the worker machine; at most MAX_THREADS
+    # (1,024, a ValueError above, as pcd_collision refuses it).
     "threads": 1,
 }
 OPTION_NAMES = tuple(DEFAULT_OPTIONS)

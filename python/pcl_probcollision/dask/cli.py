@@ -43,8 +43,8 @@ _SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kerne
            "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b", "json",
            "v")
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
-_FLOAT = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?\Z")
-_INT = re.compile(r"[+-]?\d+\Z")
+_FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")  # ASCII digits, as pcd_collision
+_INT = re.compile(r"[+-]?[0-9]+\Z")
 
 
 class Usage(Exception):
@@ -91,15 +91,15 @@ def parse(argv):
         if arg == "--":
             only_positional = True
             continue
-        if arg in ("-h", "--help"):
+        if arg in ("-h", "-help", "--help"):
             raise SystemExit(print(USAGE, end="") or 0)
         name, eq, value = arg.lstrip("-").partition("=")
+        if name in ("pose", "poses", "o"):
+            raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
         dashes = len(arg) - len(arg.lstrip("-"))
         # pcd_collision's options take one dash, as there; this command's own take two.
         if dashes != (2 if name in _OWN else 1):
             raise Usage(f"unknown option '{arg.partition('=')[0]}'")
-        if name in ("pose", "poses", "o"):
-            raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
         if name in seen:
             raise Usage(f"option -{name} given twice")
         seen.add(name)
