@@ -643,6 +643,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       const double area = 4.0 * kPi * std::sqrt (std::max (0.0, l[1]) * std::max (0.0, l[2]));
       s = std::min (s, std::sqrt (area / static_cast<double> (count)));
     }
+    // The area reads the same neighbours again, in differences from the sample: the spacing
+    // above keeps its own sums, so that its values (which the query's reaches were chosen with)
+    // stay those it had before the areas.
     areas_[i] = static_cast<float> (count >= 3 ? neighbourhoodArea (points, i, &in.neighbours[i * k], k, normals_[i]) : s * s);
     spacing_[i] = static_cast<float> (s);
     open[i] = openingOf (points, normals_[i], i, &in.neighbours[i * k], k, in.radii[i]);
