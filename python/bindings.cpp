@@ -951,7 +951,9 @@ PYBIND11_MODULE (_core, m)
                      "> 0 the gap, < 0 minus the penetration depth. NaN when not computed: request.surface off, a\n"
                      "model built without CloudModelParams.surface, or the surfaces never came within reach.\n"
                      "When the query stopped early at a collision (lower_bound), the distance at the first point\n"
-                     "that decided it, not the deepest (request.exhaustive visits every pair).")
+                     "that decided it, not the deepest (request.exhaustive visits every pair). From a point deep\n"
+                     "inside the other object (or one object wholly inside the other): minus that point's distance\n"
+                     "to the other's nearest sample, which the penetration is at least.")
       .def_readonly ("signed_distance_std", &CollisionResult::signed_distance_std,
                      "Standard deviation of signed_distance (both clouds' noise, the fitted surfaces' uncertainty,\n"
                      "the discretisation between samples); NaN with it.")

@@ -61,7 +61,11 @@ struct CollisionResult
     * query's most significant point (lowest d / std); when the query stopped early at a
     * collision (lower_bound), at the first point that decided it: the deepest may lie elsewhere
     * (CollisionRequest::exhaustive visits every pair; so does CollisionRequest::distance, whose
-    * distance is never such a bound). */
+    * distance is never such a bound). Where the answer is a point deep inside the other object,
+    * out of reach of its surface (or one object wholly inside the other, the ladder's
+    * containment check), it is minus that point's distance to the other's nearest sample, in
+    * every mode: the penetration is at least that deep (the point must cross the other's
+    * surface to get out), and the translation that separates the two may be longer. */
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
     * surfaces' own uncertainty and the discretisation between samples); NaN with it. */
