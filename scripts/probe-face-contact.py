@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Face-to-face contact: a cube held above a slab, scanned anew at each gap.
 
-A developer's probe of the surface layer (docs/RELIABILITY.md, "Face contact near edges"). A
+A developer's probe of the surface layer (docs/SURFACE.md, "What it does not do yet"). A
 1 m cube (its six faces sampled uniformly at random, --points samples) faces a 1 x 3 x 3 m slab
 sampled at the same density, the cube's +x face parallel to the slab's -x face and wholly inside
 it, at gaps of -1 to +3 sigma_eff (sigma_eff = sqrt(2) sigma, the two clouds' noise combined).
@@ -18,11 +18,12 @@ witness (the point attaining P) lies from the nearest edge of the cube's face, i
 Two faces of about 190 samples each, noise known: the gap is known to a small fraction of
 sigma_eff from the samples, so P at a gap of +2 sigma_eff should be near 0. The surface layer
 reads it from the samples nearest each point, and near the cube's edges those samples' normals
-blend the two faces (docs/RELIABILITY.md gives the figures and what was tried).
+blend the two faces (docs/SURFACE.md gives the figures and what was tried).
 
     PYTHONPATH=build/python /usr/bin/python3 scripts/probe-face-contact.py --noise 0.0025,0.01
 
-Deterministic: the same options print the same numbers. Exit status 0, or 1 on bad options.
+Deterministic: the same options print the same numbers. Exit status 0; 2 on bad options (the
+message names the option); 1 when the module cannot be imported.
 """
 import argparse
 import math
