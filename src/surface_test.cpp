@@ -41,6 +41,13 @@ constexpr double kConcaveNoiseSigmas = 6.0;
 /** \brief A face other than the nearest sample's needs this many samples to count: a single
   * stray normal must not turn a point inside out. */
 constexpr int kMinFaceSamples = 2;
+/** \brief ... or one among the nearest, corroborated by another sample of the pool within this
+  * many gaps of the point, on that sample's plane (within the sheet's thickness) with a normal
+  * along it. Beside a convex edge the nearest samples can hold one sample of the face the point
+  * stands in front of and many of the side face, behind whose plane it lies: without the second
+  * face it read inside (a cube held 3 sigma_eff above a slab, its true normals given, read
+  * P = 0.48 at 2.5 mm noise, scripts/probe-face-contact.py's geometry). */
+constexpr double kCorroborationGaps = 3.0;
 /** \brief Behind the local plane by more than this many of its deviations, a point is inside
   * only if the winding number agrees. */
 constexpr double kDeepSigmas = 2.0;
@@ -407,11 +414,35 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   // face behind the other's plane; also the two faces of a slab) inside means behind both, the
   // larger distance; at a concave one (each in front of the other: an inner corner, a gap
   // between two solids) behind either, the smaller.
+  // A face's lone sample among the nearest, and another sample of the pool on its plane within
+  // kCorroborationGaps of x (kMinFaceSamples).
+  auto corroborated = [&] (int c) {
+    int k = 0;
+    while (face[static_cast<std::size_t> (k)] != c)
+      ++k;
+    const int lone = nearest[static_cast<std::size_t> (k)];
+    const Sample& s = samples[static_cast<std::size_t> (lone)];
+    const double thickness = 0.5 * std::max (s.spacing, 1e-12) + 3.0 * std::sqrt (std::max (s.variance, 0.0));
+    const double reach = kCorroborationGaps * g;
+    const double reach2 = reach * reach;
+    // The pool is sorted by key (distance from the query leaf's centre), and |p - x| >=
+    // |key(p) - key(x)|: only keys within reach of x's can hold such a sample.
+    const auto begin = std::lower_bound (keys.begin (), keys.end (), x_key - reach);
+    for (auto it = begin; it != keys.end () && *it <= x_key + reach; ++it)
+    {
+      const int j = pool[static_cast<std::size_t> (it - keys.begin ())];
+      const Sample& o = samples[static_cast<std::size_t> (j)];
+      if (j != lone && o.normal.dot (s.normal) >= kSameFaceCosine && std::abs (s.normal.dot (o.position - s.position)) < thickness &&
+          (o.position - x).squaredNorm () < reach2)
+        return true;
+    }
+    return false;
+  };
   const Fit nearest_face = fit (0);
   Fit chosen = nearest_face;
   for (int c = 1; c < faces; ++c)
   {
-    if (face_size[static_cast<std::size_t> (c)] < kMinFaceSamples)
+    if (face_size[static_cast<std::size_t> (c)] < kMinFaceSamples && !corroborated (c))
       continue;
     Fit other = fit (c);
     if (two_sided)
