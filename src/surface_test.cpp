@@ -107,6 +107,14 @@ struct Sample
   double open_cos = 1.0;
 };
 
+/** \brief How far off a sample's plane another sample still lies on the same sheet: half its
+  * spacing and 3 noise deviations. */
+double
+sheetThickness (const Sample& s)
+{
+  return 0.5 * std::max (s.spacing, 1e-12) + 3.0 * std::sqrt (std::max (s.variance, 0.0));
+}
+
 /** \brief Per-thread buffers: a query allocates nothing once they have grown. */
 struct Scratch
 {
@@ -208,11 +216,10 @@ bool
 farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tangential, double reach,
         const std::vector<int>& pool, const std::vector<Sample>& samples)
 {
-  const double h = std::max (first.spacing, 1e-12);
   const Eigen::Vector3d offset = x - first.position;
   const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
   const double reach2 = (reach * first.gap) * (reach * first.gap);
-  const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+  const double thickness = sheetThickness (first);
   for (const int j : pool)
   {
     const Sample& s = samples[static_cast<std::size_t> (j)];
@@ -247,7 +254,7 @@ surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const s
   u = u.norm () > 1e-9 * h ? Eigen::Vector3d (u.normalized ()) : n.unitOrthogonal ();
   const Eigen::Vector3d w = n.cross (u);
   const double reach2 = (reach * h) * (reach * h);
-  const double thickness = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+  const double thickness = sheetThickness (first);
   const double along = n.dot (offset);
   int quarters = 0;
   for (const int j : pool)
@@ -335,6 +342,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   std::array<int, kSurfaceNeighbours> face;
   std::array<Eigen::Vector3d, kMaxFaces> face_seed;
   std::array<int, kMaxFaces> face_size{};
+  std::array<int, kMaxFaces> face_first{};  ///< each face's nearest sample, an index into nearest
   int faces = 0;
   for (int j = 0; j < found; ++j)
   {
@@ -357,12 +365,14 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     {
       best = faces++;
       face_seed[static_cast<std::size_t> (best)] = s.normal;
+      face_first[static_cast<std::size_t> (best)] = j;
     }
     face[sj] = best;
     ++face_size[static_cast<std::size_t> (best)];
   }
-  // Residual scale of the robust weights: half a spacing plus the samples' noise.
-  const double scale = 0.5 * h + 3.0 * std::sqrt (std::max (first.variance, 0.0));
+  // Residual scale of the robust weights: the sheet's thickness (half a spacing plus the
+  // samples' noise).
+  const double scale = sheetThickness (first);
   struct Fit
   {
     double f = 0.0, fit_var = 0.0, weight = 0.0, spread = 0.0;
@@ -417,12 +427,9 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   // A face's lone sample among the nearest, and another sample of the pool on its plane within
   // kCorroborationGaps of x (kMinFaceSamples).
   auto corroborated = [&] (int c) {
-    int k = 0;
-    while (face[static_cast<std::size_t> (k)] != c)
-      ++k;
-    const int lone = nearest[static_cast<std::size_t> (k)];
+    const int lone = nearest[static_cast<std::size_t> (face_first[static_cast<std::size_t> (c)])];
     const Sample& s = samples[static_cast<std::size_t> (lone)];
-    const double thickness = 0.5 * std::max (s.spacing, 1e-12) + 3.0 * std::sqrt (std::max (s.variance, 0.0));
+    const double thickness = sheetThickness (s);
     const double reach = kCorroborationGaps * g;
     const double reach2 = reach * reach;
     // The pool is sorted by key (distance from the query leaf's centre), and |p - x| >=
@@ -452,10 +459,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
       // with 1 mm noise, three scattered normals made a face whose plane, extended 19 mm past
       // them, put a point 6 sigma clear on the surface). Only for a two-sided surface, whose
       // faces' signs say nothing.
-      int k = 0;
-      while (face[static_cast<std::size_t> (k)] != c)
-        ++k;
-      const Sample& p = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (k)])];
+      const Sample& p = samples[static_cast<std::size_t> (nearest[static_cast<std::size_t> (face_first[static_cast<std::size_t> (c)])])];
       const double across = std::sqrt (std::max (0.0, (x - p.position).squaredNorm () - other.f * other.f));
       const double beyond = std::max (0.0, across - std::max (p.gap, p.spacing));
       other.f = std::copysign (std::hypot (other.f, beyond), other.f);
