@@ -406,7 +406,7 @@ sharedBuild (const Options& o)
   b.model.surface = true;
   for (const OursSetting& s : oursSettings (false))
     if ((s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
-         s.name == "ladder") && o.keeps (s.name))
+         s.name == "ladder" || s.name == "ladder-distance") && o.keeps (s.name))
     {
       pcl_probcollision::CloudModelParams m = s.model;
       m.surface = true;
@@ -1194,6 +1194,7 @@ issue16Targets (const Options& o, const std::vector<Summary>& summaries, const R
     oursTargets ("surface");
     oursTargets ("pooled");
     oursTargets ("ladder");
+    oursTargets ("ladder-distance");
   }
   // The README demo through pcd_collision, without and with -surface and -surface_ladder. No
   // comma in these rows: scripts/evaluate.sh rewrites them with pcd_collision's answers.

@@ -54,6 +54,12 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   OursSetting ladder = surface;
   ladder.name = "ladder";
   ladder.request.surface_ladder = true;
+  // The ladder with a distance asked for (CollisionRequest::distance): every near-contact answer
+  // carries the surface layer's distance, including the separators' sure collisions; the
+  // surface layer then visits every pair within reach, as exhaustive does.
+  OursSetting ladder_distance = ladder;
+  ladder_distance.name = "ladder-distance";
+  ladder_distance.request.distance = true;
   // The surface layer on models of 20 neighbours instead of 10 (covariances, projected
   // positions and normals): surer near contact in the dense room, not in the sparse one; on the
   // chart, not the default (docs/SURFACE.md, "Twenty neighbours").
@@ -70,6 +76,7 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
   s.push_back (surface);
   s.push_back (pooled);
   s.push_back (ladder);
+  s.push_back (ladder_distance);
   s.push_back (surface_k20);
   s.push_back (other);
   // Issue #17 item 1: samples closer than c noise sigmas merged ("merge<c>"), or only where the

@@ -852,7 +852,8 @@ PYBIND11_MODULE (_core, m)
       "procedural scenes (default False: the model's raw P);\n"
       "distance: beyond the query's reach, signed_distance is the distance between the nearest samples\n"
       "(CollisionResult.sample_distance, nearest_point_a/_b), as FCL's distance request; near contact\n"
-      "the surface layer's signed_distance is then an estimate, never the first deciding point's bound.")
+      "the surface layer's signed_distance is then an estimate, never the first deciding point's bound\n"
+      "(with surface_ladder also where the separators find a sure collision; their P stands).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
@@ -912,7 +913,8 @@ PYBIND11_MODULE (_core, m)
                       "Beyond the query's reach (no_leaf_tested), signed_distance is the nearest samples' distance,\n"
                       "its std their covariances' along the line between them with 0.29 of each one's spacing\n"
                       "(result.sample_distance). Near contact the surface layer's signed_distance is then an estimate,\n"
-                      "never the first deciding point's bound (it visits every pair, as exhaustive). Default False.")
+                      "never the first deciding point's bound (it visits every pair, as exhaustive); where the ladder's\n"
+                      "separators find a sure collision, the surface layer runs for the distance alone. Default False.")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {

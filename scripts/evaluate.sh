@@ -83,7 +83,7 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
            s = $c["setting"]; v = $c["surface_answered_share"] + 0
            if ((s == "default" || s == "classifier") && v != 0) bad = bad " " $c["workload"] "/" s "=" v
            if ((s == "surface" || s == "pooled" || s == "surface-k20") && v != 1) bad = bad " " $c["workload"] "/" s "=" v
-           if (s == "ladder" && (v < 0 || v > 1)) bad = bad " " $c["workload"] "/" s "=" v }
+           if ((s == "ladder" || s == "ladder-distance") && (v < 0 || v > 1)) bad = bad " " $c["workload"] "/" s "=" v }
          END { if (bad != "") { print "evaluate.sh: wrong surface_answered_share:" bad > "/dev/stderr"; exit 1 } }' \
   "$out/summary.csv"
 

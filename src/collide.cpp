@@ -304,7 +304,28 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
         result = std::move (separators);
     }
     else
+    {
       result = std::move (separators);
+      // A sure collision of the separators carries no distance. Asked for one, the caller gets
+      // the surface layer's, as it gives alone; P, the verdict and the witness stay theirs.
+      if (request.distance)
+      {
+        CollisionRequest for_distance = request;
+        for_distance.per_point = false;
+        CollisionResult surface_answer;
+        if (!collideSurface (a, b, T_local, for_distance, surface_answer))
+        {
+          result = std::move (surface_answer);
+          return false;
+        }
+        surface_ran = true;
+        surface_reached = !surface_answer.no_leaf_tested;
+        result.signed_distance = surface_answer.signed_distance;
+        result.signed_distance_std = surface_answer.signed_distance_std;
+        result.bv_tests += surface_answer.bv_tests;
+        result.leaf_pairs_tested += surface_answer.leaf_pairs_tested;
+      }
+    }
   }
   else
   {

@@ -413,6 +413,41 @@ TEST (SurfaceLayer, AnAskedDistanceIsNeverTheFirstDecidingPoint)
   EXPECT_LT (with_distance.signed_distance, -0.005);
 }
 
+// The ladder's separators answer a sure collision alone, with no distance. Asked for one, the
+// caller gets the surface layer's as it gives alone (found in review: NaN), and the separators'
+// P, verdict and witness stand.
+TEST (SurfaceLayer, AnAskedDistanceIsGivenWhereTheLaddersSeparatorsAnswer)
+{
+  // Two balls of 10 cm radius, 3 cm into each other (their normals given, 1 mm noise).
+  const auto ball = buildCloudModel (sphere (800, 0.1, Eigen::Vector3d::Zero ()), noisy (0.001));
+  const auto other = buildCloudModel (sphere (800, 0.1, Eigen::Vector3d::Zero ()), noisy (0.001));
+  const Eigen::Isometry3d T = shift (0.17, 0, 0);
+  CollisionRequest ladder = surfaceRequest ();
+  ladder.exhaustive = false;
+  ladder.surface_ladder = true;
+  CollisionRequest asked = ladder;
+  asked.distance = true;
+  CollisionRequest alone = asked;
+  alone.surface_ladder = false;
+  CollisionResult without, with_distance, surface_alone;
+  ASSERT_TRUE (collide (*ball, *other, T, ladder, without)) << without.message;
+  ASSERT_TRUE (collide (*ball, *other, T, asked, with_distance)) << with_distance.message;
+  ASSERT_TRUE (collide (*ball, *other, T, alone, surface_alone)) << surface_alone.message;
+  ASSERT_EQ (without.answered_by, AnsweredBy::Separators) << "P " << without.probability;  // the case exercised
+  ASSERT_EQ (without.verdict, Verdict::InCollision);
+  EXPECT_TRUE (std::isnan (without.signed_distance));
+  EXPECT_EQ (with_distance.answered_by, AnsweredBy::Separators);
+  EXPECT_EQ (with_distance.probability, without.probability);
+  EXPECT_EQ (with_distance.verdict, without.verdict);
+  EXPECT_EQ (with_distance.witness_index, without.witness_index);
+  EXPECT_FALSE (with_distance.sample_distance);
+  ASSERT_TRUE (std::isfinite (surface_alone.signed_distance));
+  EXPECT_EQ (with_distance.signed_distance, surface_alone.signed_distance);
+  EXPECT_EQ (with_distance.signed_distance_std, surface_alone.signed_distance_std);
+  EXPECT_LT (with_distance.signed_distance, -0.005);
+  EXPECT_GT (with_distance.leaf_pairs_tested, without.leaf_pairs_tested);
+}
+
 // A sheet's opening (SurfaceModel::opening) says how far around a sample the surface is open:
 // w the cosine of half the widest gap between its neighbours. At a straight edge the gap is
 // 180 degrees (w about 0), at a corner 270 (w about cos 135 = -0.71): found in review, the
