@@ -393,6 +393,7 @@ def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):
     # free. Over a sweep through contact at least two of the rungs answer.
     _, _, A, B = sheets
     rungs = set()
+    sure_collisions = 0
     for z in np.linspace(-0.004, 0.03, 18):
         T = translation(0.005, -0.003, z)
         separators = pc.collide(A, B, T)
@@ -414,7 +415,20 @@ def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):
         assert pooled.answered_by == pc.AnsweredBy.Pooled
         assert ladder.answered_by == expected.answered_by, (z, rung)
         assert ("answered_by=AnsweredBy." in repr(ladder)) == (rung != "separators")
+        # A distance asked for: where the separators' sure collision stands, the surface layer's
+        # distance (as it gives it alone) with their probability.
+        if rung == "separators" and not separators.no_leaf_tested:
+            asked = pc.collide(A, B, T, pc.CollisionRequest(surface=True, surface_ladder=True, distance=True))
+            alone = pc.collide(A, B, T, pc.CollisionRequest(surface=True, distance=True))
+            assert np.isnan(ladder.signed_distance), z
+            assert asked.probability == separators.probability, z
+            assert asked.answered_by == pc.AnsweredBy.Separators
+            assert np.isfinite(alone.signed_distance), z
+            assert asked.signed_distance == alone.signed_distance, z
+            assert asked.signed_distance_std == alone.signed_distance_std, z
+            sure_collisions += 1
     assert len(rungs) >= 2, rungs
+    assert sure_collisions >= 1, "no sure collision of the separators in the sweep"
     assert pc.CollisionResult().answered_by == pc.AnsweredBy.Unknown
     assert "surface_ladder=True" in repr(pc.CollisionRequest(surface=True, surface_ladder=True))
     with pytest.raises(ValueError, match="surface_pooled and surface_ladder"):
