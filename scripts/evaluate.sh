@@ -2,7 +2,7 @@
 # The evaluation suite of docs/RESULTS.md: builds evaluate_collision, runs every method on every
 # workload (W1 piano/room, W2 primitives, W3 real scans), writes CSV files, a markdown summary
 # and PNG charts (gnuplot).
-#   scripts/evaluate.sh           full run (about 15-20 min on 2 cores) into docs/results/
+#   scripts/evaluate.sh           full run (about 80 min on 2 cores) into docs/results/
 #   scripts/evaluate.sh --quick   smoke run (about 30 s after the build) into build/evaluation-quick/
 # Issue 16's targets: targets.csv / targets.md (met, missed or not measured), printed by the run.
 #   --out=DIR                     another output directory
