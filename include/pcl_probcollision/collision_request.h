@@ -116,9 +116,10 @@ struct CollisionRequest
     * (CollisionResult::sample_distance, nearest_point_a / nearest_point_b). Near contact the
     * surface layer's signed distance stands (NaN there without it: the separators give none;
     * where the ladder's separators find a sure collision, the surface layer runs for the
-    * distance alone and their P stands), and it is an estimate, never a bound: the surface layer does not stop at the first point
-    * that decides a collision but visits every pair within reach, as with exhaustive (P is then
-    * not a lower bound either; about 3 times the mean query near contact, docs/SURFACE.md).
+    * distance alone and their P stands), and it is an estimate, never a bound: the surface
+    * layer does not stop at the first point that decides a collision but visits every pair
+    * within reach, as with exhaustive (P is then not a lower bound either; about 3 times the
+    * mean query near contact, docs/SURFACE.md).
     * An exact nearest-pair search over the two hierarchies; off by default, since a planner's
     * free poses would pay for it (docs/PERFORMANCE.md). */
   bool distance = false;
