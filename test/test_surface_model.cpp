@@ -418,9 +418,8 @@ TEST (SurfaceLayer, AnAskedDistanceIsNeverTheFirstDecidingPoint)
 // P, verdict and witness stand.
 TEST (SurfaceLayer, AnAskedDistanceIsGivenWhereTheLaddersSeparatorsAnswer)
 {
-  // Two balls of 10 cm radius, 3 cm into each other (their normals given, 1 mm noise).
+  // Two copies of one ball of 10 cm radius, 3 cm into each other (normals given, 1 mm noise).
   const auto ball = buildCloudModel (sphere (800, 0.1, Eigen::Vector3d::Zero ()), noisy (0.001));
-  const auto other = buildCloudModel (sphere (800, 0.1, Eigen::Vector3d::Zero ()), noisy (0.001));
   const Eigen::Isometry3d T = shift (0.17, 0, 0);
   CollisionRequest ladder = surfaceRequest ();
   ladder.exhaustive = false;
@@ -430,9 +429,9 @@ TEST (SurfaceLayer, AnAskedDistanceIsGivenWhereTheLaddersSeparatorsAnswer)
   CollisionRequest alone = asked;
   alone.surface_ladder = false;
   CollisionResult without, with_distance, surface_alone;
-  ASSERT_TRUE (collide (*ball, *other, T, ladder, without)) << without.message;
-  ASSERT_TRUE (collide (*ball, *other, T, asked, with_distance)) << with_distance.message;
-  ASSERT_TRUE (collide (*ball, *other, T, alone, surface_alone)) << surface_alone.message;
+  ASSERT_TRUE (collide (*ball, *ball, T, ladder, without)) << without.message;
+  ASSERT_TRUE (collide (*ball, *ball, T, asked, with_distance)) << with_distance.message;
+  ASSERT_TRUE (collide (*ball, *ball, T, alone, surface_alone)) << surface_alone.message;
   ASSERT_EQ (without.answered_by, AnsweredBy::Separators) << "P " << without.probability;  // the case exercised
   ASSERT_EQ (without.verdict, Verdict::InCollision);
   EXPECT_TRUE (std::isnan (without.signed_distance));
