@@ -21,3 +21,19 @@ if(benchmark_FOUND)
   target_compile_definitions(bench_performance PRIVATE
     PCL_PROBCOLLISION_SHARED_DATA="${PCL_PROBCOLLISION_SHARED_DATA}")
 endif()
+
+# One W2 query's clouds as PCD files, to run it alone through pcd_collision (docs/PERFORMANCE.md).
+add_executable(dump_primitive dump_primitive.cpp)
+target_link_libraries(dump_primitive PRIVATE eval_metrics pcl_io)
+target_compile_options(dump_primitive PRIVATE -Wall -Wextra)
+if(BUILD_TESTING)
+  # The resting-contact query of the first scenario: its name, both clouds and an exact 0 gap.
+  add_test(NAME eval.DumpPrimitiveWritesOneQuery
+    COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test --seed 1 sphere_sphere/0s)
+  set_tests_properties(eval.DumpPrimitiveWritesOneQuery PROPERTIES PASS_REGULAR_EXPRESSION
+    "^sphere_sphere/0s: robot [1-9][0-9]* points, env [1-9][0-9]* points, exact distance 0 m; pcd_collision ")
+  add_test(NAME eval.DumpPrimitiveRefusesAnUnknownName
+    COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test no_such_scenario)
+  set_tests_properties(eval.DumpPrimitiveRefusesAnUnknownName PROPERTIES PASS_REGULAR_EXPRESSION
+    "no W2 query name starts with 'no_such_scenario'")
+endif()
