@@ -14,7 +14,6 @@
 #include <pcl/io/pcd_io.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <string>
@@ -41,18 +40,25 @@ main (int argc, char** argv)
   {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
-    if (a == "--out" && has_value)
-      out = argv[++i];
-    else if (a == "--seed" && has_value)
-      seed = std::strtoull (argv[++i], nullptr, 10);
-    else if (a == "--scale" && has_value)
-      scale = std::atof (argv[++i]);
-    else if (a == "--quick")
-      quick = true;
-    else if (!a.empty () && a[0] != '-' && prefix.empty ())
-      prefix = a;
-    else
-      return usage (("unknown or incomplete argument '" + a + "'").c_str ());
+    try
+    {
+      if (a == "--out" && has_value)
+        out = argv[++i];
+      else if (a == "--seed" && has_value)
+        seed = std::stoull (argv[++i]);
+      else if (a == "--scale" && has_value)
+        scale = std::stod (argv[++i]);
+      else if (a == "--quick")
+        quick = true;
+      else if (!a.empty () && a[0] != '-' && prefix.empty ())
+        prefix = a;
+      else
+        return usage (("unknown or incomplete argument '" + a + "'").c_str ());
+    }
+    catch (const std::exception&)  // std::stoull, std::stod: not a number, or out of range
+    {
+      return usage ((a + " '" + argv[i] + "' is not a number").c_str ());
+    }
   }
   if (out.empty () || prefix.empty ())
     return usage ("--out and PREFIX are required");
