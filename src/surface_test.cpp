@@ -736,14 +736,17 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
     // the depth a crossing implies (the sheet's thickness and the smaller clearance). At that
     // bound the depth is not known: a part through a thin wall may stick out anywhere from 0
-    // to it, and the deviation says so (half the bound: the +-2 deviation interval reaches 0;
-    // P keeps the crossing's z). With the pair's deviation, collisions 2-28 mm deep read 30-84
-    // mm +- 10-15 (docs/SURFACE.md, step 4).
+    // to it, and the deviation says so: half the bound, with the pair's own deviation in
+    // quadrature (independent: where in the range, and where the ends really lie), so that the
+    // +-2 deviation interval reaches past 0 by the noise. Touching free poses read as crossings
+    // at their bound fell just outside it with the larger of the two (docs/SURFACE.md, step 4).
+    // P keeps the crossing's z. With the pair's deviation alone, collisions 2-28 mm deep read
+    // 30-84 mm +- 10-15.
     const double sigma = std::max (a_end->sigma, b_end->sigma);
     const double bound = t + std::min (a_reach, b_reach);
     const bool at_bound = z * sigma < -bound;
     answer.signed_distance = at_bound ? -bound : z * sigma;
-    answer.signed_distance_std = at_bound ? std::max (sigma, 0.5 * bound) : sigma;
+    answer.signed_distance_std = at_bound ? std::hypot (sigma, 0.5 * bound) : sigma;
     answer.unobserved = false;
     answer.witness_side = side;
     answer.witness_index = a.index;

@@ -1251,6 +1251,31 @@ TEST (SurfaceLayer, ThinSheetsCrossingWithoutDeepSamples)
   EXPECT_EQ (clear.verdict, Verdict::Free) << clear.probability << " d " << clear.signed_distance;
 }
 
+// A plate through the same wall, 14 cm out below it and 2 cm above (true depth 5 cm: pushed
+// down by the wall and the 2 cm). In decision mode the first sure crossing decides, at its depth
+// bound: the wall's thickness and the smaller clearance, as the pair sees them. The depth lies
+// anywhere from 0 to that bound and the pair's ends are as uncertain as their noise, so the
+// +-2 deviation interval reaches past 0 and past the bound by that noise (half the bound and
+// the pair's deviation in quadrature; their maximum, before, ended at 0 exactly).
+TEST (SurfaceLayer, ACrossingAtItsDepthBoundIsUncertainBothWays)
+{
+  const double sigma = 0.01;
+  const auto wall = buildCloudModel (slab (1.0, 0.03, 0.05), noisy (sigma));
+  const auto through = buildCloudModel (plate (-0.2, {-0.14, -0.10, -0.06, -0.02, 0.05}), noisy (sigma));
+  CollisionRequest decision = surfaceRequest ();
+  decision.exhaustive = false;
+  CollisionResult r;
+  ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), decision, r));
+  EXPECT_EQ (r.verdict, Verdict::InCollision) << r.probability;
+  EXPECT_EQ (r.witness_side, 1);  // the plate's pair
+  const double bound = -r.signed_distance;
+  EXPECT_GT (bound, 0.03) << r.signed_distance;  // at least the wall
+  EXPECT_GT (r.signed_distance_std, 0.5 * bound);
+  EXPECT_GT (r.signed_distance + 2.0 * r.signed_distance_std, 0.25 * sigma) << r.signed_distance << " +- " << r.signed_distance_std;
+  EXPECT_LT (r.signed_distance + 2.0 * r.signed_distance_std, bound) << r.signed_distance << " +- " << r.signed_distance_std;
+  EXPECT_LT (std::abs (r.signed_distance + 0.05), 2.0 * r.signed_distance_std) << r.signed_distance << " +- " << r.signed_distance_std;
+}
+
 // The same crossing with both hierarchies split down to leaves of at most 2 points: the pairs
 // that straddle the wall lie in different leaves, and are found across them (within leaves
 // alone P = 0.46).
