@@ -741,12 +741,14 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     // +-2 deviation interval reaches past 0 by the noise. Touching free poses read as crossings
     // at their bound fell just outside it with the larger of the two (docs/SURFACE.md, step 4).
     // P keeps the crossing's z. With the pair's deviation alone, collisions 2-28 mm deep read
-    // 30-84 mm +- 10-15.
+    // 30-84 mm +- 10-15. Short of the bound, z sigma says how sure the crossing is, not how
+    // deep: the same half bound, weighted by the crossing's probability (a plate 2 cm through
+    // a wall read 15 +- 1 cm deep by the wall's own pair, whose bound holds along one direction).
     const double sigma = std::max (a_end->sigma, b_end->sigma);
     const double bound = t + std::min (a_reach, b_reach);
     const bool at_bound = z * sigma < -bound;
     answer.signed_distance = at_bound ? -bound : z * sigma;
-    answer.signed_distance_std = at_bound ? std::hypot (sigma, 0.5 * bound) : sigma;
+    answer.signed_distance_std = std::hypot (sigma, 0.5 * bound * (at_bound ? 1.0 : 1.0 - free));
     answer.unobserved = false;
     answer.witness_side = side;
     answer.witness_index = a.index;

@@ -1274,6 +1274,15 @@ TEST (SurfaceLayer, ACrossingAtItsDepthBoundIsUncertainBothWays)
   EXPECT_GT (r.signed_distance + 2.0 * r.signed_distance_std, 0.25 * sigma) << r.signed_distance << " +- " << r.signed_distance_std;
   EXPECT_LT (r.signed_distance + 2.0 * r.signed_distance_std, bound) << r.signed_distance << " +- " << r.signed_distance_std;
   EXPECT_LT (std::abs (r.signed_distance + 0.05), 2.0 * r.signed_distance_std) << r.signed_distance << " +- " << r.signed_distance_std;
+  // Every pair visited: the wall's own pair, two of its samples either side of the 2 cm plate,
+  // is the surest crossing, short of its bound (the wall's reach along the plate's normal,
+  // about 0.5 m). Its z sigma (about 15 cm with the pair's deviation alone) is how sure it is,
+  // not how deep: the deviation carries the bound, and the interval holds the true 5 cm.
+  CollisionResult all;
+  ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), all));
+  EXPECT_EQ (all.witness_side, -1);
+  EXPECT_LT (all.signed_distance, -0.1) << all.signed_distance;
+  EXPECT_LT (std::abs (all.signed_distance + 0.05), 2.0 * all.signed_distance_std) << all.signed_distance << " +- " << all.signed_distance_std;
 }
 
 // The same crossing with both hierarchies split down to leaves of at most 2 points: the pairs
