@@ -1275,9 +1275,10 @@ TEST (SurfaceLayer, ACrossingAtItsDepthBoundIsUncertainBothWays)
   EXPECT_LT (r.signed_distance + 2.0 * r.signed_distance_std, bound) << r.signed_distance << " +- " << r.signed_distance_std;
   EXPECT_LT (std::abs (r.signed_distance + 0.05), 2.0 * r.signed_distance_std) << r.signed_distance << " +- " << r.signed_distance_std;
   // Every pair visited: the wall's own pair, two of its samples either side of the 2 cm plate,
-  // is the surest crossing, short of its bound (the wall's reach along the plate's normal,
-  // about 0.5 m). Its z sigma (about 15 cm with the pair's deviation alone) is how sure it is,
-  // not how deep: the deviation carries the bound, and the interval holds the true 5 cm.
+  // is the surest crossing, just short of its bound (the plate's thickness and the wall's reach
+  // along the plate's normal, about 15 cm). Its z sigma (15 cm, +- 1 cm with the pair's
+  // deviation alone) is how sure it is, not how deep: the deviation carries the bound, and the
+  // interval holds the true 5 cm.
   CollisionResult all;
   ASSERT_TRUE (collide (*through, *wall, Eigen::Isometry3d::Identity (), surfaceRequest (), all));
   EXPECT_EQ (all.witness_side, -1);

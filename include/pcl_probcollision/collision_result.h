@@ -69,8 +69,8 @@ struct CollisionResult
   double signed_distance = std::numeric_limits<double>::quiet_NaN ();
   /** \brief Standard deviation of signed_distance (sensor noise of both clouds, the fitted
     * surfaces' own uncertainty and the discretisation between samples; where two thin sheets
-    * cross and the distance is the crossing's depth bound, also half that bound, as the depth
-    * lies anywhere from 0 to it); NaN with it. */
+    * cross, also half the crossing's depth bound, weighted by how sure the crossing is, as the
+    * depth lies anywhere from 0 to that bound); NaN with it. */
   double signed_distance_std = std::numeric_limits<double>::quiet_NaN ();
   /** \brief True when signed_distance is the distance between the two clouds' nearest samples
     * (CollisionRequest::distance, the objects beyond the query's reach): a clearance between
