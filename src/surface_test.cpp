@@ -736,14 +736,11 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     // In the pair's deviation, so that P = Phi(-d / sigma) holds as for a point; at most
     // the depth a crossing implies (the sheet's thickness and the smaller clearance). At that
     // bound the depth is not known: a part through a thin wall may stick out anywhere from 0
-    // to it, and the deviation says so: half the bound, with the pair's own deviation in
-    // quadrature (independent: where in the range, and where the ends really lie), so that the
-    // +-2 deviation interval reaches past 0 by the noise. Touching free poses read as crossings
-    // at their bound fell just outside it with the larger of the two (docs/SURFACE.md, step 4).
-    // P keeps the crossing's z. With the pair's deviation alone, collisions 2-28 mm deep read
-    // 30-84 mm +- 10-15. Short of the bound, z sigma says how sure the crossing is, not how
-    // deep: the same half bound, weighted by the crossing's probability (a plate 2 cm through
-    // a wall read 15 +- 1 cm deep by the wall's own pair, whose bound holds along one direction).
+    // to it: the deviation adds half the bound to the pair's own in quadrature (independent:
+    // where in the range, and where the ends really lie), so the +-2 interval reaches past 0
+    // by the noise. Short of the bound, z sigma says how sure the crossing is, not how deep: the
+    // same half bound, weighted by the crossing's probability. P keeps the crossing's z
+    // (docs/SURFACE.md, "A crossing's depth is its bound").
     const double sigma = std::max (a_end->sigma, b_end->sigma);
     const double bound = t + std::min (a_reach, b_reach);
     const bool at_bound = z * sigma < -bound;
