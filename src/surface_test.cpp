@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <tuple>
 #include <utility>
 
@@ -151,6 +152,21 @@ struct Scratch
     std::size_t begin = 0, end = 0;
   };
   std::vector<OutsideLeaf> earlier_leaves;
+  /** \brief farthestJoined's candidates for a point, kept for one crossings() call (outside
+    * and earlier do not change within it): the points joined to it that face the same way and
+    * lie in front of its face. They depend on the point alone, not on the sheet's thickness, and
+    * one point ends many pairs. Per point slot (its index in outside, then in earlier after
+    * those): seen_stamp holds the call's stamp once the point was asked (a plain scan, nothing
+    * kept), joined_stamp once its candidates are kept, at [joined_begin, joined_end). */
+  struct Joined
+  {
+    const Outside* point;
+    double offset;  ///< from the asking point's face plane
+  };
+  std::vector<Joined> joined;
+  std::vector<std::uint32_t> seen_stamp, joined_stamp;
+  std::vector<std::size_t> joined_begin, joined_end;
+  std::uint32_t joined_call = 0;
 
   void
   prepare (std::size_t n)
@@ -554,34 +570,78 @@ joinedBySurface (const Scratch::Outside& p, const Scratch::Outside& q, const Eig
   * sigma, t the sheet's thickness), among p and the points joined to p (joinedBySurface) that
   * face the same way (normals within kSameFaceCosine) and lie in front of that same face: their
   * own distance within kCrossingPlaneSigmas of their offset from p's face plane (not another
-  * face with the same normal). Returns that point and its offset. */
+  * face with the same normal). Returns that point and its offset. A point asked again within
+  * one crossings() call reads its candidates back (Scratch::joined): only the choice among them
+  * depends on t. */
 std::pair<const Scratch::Outside*, double>
-farthestJoined (const Scratch& scratch, const Scratch::Outside& p, double t)
+farthestJoined (Scratch& scratch, const Scratch::Outside& p, double t)
 {
+  const Scratch::Outside* const begin = scratch.outside.data ();
+  const std::size_t slot = std::less_equal<const Scratch::Outside*> () (begin, &p) &&
+                                   std::less<const Scratch::Outside*> () (&p, begin + scratch.outside.size ())
+                               ? static_cast<std::size_t> (&p - begin)
+                               : scratch.outside.size () + static_cast<std::size_t> (&p - scratch.earlier.data ());
+  // Calls f (q, offset) for every joined point q in front of p's face, in a fixed order.
+  auto forEachJoined = [&] (auto&& f) {
+    auto consider = [&] (const Scratch::Outside& q) {
+      if (&q == &p)
+        return;
+      const Eigen::Vector3d v = q.x - p.x;
+      const double offset = p.distance + p.normal.dot (v);
+      if (f.skip (q, offset) || q.normal.dot (p.normal) < kSameFaceCosine ||
+          std::abs (q.distance - offset) > kCrossingPlaneSigmas * q.sigma || !joinedBySurface (p, q, v, v.norm ()))
+        return;
+      f.take (q, offset);
+    };
+    for (const Scratch::Outside& q : scratch.outside)
+      consider (q);
+    for (const Scratch::OutsideLeaf& leaf : scratch.earlier_leaves)
+    {
+      if ((leaf.center - p.x).norm () > leaf.radius + kCrossingSpacings * std::max (leaf.spacing, p.spacing))
+        continue;
+      for (std::size_t k = leaf.begin; k < leaf.end; ++k)
+        consider (scratch.earlier[k]);
+    }
+  };
   const Scratch::Outside* best = &p;
   double best_offset = p.distance;
   double best_score = (p.distance + t) / p.sigma;
-  auto consider = [&] (const Scratch::Outside& q) {
-    if (&q == &p)
-      return;
-    const Eigen::Vector3d v = q.x - p.x;
-    const double offset = p.distance + p.normal.dot (v);
-    const double score = (offset + t) / q.sigma;
-    if (score <= best_score || q.normal.dot (p.normal) < kSameFaceCosine ||
-        std::abs (q.distance - offset) > kCrossingPlaneSigmas * q.sigma || !joinedBySurface (p, q, v, v.norm ()))
-      return;
-    best_score = score;
-    best_offset = offset;
-    best = &q;
-  };
-  for (const Scratch::Outside& q : scratch.outside)
-    consider (q);
-  for (const Scratch::OutsideLeaf& leaf : scratch.earlier_leaves)
+  // The largest score wins, the first of equals.
+  struct Choose
   {
-    if ((leaf.center - p.x).norm () > leaf.radius + kCrossingSpacings * std::max (leaf.spacing, p.spacing))
-      continue;
-    for (std::size_t k = leaf.begin; k < leaf.end; ++k)
-      consider (scratch.earlier[k]);
+    const Scratch::Outside*& best;
+    double &best_offset, &best_score, t;
+    bool skip (const Scratch::Outside& q, double offset) const { return (offset + t) / q.sigma <= best_score; }
+    void take (const Scratch::Outside& q, double offset) { best = &q; best_offset = offset; best_score = (offset + t) / q.sigma; }
+  };
+  Choose choose {best, best_offset, best_score, t};
+  if (scratch.seen_stamp[slot] != scratch.joined_call)
+  {
+    // First asked in this call: one scan that skips every point no farther than the best so far.
+    scratch.seen_stamp[slot] = scratch.joined_call;
+    forEachJoined (choose);
+    return {best, best_offset};
+  }
+  if (scratch.joined_stamp[slot] != scratch.joined_call)
+  {
+    // Asked again: every candidate kept, whatever t.
+    struct Keep
+    {
+      std::vector<Scratch::Joined>& joined;
+      bool skip (const Scratch::Outside&, double) const { return false; }
+      void take (const Scratch::Outside& q, double offset) { joined.push_back ({&q, offset}); }
+    };
+    scratch.joined_stamp[slot] = scratch.joined_call;
+    scratch.joined_begin[slot] = scratch.joined.size ();
+    Keep keep {scratch.joined};
+    forEachJoined (keep);
+    scratch.joined_end[slot] = scratch.joined.size ();
+  }
+  for (std::size_t k = scratch.joined_begin[slot]; k < scratch.joined_end[slot]; ++k)
+  {
+    const Scratch::Joined& j = scratch.joined[k];
+    if (!choose.skip (*j.point, j.offset))
+      choose.take (*j.point, j.offset);
   }
   return {best, best_offset};
 }
@@ -765,6 +825,22 @@ crossings (Scratch& scratch, const Eigen::Vector3d& center, int side, std::vecto
   const auto& outside = scratch.outside;
   if (outside.empty ())
     return;
+  // farthestJoined's candidates are found anew for this call's points.
+  scratch.joined.clear ();
+  const std::size_t slots = outside.size () + scratch.earlier.size ();
+  if (scratch.joined_stamp.size () < slots)
+  {
+    scratch.seen_stamp.resize (slots, 0);
+    scratch.joined_stamp.resize (slots, 0);
+    scratch.joined_begin.resize (slots);
+    scratch.joined_end.resize (slots);
+  }
+  if (++scratch.joined_call == 0)
+  {
+    std::fill (scratch.seen_stamp.begin (), scratch.seen_stamp.end (), 0);
+    std::fill (scratch.joined_stamp.begin (), scratch.joined_stamp.end (), 0);
+    scratch.joined_call = 1;
+  }
   for (const Scratch::Outside& a : outside)
     for (const Scratch::Outside& b : outside)
       if (mayCross (a, b))
