@@ -796,6 +796,10 @@ PYBIND11_MODULE (_core, m)
                                                    : CloudModelParams::ResolutionGate::Everywhere;
                      },
                      "noise_resolution_gate == 'cloud'; setting False sets 'everywhere'.")
+      .def_readwrite ("keep_full_resolution", &CloudModelParams::keep_full_resolution,
+                      "Where noise_resolution merged samples, also keep the unmerged model: the separators' contact\n"
+                      "leaning to collision (P >= 0.5) is asked again at full resolution within 256 leaf-pair fits,\n"
+                      "and its collision stands (CollisionResult.full_resolution). Default True.")
       .def_readwrite ("threads", &CloudModelParams::threads,
                       "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
                       "hardware thread. The model is the same for any count.")
@@ -967,6 +971,9 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
       .def_readonly ("budget_exhausted", &CollisionResult::budget_exhausted,
                      "True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound.")
+      .def_readonly ("full_resolution", &CollisionResult::full_resolution,
+                     "True when the answer is the unmerged models' (CloudModelParams.keep_full_resolution): the merged\n"
+                     "ones read contact at P >= 0.5 and the unmerged ones found a collision.")
       .def_readonly ("no_leaf_tested", &CollisionResult::no_leaf_tested)
       .def_readonly ("unobserved", &CollisionResult::unobserved,
                      "True when the surface layer's answer rests on surface the samples do not show\n"
@@ -1007,6 +1014,8 @@ PYBIND11_MODULE (_core, m)
           s += ", unobserved=True";
         if (r.budget_exhausted)  // shown only when set
           s += ", budget_exhausted=True";
+        if (r.full_resolution)  // shown only when set
+          s += ", full_resolution=True";
         s = s + ", lower_bound=" + (r.lower_bound ? "True" : "False") +
             ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
             ", witness_side=" + std::to_string (r.witness_side) +

@@ -24,6 +24,17 @@ namespace pcl_probcollision
 namespace
 {
 constexpr float kNotReached = std::numeric_limits<float>::quiet_NaN ();
+/** \brief A merged model's contact answer at or above this P is asked again at full resolution
+  * (CloudModelParams::keep_full_resolution): the merged points' broad covariances read some
+  * deep collisions as contact (P 0.64-0.89 on the evaluation). Below it the answer leans to
+  * free, where the full resolution's over-confident collisions would mostly cost calibration
+  * (docs/PERFORMANCE.md, "A full-resolution rung for merged clouds"). */
+constexpr double kFullResolutionFrom = 0.5;
+/** \brief Leaf-pair fits the full-resolution query may make: a bound on its worst case (the
+  * unmerged query's worst at 4 % noise: 73 ms on the evaluation's development seeds). 512 gave
+  * the same easy answers there, 128 lost one. Exhausted without a collision, the merged answer
+  * stands. */
+constexpr std::size_t kFullResolutionFits = 256;
 
 void
 fail (CollisionResult& result, CollisionResult::Status status, const std::string& message)
@@ -234,11 +245,14 @@ verdictFor (double probability, const CollisionRequest& request)
 }
 
 
-bool
-collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
-         CollisionResult& result, const RobustClassifier* classifier)
+namespace
 {
-  const auto start = std::chrono::steady_clock::now ();
+/** \brief collide() on the two models as they are, without the full-resolution rung and the
+  * timing. */
+bool
+collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+               CollisionResult& result, const RobustClassifier* classifier)
+{
   result = CollisionResult ();
   try
   {
@@ -388,6 +402,49 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
   for (const CloudModel* m : {&a, &b})
     if (!m->warning ().empty ())
       result.message += (result.message.empty () ? "" : "; ") + m->warning ();
+  return true;
+}
+} // namespace
+
+bool
+collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+         CollisionResult& result, const RobustClassifier* classifier)
+{
+  const auto start = std::chrono::steady_clock::now ();
+  if (!collideModels (a, b, T_a_b, request, result, classifier))
+    return false;
+  // The full-resolution rung (CloudModelParams::keep_full_resolution): the separators' contact
+  // on a merged model, leaning to collision, asked again unmerged within a budget; its collision
+  // stands. Only the separators' answers: the budget bounds their work, not the surface layer's.
+  const CloudModel* full_a = a.fullResolution ();
+  const CloudModel* full_b = b.fullResolution ();
+  if ((full_a || full_b) && result.answered_by == AnsweredBy::Separators && result.verdict == Verdict::InContact &&
+      result.probability >= kFullResolutionFrom)
+  {
+    CollisionRequest full_request = request;
+    full_request.max_leaf_fits =
+        request.max_leaf_fits > 0 ? std::min (request.max_leaf_fits, kFullResolutionFits) : kFullResolutionFits;
+    CollisionResult full;
+    if (!collideModels (full_a ? *full_a : a, full_b ? *full_b : b, T_a_b, full_request, full, classifier))
+    {
+      result = std::move (full);
+      return false;
+    }
+    if (full.verdict == Verdict::InCollision)
+    {
+      full.bv_tests += result.bv_tests;
+      full.leaf_pairs_tested += result.leaf_pairs_tested;
+      full.classifier_iterations += result.classifier_iterations;
+      full.full_resolution = true;
+      result = std::move (full);
+    }
+    else
+    {
+      result.bv_tests += full.bv_tests;
+      result.leaf_pairs_tested += full.leaf_pairs_tested;
+      result.classifier_iterations += full.classifier_iterations;
+    }
+  }
   if (request.enable_timings)
   {
     result.build_ms = 0.0;  // the models were built before

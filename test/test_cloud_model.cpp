@@ -602,6 +602,75 @@ TEST (NoiseResolution, DeterministicAndInvariantUnderRigidMotion)
   EXPECT_LE (differ, a->size () / 100);
 }
 
+TEST (NoiseResolution, AContactLeaningToCollisionIsAskedAgainAtFullResolution)
+{
+  // A noisy wall pushed through a noisy sheet, both 80 mm wide, sampled 5 mm apart with 8 mm
+  // noise (the whole-cloud gate merges them), its edge from 8 mm short of the sheet to 56 mm
+  // through it.
+  const double size = 0.08;
+  const Cloud::Ptr a = sheet (size, 0.005, 0.008, 21);
+  const Cloud::Ptr b = sheet (size, 0.005, 0.008, 22);
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.008);
+  params.noise_resolution = 2.0;
+  CloudModelParams coarse_only = params;
+  coarse_only.keep_full_resolution = false;
+  const CloudModel::ConstPtr ma = buildCloudModel (*a, params, nullptr, nullptr, "a");
+  const CloudModel::ConstPtr mb = buildCloudModel (*b, params, nullptr, nullptr, "b");
+  const CloudModel::ConstPtr ca = buildCloudModel (*a, coarse_only, nullptr, nullptr, "a");
+  const CloudModel::ConstPtr cb = buildCloudModel (*b, coarse_only, nullptr, nullptr, "b");
+  ASSERT_GT (ma->mergedSamples (), 0u);
+  ASSERT_NE (ma->fullResolution (), nullptr);
+  EXPECT_EQ (ca->fullResolution (), nullptr);
+  EXPECT_EQ (ma->size (), ca->size ());
+  const CloudModel& full_a = *ma->fullResolution ();
+  EXPECT_EQ (full_a.size (), a->size ());  // unmerged
+  EXPECT_EQ (full_a.mergedSamples (), 0u);
+  EXPECT_EQ (full_a.fullResolution (), nullptr);
+  EXPECT_EQ (ma->bytes (), ca->bytes () + full_a.bytes ());
+  // A cloud that does not merge keeps nothing more.
+  const CloudModel::ConstPtr sparse = buildCloudModel (*sheet (0.12, 0.02, 0.002, 23), params);
+  EXPECT_EQ (sparse->mergedSamples (), 0u);
+  EXPECT_EQ (sparse->fullResolution (), nullptr);
+
+  CollisionRequest capped;
+  capped.max_leaf_fits = 256;
+  int asked = 0, upgraded = 0;
+  for (int step = 0; step <= 16; ++step)
+  {
+    const double depth = -0.008 + 0.004 * step;  // the wall's lower edge below the sheet
+    const Eigen::Isometry3d T (Eigen::Translation3d (0.0, 0.0, size / 2 - depth) *
+                               Eigen::AngleAxisd (M_PI / 2, Eigen::Vector3d::UnitX ()));
+    CollisionResult r, coarse, full;
+    ASSERT_TRUE (collide (*ma, *mb, T, CollisionRequest (), r)) << r.message;
+    ASSERT_TRUE (collide (*ca, *cb, T, CollisionRequest (), coarse)) << coarse.message;
+    ASSERT_TRUE (collide (full_a, *mb->fullResolution (), T, capped, full)) << full.message;
+    // The rule: the merged answer, unless it is contact at P >= 0.5 and the unmerged models
+    // within 256 fits find a collision.
+    const bool ask = coarse.verdict == Verdict::InContact && coarse.probability >= 0.5;
+    asked += ask ? 1 : 0;
+    if (ask && full.verdict == Verdict::InCollision)
+    {
+      ++upgraded;
+      EXPECT_TRUE (r.full_resolution) << depth;
+      EXPECT_EQ (r.probability, full.probability) << depth;
+      EXPECT_EQ (r.verdict, Verdict::InCollision);
+      EXPECT_EQ (r.witness_index, full.witness_index);
+      EXPECT_EQ (r.leaf_pairs_tested, full.leaf_pairs_tested + coarse.leaf_pairs_tested);
+    }
+    else
+    {
+      EXPECT_FALSE (r.full_resolution) << depth;
+      EXPECT_EQ (r.probability, coarse.probability) << depth;
+      EXPECT_EQ (r.verdict, coarse.verdict);
+      EXPECT_EQ (r.witness_index, coarse.witness_index);
+    }
+  }
+  // Some merged contacts are collisions at full resolution, not all of them.
+  EXPECT_GT (upgraded, 0);
+  EXPECT_GT (asked, upgraded);
+}
+
 // ---- The spacing gate (CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing) ----------
 
 namespace

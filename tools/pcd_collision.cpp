@@ -368,6 +368,9 @@ resultJson (const Options& o, const Input& a, const Input& b, const pcl_probcoll
     j.key ("nearest_points").null ();
   j.key ("lower_bound").boolean (r.lower_bound);
   j.key ("budget_exhausted").boolean (r.budget_exhausted);
+  // Always a boolean (false without -noise_resolution): the answer is the unmerged models',
+  // asked again after the merged ones read contact leaning to collision (CollisionResult::full_resolution).
+  j.key ("full_resolution").boolean (r.full_resolution);
   j.key ("no_leaf_tested").boolean (r.no_leaf_tested);
   j.key ("points_a").unsignedInteger (r.points_a);
   j.key ("points_b").unsignedInteger (r.points_b);
@@ -471,6 +474,8 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bo
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";
+  // A merged cloud's contact that the unmerged models read as collision (CollisionResult::full_resolution).
+  const char* full = r.full_resolution ? "  (full resolution)" : "";
   // With -surface_ladder, the rung that answered (CollisionResult::answered_by); the other
   // settings have one answerer, which the command line names.
   const char* rung = !ladder ? ""
@@ -479,10 +484,10 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bo
                      : r.answered_by == pcl_probcollision::AnsweredBy::Pooled       ? "  (ladder: pooled)"
                                                                                     : "";
   std::snprintf (buf, sizeof (buf),
-                 "%s%-9s P %s %.6f%s%s%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
+                 "%s%-9s P %s %.6f%s%s%s%s%s   [points a %zu, b %zu, non-finite skipped %zu; leaf pairs %zu; build %.1f ms, "
                  "query %.1f ms]",
                  prefix.c_str (), pcl_probcollision::verdictName (r.verdict), r.lower_bound ? ">=" : "=",
-                 r.probability, distance, unobserved, rung, capped, r.points_a, r.points_b, r.points_skipped_nonfinite,
+                 r.probability, distance, unobserved, rung, capped, full, r.points_a, r.points_b, r.points_skipped_nonfinite,
                  r.leaf_pairs_tested,
                  std::isfinite (r.build_ms) ? r.build_ms : 0.0, std::isfinite (r.query_ms) ? r.query_ms : 0.0);
   return buf;

@@ -106,8 +106,13 @@ public:
     * merged samples). */
   std::size_t bytes () const
   {
-    return bvh_.bytes () + surface_.bytes () + (point_of_source_.capacity () + representatives_.capacity ()) * sizeof (int);
+    return bvh_.bytes () + surface_.bytes () + (point_of_source_.capacity () + representatives_.capacity ()) * sizeof (int) +
+           (full_resolution_ ? full_resolution_->bytes () : 0);
   }
+  /** \brief Where samples were merged and CloudModelParams::keep_full_resolution kept it: the
+    * model of the same cloud unmerged, which collide() asks when the merged answer is contact
+    * leaning to collision. Null otherwise. */
+  const CloudModel* fullResolution () const { return full_resolution_.get (); }
   /** \brief Samples merged into another (CloudModelParams::noise_resolution): the finite
     * samples in the model minus size(); 0 when none merged. */
   std::size_t mergedSamples () const { return merged_samples_; }
@@ -166,6 +171,7 @@ private:
   std::size_t merged_samples_ = 0;
   std::vector<int> point_of_source_;
   std::vector<int> representatives_;
+  std::shared_ptr<const CloudModel> full_resolution_;
   CloudModelParams params_;
   double build_ms_ = 0.0;
   double neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();

@@ -102,6 +102,12 @@ struct CollisionResult
     * the verdict then say what the bridged or occupied surface implies; a planner may treat
     * such a pose as unknown. */
   bool unobserved = false;
+  /** \brief True when the answer is the full-resolution models' (CloudModel::fullResolution()):
+    * a model merged its samples (CloudModelParams::noise_resolution), the merged answer was
+    * the separators' contact at P >= 0.5, and the unmerged models, asked again with a budget of 256 leaf-pair
+    * fits, found a collision. Every field is then theirs but the work counters, which count both
+    * queries. */
+  bool full_resolution = false;
 
   /** \brief The point attaining P: side +1 = input (A), -1 = target (B), 0 = none. */
   int witness_side = 0;

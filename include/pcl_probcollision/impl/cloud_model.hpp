@@ -124,9 +124,15 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   const bool merging = params.noise_resolution > 0.0 && !covariances;
   // The whole-cloud gate reads the covariance estimation's neighbour radii (below) and decides
   // there; the other gates merge first.
+  // The merged model, when samples merge; with keep_full_resolution the unmerged one is built
+  // on below and kept in it (CloudModel::fullResolution()).
+  std::shared_ptr<const CloudModel> merged_model;
   if (merging && params.noise_resolution_gate != Gate::WholeCloud)
-    if (auto model = mergedModel (params.noise_resolution_gate == Gate::WhereNoiseExceedsSpacing ? params.k : 0))
-      return model;
+  {
+    merged_model = mergedModel (params.noise_resolution_gate == Gate::WhereNoiseExceedsSpacing ? params.k : 0);
+    if (merged_model && !params.keep_full_resolution)
+      return merged_model;
+  }
 
   // Estimate what the caller did not give: covariances, neighbour radii (area weights) and the
   // surface displacements. The estimation reads the cloud through a non-owning pointer: it is
@@ -177,9 +183,12 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
           return std::numeric_limits<double>::quiet_NaN ();
         return detail::smallestDeviation (params.noise, p.getVector3fMap ().template cast<double> (), sensor);
       };
-      if (detail::noiseExceedsTypicalSpacing (radii, params.k, deviation))
-        if (auto model = mergedModel (0))
-          return model;
+      if (!merged_model && detail::noiseExceedsTypicalSpacing (radii, params.k, deviation))
+      {
+        merged_model = mergedModel (0);
+        if (merged_model && !params.keep_full_resolution)
+          return merged_model;
+      }
     }
     displacements = estimation.getSurfaceDisplacements ();
     normals = estimation.getNormals ();
@@ -318,6 +327,18 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   if (!model->warning_.empty ())
     PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", model->warning_.c_str ());
+  if (merged_model)
+  {
+    // The unmerged model above is the merged one's full-resolution rung; the build time counts
+    // both.
+    CloudModelParams unmerged = params;
+    unmerged.noise_resolution = 0.0;
+    model->params_ = unmerged;
+    const auto coarse = std::const_pointer_cast<CloudModel> (merged_model);
+    coarse->full_resolution_ = std::move (model);
+    coarse->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+    return coarse;
+  }
   return model;
 }
 } // namespace pcl_probcollision

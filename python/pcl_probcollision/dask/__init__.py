@@ -384,6 +384,8 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
         "status": np.array([int(r.status) for r in results], dtype=np.int8),
         "lower_bound": np.array([r.lower_bound for r in results], dtype=bool),
         "budget_exhausted": np.array([r.budget_exhausted for r in results], dtype=bool),
+        # The answer is the unmerged models' (CloudModelParams.keep_full_resolution); False unless merged.
+        "full_resolution": np.array([r.full_resolution for r in results], dtype=bool),
         "no_leaf_tested": np.array([r.no_leaf_tested for r in results], dtype=bool),
         # NaN without surface (or where the surfaces never came within reach), as in CollisionResult.
         "signed_distance": np.array([r.signed_distance for r in results], dtype=np.float64),

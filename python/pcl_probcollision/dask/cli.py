@@ -271,6 +271,7 @@ def json_lines(r, pose_rows, o, a, b):
                f'"probability":{_num(r.probability[i])},"answered_by":"{_ANSWERED_BY[int(r.answered_by[i])]}",'
                f'{surface(i)}"lower_bound":{_bool(r.lower_bound[i])},'
                f'"budget_exhausted":{_bool(r.budget_exhausted[i])},'
+               f'"full_resolution":{_bool(r.full_resolution[i])},'
                f'"no_leaf_tested":{_bool(r.no_leaf_tested[i])},"points_a":{int(r.points_a[i])},'
                f'"points_b":{int(r.points_b[i])},"points_skipped_nonfinite":{int(r.points_skipped_nonfinite[i])},'
                f'"leaf_pairs":{int(r.leaf_pairs_tested[i])},"bv_tests":{int(r.bv_tests[i])},'
