@@ -1036,6 +1036,9 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("size", &CloudModel::size, "Points in the model (finite rows).")
       .def_property_readonly ("source_size", &CloudModel::sourceSize, "Rows of the input (per-point results align with it).")
       .def_property_readonly ("skipped_points", &CloudModel::skippedPoints, "Rows left out as non-finite (NaN / Inf).")
+      .def_property_readonly ("keeps_full_resolution", [] (const CloudModel& model) { return model.fullResolution () != nullptr; },
+                              "True when samples were merged and the unmerged model is kept beside the merged one\n"
+                              "(CloudModelParams.keep_full_resolution): the full-resolution rung of collide().")
       .def_property_readonly ("merged_samples", &CloudModel::mergedSamples,
                               "Finite rows merged into another by noise_resolution (size is the finite rows minus these);\n"
                               "0 when none merged.")

@@ -53,6 +53,23 @@ def test_noise_resolution_merges_a_patch_sampled_finer_than_its_noise(gripper_pa
     assert 0 < merged.size < 40 and merged.merged_samples == 400 - merged.size
     kept = pc.load_model(table_path, merging)
     assert kept.size == table.size == 10848 and kept.merged_samples == 0
+    # The merged patch keeps its unmerged model for the full-resolution rung; nothing else does.
+    assert merged.keeps_full_resolution is True
+    assert gripper_patch.keeps_full_resolution is False and kept.keeps_full_resolution is False
+    merging.keep_full_resolution = False
+    alone = pc.build_model(patch(), params=merging)
+    assert alone.size == merged.size and alone.keeps_full_resolution is False
+    # At the table (contact at P 0.53-0.81 for z = -0.001 to 0.002): the rung asks those contacts
+    # again, so the answers of the two models agree except where result.full_resolution says the
+    # unmerged models answered.
+    for z in (-0.002, -0.001, 0.0, 0.001, 0.002, 0.01):
+        r = pc.collide(kept, merged, translation(0.1, 0.1, z))
+        s = pc.collide(kept, alone, translation(0.1, 0.1, z))
+        assert isinstance(r.full_resolution, bool) and s.full_resolution is False
+        if not r.full_resolution:
+            assert (r.probability, r.verdict) == (s.probability, s.verdict)
+        else:
+            assert s.verdict == pc.Verdict.InContact and s.probability >= 0.5 and r.verdict == pc.Verdict.InCollision
 
 
 def test_imported_from_the_build_tree():
@@ -71,7 +88,7 @@ def test_defaults_are_the_cpp_defaults():
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
     assert p.surface is False and p.orientation == pc.NormalOrientation.Auto and p.closed_objects is False
     # Issue #17's resolution: off by default; set, it merges a whole cloud sampled finer than its noise.
-    assert p.noise_resolution == 0.0 and p.noise_resolution_gate == "cloud"
+    assert p.noise_resolution == 0.0 and p.noise_resolution_gate == "cloud" and p.keep_full_resolution is True
     assert p.noise_stop == 0.0
     assert p.noise_resolution_whole_cloud is True and p.noise_resolution_gated is False
     p.noise_resolution_gated = True  # one gate: the last set wins
