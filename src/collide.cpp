@@ -430,19 +430,19 @@ collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_
       result = std::move (full);
       return false;
     }
-    if (full.verdict == Verdict::InCollision)
+    // The answer that stands counts the work of both queries.
+    const bool full_stands = full.verdict == Verdict::InCollision;
+    CollisionResult& kept = full_stands ? full : result;
+    const CollisionResult& other = full_stands ? result : full;
+    kept.bv_tests += other.bv_tests;
+    kept.leaf_pairs_tested += other.leaf_pairs_tested;
+    kept.kernel_leaf_pairs += other.kernel_leaf_pairs;
+    kept.degenerate_leaf_pairs += other.degenerate_leaf_pairs;
+    kept.classifier_iterations += other.classifier_iterations;
+    if (full_stands)
     {
-      full.bv_tests += result.bv_tests;
-      full.leaf_pairs_tested += result.leaf_pairs_tested;
-      full.classifier_iterations += result.classifier_iterations;
       full.full_resolution = true;
       result = std::move (full);
-    }
-    else
-    {
-      result.bv_tests += full.bv_tests;
-      result.leaf_pairs_tested += full.leaf_pairs_tested;
-      result.classifier_iterations += full.classifier_iterations;
     }
   }
   if (request.enable_timings)

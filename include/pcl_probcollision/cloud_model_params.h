@@ -103,8 +103,8 @@ struct CloudModelParams
     * sampled finer than its noise. Off by default: it lowers the probability of some deep
     * collisions to contact (docs/PERFORMANCE.md, "Merging a whole cloud sampled finer than its
     * noise"); keep_full_resolution gives most of them back, not all ("A full-resolution rung for
-    * merged clouds"). No effect without a noise model (noise None) or with covariances given by the
-    * caller. */
+    * merged clouds"). No effect without a noise model (noise None) or with covariances given by
+    * the caller. */
   double noise_resolution = 0.0;
   /** \brief Where noise_resolution merges (issue #17 item 1). Everywhere: every sample within
     * the radius of a seed. WhereNoiseExceedsSpacing: only samples whose local spacing is at most
@@ -131,11 +131,11 @@ struct CloudModelParams
     * (CloudModel::fullResolution()): a query whose merged answer is the separators' contact
     * leaning to collision (P at least 0.5) is asked again at full resolution, with a budget of
     * 256 leaf-pair fits, and its collision stands when it finds one (collide(),
-    * CollisionResult::full_resolution; the surface layer's answers are not asked again). The merged point's covariance is broad, so a deep
-    * collision can read contact on the merged model alone; this rung gives it back its
-    * collision (docs/PERFORMANCE.md, "A full-resolution rung for merged clouds"). Default on;
-    * it costs the unmerged hierarchy's build and memory on a cloud that merges, nothing on one
-    * that does not. */
+    * CollisionResult::full_resolution; the surface layer's answers are not asked again). The
+    * merged point's covariance is broad, so a deep collision can read contact on the merged
+    * model alone; this rung gives it back its collision (docs/PERFORMANCE.md, "A
+    * full-resolution rung for merged clouds"). Default on; it costs the unmerged hierarchy's
+    * build and memory on a cloud that merges, nothing on one that does not. */
   bool keep_full_resolution = true;
   /** \brief "everywhere", "spacing" or "cloud" (pcd_collision's -noise_resolution_gate). */
   static const char*

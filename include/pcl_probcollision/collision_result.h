@@ -104,9 +104,10 @@ struct CollisionResult
   bool unobserved = false;
   /** \brief True when the answer is the full-resolution models' (CloudModel::fullResolution()):
     * a model merged its samples (CloudModelParams::noise_resolution), the merged answer was
-    * the separators' contact at P >= 0.5, and the unmerged models, asked again with a budget of 256 leaf-pair
-    * fits, found a collision. Every field is then theirs but the work counters, which count both
-    * queries. */
+    * the separators' contact at P >= 0.5, and the unmerged models, asked again with a budget of
+    * 256 leaf-pair fits, found a collision. Every field is then theirs but the work counters
+    * (bv_tests, leaf_pairs_tested and its parts, classifier_iterations), which count both
+    * queries, whichever answer stands. */
   bool full_resolution = false;
 
   /** \brief The point attaining P: side +1 = input (A), -1 = target (B), 0 = none. */
