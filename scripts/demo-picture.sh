@@ -34,8 +34,9 @@ run() {
   local header points
   header=$(grep -abo 'DATA binary' "$tmp/$name.pcd" | head -1 | cut -d: -f1)
   points=$(grep -a '^POINTS ' "$tmp/$name.pcd" | head -1 | awk '{ print $2 }')
-  grep -aq '^FIELDS x y z intensity rgb label$' "$tmp/$name.pcd" ||
-    { echo "demo-picture.sh: $tmp/$name.pcd: unexpected fields" >&2; exit 1; }
+  grep -aq '^FIELDS x y z intensity rgb label$' "$tmp/$name.pcd" && grep -aq '^SIZE 4 4 4 4 4 4$' "$tmp/$name.pcd" &&
+    [ -n "$header" ] && [ -n "$points" ] ||
+    { echo "demo-picture.sh: $tmp/$name.pcd: not the binary layout this script reads (x y z intensity rgb label, 4 bytes each)" >&2; exit 1; }
   echo "$((header + 12)) $points" > "$tmp/$name.layout"
 }
 run separators
