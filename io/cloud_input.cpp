@@ -11,11 +11,13 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <string>
 
 namespace pcl_probcollision
 {
@@ -53,6 +55,45 @@ fieldSize (std::uint8_t datatype)
     default: return 0;
   }
 }
+/** \brief For a PCD with DATA ascii: every value of its first `points` data lines a number, as
+  * strtod reads it whole (nan and inf included), the rest of the file unread. PCL's reader
+  * reads a value that is not a number ("abc") as 0 and one with trailing garbage ("1.5x") as its
+  * numeric start, and says nothing. */
+bool
+checkAsciiValues (const std::string& path, std::size_t points, std::string& error)
+{
+  std::ifstream in (path, std::ios::binary);
+  std::string line;
+  std::size_t line_number = 0;
+  bool in_data = false;
+  for (std::size_t read = 0; read < points && std::getline (in, line);)
+  {
+    ++line_number;
+    if (!in_data)
+    {
+      in_data = line.compare (0, 4, "DATA") == 0;
+      continue;
+    }
+    std::istringstream words (line);
+    std::string word;
+    bool any = false;
+    for (std::size_t column = 1; words >> word; ++column)
+    {
+      any = true;
+      char* end = nullptr;
+      std::strtod (word.c_str (), &end);
+      if (end != word.c_str () + word.size ())
+      {
+        error = "'" + path + "' line " + std::to_string (line_number) + ", value " + std::to_string (column) + ": '" +
+                word + "' is not a number";
+        return false;
+      }
+    }
+    read += any ? 1 : 0;  // PCL skips blank lines
+  }
+  return true;
+}
+
 bool
 isPly (const std::string& path)
 {
@@ -173,6 +214,8 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
       error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
       return false;
     }
+    if (data_type == 0 && !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, error))
+      return false;
   }
   if (static_cast<std::size_t> (blob.width) * blob.height == 0)
   {

@@ -12,6 +12,8 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <string>
+#include <tuple>
 
 namespace pcd_collision
 {
@@ -536,6 +538,14 @@ parseCommandLine (const std::vector<std::string>& args)
   // sigmas, which only an isotropic input uses.
   o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
   o.sensor_b = sensor_b.value_or (sensor.value_or (Defaults::sensor));
+  // A mesh is sampled exactly, with a zero covariance: a noise model or sigma named for it alone
+  // would be ignored (-sensor and -sigma, for both inputs, apply to the clouds among them).
+  for (const auto& [input, path, given_sigma, given_sensor] :
+       {std::tuple ("a", o.input_a, sigma_a.has_value (), sensor_a.has_value ()),
+        std::tuple ("b", o.input_b, sigma_b.has_value (), sensor_b.has_value ())})
+    if ((given_sigma || given_sensor) && inputKindOf (path) == InputKind::Mesh)
+      return usage (std::string ("option -") + (given_sigma ? "sigma_" : "sensor_") + input + ": <" + input + "> '" +
+                    path + "' is a mesh, sampled exactly with no sensor noise; the option applies to a cloud");
   const std::string iso = "isotropic";
   if (sigma && (o.sensor_a != iso || o.sensor_b != iso))
     return usage ("option -sigma needs the isotropic model for both inputs (got " + o.sensor_a + " for <a>, " +

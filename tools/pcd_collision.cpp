@@ -867,8 +867,8 @@ run (int argc, char** argv)
     pc.setTargetModel (orientedModel (b, SensorNoiseModel::fromName (o.sensor_b, o.sigma_b), false));
   else
     pc.setTargetNoise (SensorNoiseModel::fromName (o.sensor_b, o.sigma_b));
-  // The build time of the clouds built here, which compute() would otherwise have counted.
-  double cloud_build_ms = 0.0;
+  // The build time of the models built here (compute() reuses them, so it counts none).
+  double models_build_ms = 0.0;
   // The other clouds' models are built here too (or taken from their early build), so that every
   // model gets its stage line (a 5,000,000-point cloud takes seconds); a build that fails is
   // left to compute(), which builds it again and reports the error as before.
@@ -881,7 +881,7 @@ run (int argc, char** argv)
       const auto shown = ticker.show ("Building " + in.path);
       const auto built = early.valid () ? early.get () : buildCloud (in, sensor, sigma, input);
       input ? pc.setInputModel (built) : pc.setTargetModel (built);
-      cloud_build_ms += built->buildMilliseconds ();
+      models_build_ms += built->buildMilliseconds ();
     }
     catch (const pcl::PCLException&)
     {
@@ -889,10 +889,12 @@ run (int argc, char** argv)
   };
   cloudModel (a, early_a, o.sensor_a, o.sigma_a, true);
   cloudModel (b, early_b, o.sensor_b, o.sigma_b, false);
-  if (a.kind == InputKind::Cloud && a.oriented)
-    cloud_build_ms += pc.getInputModel ()->buildMilliseconds ();
-  if (b.kind == InputKind::Cloud && b.oriented)
-    cloud_build_ms += pc.getTargetModel ()->buildMilliseconds ();
+  // Models built from oriented points (a mesh's samples, a cloud with normals) count too: the
+  // answer's build time is every model's, whoever built it.
+  if (a.oriented)
+    models_build_ms += pc.getInputModel ()->buildMilliseconds ();
+  if (b.oriented)
+    models_build_ms += pc.getTargetModel ()->buildMilliseconds ();
   for (const auto& [in, model] : {std::pair (&a, pc.getInputModel ()), std::pair (&b, pc.getTargetModel ())})
     if (model)
       // The model's memory (CloudModel::bytes), for whoever sizes a large map.
@@ -930,6 +932,13 @@ run (int argc, char** argv)
     pc.computeBatch (c.T, c.results, static_cast<int> (workers));
     return c;
   };
+  // Two meshes are sampled exactly (zero covariance), so nothing models the surface between
+  // their samples: a thin part through a thin wall can pass between the samples of both and read
+  // free (FCL's piano legs, 40 mm across, through its 9 mm floor at the default 90 mm spacing).
+  // A free answer whose samples came within reach of each other (leaf pairs were fitted) says
+  // so, once a run.
+  const bool both_meshes = a.kind == InputKind::Mesh && b.kind == InputKind::Mesh;
+  bool warned_between_samples = false;
   // Prints pose i (k-th of its chunk) and its answer; throws Failure for a failed query.
   auto emit = [&] (std::size_t i, std::size_t k, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
     if (!result.ok () || shares_terminal)
@@ -947,7 +956,7 @@ run (int argc, char** argv)
     if (i > 0 && std::isfinite (result.build_ms))
       result.build_ms = 0.0;
     if (i == 0)
-      result.build_ms += cloud_build_ms;
+      result.build_ms += models_build_ms;
     // With -surface, how each surface was oriented, once both models exist.
     if (i == 0 && o.surface)
     {
@@ -979,6 +988,18 @@ run (int argc, char** argv)
       write_ms = msSince (start);
     }
 
+    if (both_meshes && !warned_between_samples && result.verdict == pcl_probcollision::Verdict::Free &&
+        result.leaf_pairs_tested > 0)
+    {
+      warned_between_samples = true;
+      progress.clear ();
+      std::fprintf (stderr,
+                    "pcd_collision: warning: %s reads free, but both inputs are meshes sampled %g apart and their "
+                    "samples come within reach of each other there: a part thinner than that crossing a thin wall "
+                    "passes between samples and reads free. Check it with a smaller -mesh_density (said once a "
+                    "run)\n",
+                    batch ? ("pose " + std::to_string (i)).c_str () : "the pose", std::max (a.spacing, b.spacing));
+    }
     const long long index = batch ? static_cast<long long> (i) : -1;
     if (o.json)
     {

@@ -732,12 +732,17 @@ def test_malformed_pcd_files(tmp_path, table_path):
         "no_z.pcd": b"VERSION 0.7\nFIELDS x y\nSIZE 4 4\nTYPE F F\nCOUNT 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n0 0\n",
         "empty.pcd": header.replace(b"10", b"0"),
         "cut.pcd": table_path.read_bytes()[:4000],
+        # PCL's ASCII reader would read "abc" as 0: the value is named instead
+        "word.pcd": b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\n"
+                    b"DATA ascii\n0 0 0\n1 abc 1\n",
     }
     for name, content in cases.items():
         f = tmp_path / name
         f.write_bytes(content)
         with pytest.raises(ValueError, match=name):
             pc.load_model(f)
+    with pytest.raises(ValueError, match=r"word\.pcd' line 11, value 2: 'abc' is not a number"):
+        pc.load_model(tmp_path / "word.pcd")
 
 
 def test_cmake_install_gives_an_importable_package(tmp_path):

@@ -110,6 +110,10 @@ def test_options_are_pcd_collision_flags():
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), thresholds=(0.9, 0.1))
     with pytest.raises(ValueError, match="noise_resolution_gate"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution=2, noise_resolution_gate="somewhere")
+    with pytest.raises(ValueError, match=r"option sigma_a: <a> '.*gripper\.obj' is a mesh"):
+        pcd.collide_poses(str(DATA / "gripper.obj"), patch(), np.zeros((1, 6)), sigma_a=0.01)
+    with pytest.raises(ValueError, match=r"option sensor_b: <b> '.*gripper\.obj' is a mesh"):
+        pcd.collide_poses(patch(), str(DATA / "gripper.obj"), np.zeros((1, 6)), sensor_b="kinect")
     # thresholds change verdicts, not probabilities
     P = near_table_poses(30)
     P[:, 2] = np.linspace(-0.01, 0.01, 30)

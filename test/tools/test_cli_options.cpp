@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <sstream>
+#include <utility>
 
 using namespace pcd_collision;
 using Kind = ParseResult::Kind;
@@ -17,7 +18,7 @@ parse (std::vector<std::string> extra, bool with_inputs = true)
 {
   std::vector<std::string> args;
   if (with_inputs)
-    args = {"a.pcd", "b.obj"};
+    args = {"a.pcd", "b.pcd"};
   args.insert (args.end (), extra.begin (), extra.end ());
   return parseCommandLine (args);
 }
@@ -37,7 +38,7 @@ TEST (CliOptions, Defaults)
   ASSERT_EQ (r.kind, Kind::Run) << r.error;
   const Options& o = r.options;
   EXPECT_EQ (o.input_a, "a.pcd");
-  EXPECT_EQ (o.input_b, "b.obj");
+  EXPECT_EQ (o.input_b, "b.pcd");
   EXPECT_FALSE (o.pose);
   EXPECT_FALSE (o.poses_file);
   EXPECT_EQ (o.threads, 0);  // one per hardware thread
@@ -342,6 +343,22 @@ TEST (CliOptions, SensorPerInput)
   expectUsageError ({"-sensor_b", "none", "-sigma_b", "0.01"}, "-sigma_b");
   expectUsageError ({"-sensor_a", "sonar"}, "-sensor_a");
   expectUsageError ({"-sensor_b", "kinect", "-sensor_b", "stereo"}, "more than once");
+
+  // A mesh has no sensor noise: a sigma or model given to it alone is refused, naming the input;
+  // -sigma and -sensor, for both inputs, still apply to the cloud beside it.
+  for (const auto& [flag, value] : {std::pair ("-sigma_b", "0.01"), std::pair ("-sensor_b", "kinect")})
+  {
+    const ParseResult r = parseCommandLine ({"a.pcd", "m.OBJ", flag, value});
+    EXPECT_EQ (r.kind, Kind::Error) << flag;
+    EXPECT_NE (r.error.find (flag), std::string::npos) << r.error;
+    EXPECT_NE (r.error.find ("'m.OBJ' is a mesh"), std::string::npos) << r.error;
+  }
+  const ParseResult on_a = parseCommandLine ({"m.ply", "b.pcd", "-sigma_a", "0.01"});
+  EXPECT_EQ (on_a.kind, Kind::Error);
+  EXPECT_NE (on_a.error.find ("-sigma_a: <a> 'm.ply' is a mesh"), std::string::npos) << on_a.error;
+  const ParseResult cloud_beside = parseCommandLine ({"m.ply", "b.pcd", "-sigma", "0.01", "-sigma_b", "0.02", "-sensor", "isotropic"});
+  ASSERT_EQ (cloud_beside.kind, Kind::Run) << cloud_beside.error;
+  EXPECT_EQ (cloud_beside.options.sigma_b, 0.02);
 }
 
 TEST (CliOptions, InputKinds)

@@ -897,6 +897,49 @@ TEST_F (PcdCollisionTool, PcdWithoutXyz)
   expectFailure ({kGripper.string (), (dir_ / "noxyz.pcd").string ()}, 1, "noxyz.pcd", {dir_ / "noxyz.pcd"});
 }
 
+// PCL's reader takes "abc" for 0 and "1.5x" for 1.5 in an ASCII PCD; the tool names the value.
+TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
+{
+  const std::string header = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n"
+                             "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n";
+  writeFile (dir_ / "word.pcd", header + "0 0 0\n1 abc 1\n2 2 2\n");
+  expectFailure ({kGripper.string (), (dir_ / "word.pcd").string ()}, 1, "word.pcd' line 13, value 2: 'abc' is not a number",
+                 {dir_ / "word.pcd"});
+  writeFile (dir_ / "tail.pcd", header + "0 0 0\n\n1 1 1.5x\n2 2 2\n");
+  expectFailure ({(dir_ / "tail.pcd").string (), kScene.string ()}, 1, "tail.pcd' line 14, value 3: '1.5x' is not a number",
+                 {dir_ / "tail.pcd"});
+  // nan, inf and exponents are numbers (a NaN point is skipped, as PCL does).
+  writeFile (dir_ / "fine.pcd", header + "nan nan nan\n1e-1 -2.5E+0 1\n0.25 inf 3\n");
+  const ToolRun r = run ({kGripper.string (), (dir_ / "fine.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
+  EXPECT_EQ (r.status, 0) << r.err;
+  EXPECT_NE (r.out.find ("free"), std::string::npos) << r.out;
+}
+
+// Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass
+// between the samples. FCL's piano (legs 40 mm across, through the 9 mm floor at the identity)
+// reads free at the default spacing, 90 mm, and the tool says why it may be wrong.
+TEST_F (PcdCollisionTool, TwoMeshesWarnWhereAFreeAnswerCameWithinReach)
+{
+  const std::string shared = PCL_PROBCOLLISION_SHARED_DATA;
+  const std::string piano = shared + "/meshes/piano_room_rob.obj", room = shared + "/meshes/piano_room_env.obj";
+  const ToolRun through = run ({piano, room});
+  ASSERT_EQ (through.status, 0) << through.err;
+  EXPECT_NE (through.out.find ("free"), std::string::npos) << through.out;  // the miss this warns of
+  EXPECT_NE (through.err.find ("pcd_collision: warning: the pose reads free, but both inputs are meshes sampled 90.01"),
+             std::string::npos) << through.err;
+  EXPECT_NE (through.err.find ("-mesh_density"), std::string::npos) << through.err;
+  // Sampled finely enough, the legs cross the floor's samples: collision, nothing to warn of.
+  const ToolRun fine = run ({piano, room, "-mesh_density", "45"});
+  ASSERT_EQ (fine.status, 0) << fine.err;
+  EXPECT_NE (fine.out.find ("collision"), std::string::npos) << fine.out;
+  EXPECT_EQ (fine.err.find ("warning"), std::string::npos) << fine.err;
+  // Far apart: free without a leaf pair, no warning.
+  const ToolRun far = run ({piano, room, "-pose", "0,0,30000,0,0,0"});
+  ASSERT_EQ (far.status, 0) << far.err;
+  EXPECT_NE (far.out.find ("free"), std::string::npos) << far.out;
+  EXPECT_EQ (far.err.find ("warning"), std::string::npos) << far.err;
+}
+
 TEST_F (PcdCollisionTool, EmptyCloud)
 {
   writeFile (dir_ / "empty.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 0\n"

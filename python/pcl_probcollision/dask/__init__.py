@@ -529,6 +529,13 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     T = as_pose_matrices(poses)
     stored = o["surface"] and not o["ignore_normals"]
     A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
+    # pcd_collision's rule: a mesh is sampled exactly, so a noise model or sigma given to it alone
+    # would be ignored (sensor and sigma, for both inputs, apply to the clouds among them).
+    for side, spec in (("a", A), ("b", B)):
+        for flag in ("sigma_" + side, "sensor_" + side):
+            if spec["kind"] == "mesh" and options.get(flag) is not None:
+                raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
+                                 f"with no sensor noise; the option applies to a cloud")
     _sample_meshes(A, B, o)
     sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)
