@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
-# Runs the example on a scan and checks that it succeeds and writes a non-empty cloud.
-# cmake -DEXE=... -DSCAN=... -DOUT=... -P run_gripper_filter.cmake
+# Runs the example on a scan and checks that it succeeds and writes a non-empty cloud; with DOC,
+# that every line it prints but the last (which names OUT) is quoted in that document.
+# cmake -DEXE=... -DSCAN=... -DOUT=... [-DDOC=docs/CLI.md] -P run_gripper_filter.cmake
 file(REMOVE "${OUT}")
 execute_process(COMMAND "${EXE}" "${SCAN}" "${OUT}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "${out}${err}")
@@ -17,5 +18,21 @@ if(NOT points GREATER 0)
 endif()
 if(EXISTS "${OUT}.tmp")
   message(FATAL_ERROR "temporary file ${OUT}.tmp left behind")
+endif()
+if(DOC)
+  file(READ "${DOC}" doc)
+  # A list splits at ";", which the output has: keep them as a placeholder until compared.
+  string(REPLACE ";" "<semicolon>" escaped "${out}")
+  string(REPLACE "\n" ";" lines "${escaped}")
+  foreach(line IN LISTS lines)
+    string(REPLACE "<semicolon>" ";" line "${line}")
+    if(line STREQUAL "" OR line MATCHES "^wrote ")
+      continue()
+    endif()
+    string(FIND "${doc}" "${line}\n" at)
+    if(at EQUAL -1)
+      message(FATAL_ERROR "${DOC} does not quote the example's line '${line}'")
+    endif()
+  endforeach()
 endif()
 message(STATUS "${OUT}: ${points} points")
