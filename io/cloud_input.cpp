@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "cloud_input.h"
+#include "quiet_pcl_console.h"
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
@@ -171,6 +172,7 @@ checkField (const CloudFile& file, int index, const std::string& path, const cha
 bool
 readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std::string& error)
 {
+  const QuietPclConsole quiet;  // the error returned is the one report (pcd_collision -v shows PCL's)
   pcl::PCLPointCloud2& blob = file.blob;
   // PCL's readers are given regular files only: on a directory PCDReader::readHeader never
   // returns (found in review, through Python's read_cloud).

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "mesh_input.h"
+#include "quiet_pcl_console.h"
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/common/io.h>
@@ -15,7 +16,9 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <mutex>
+#include <string>
 
 namespace pcl_probcollision::io
 {
@@ -33,29 +36,13 @@ applyVtkMessages (bool enabled)
   vtkOutputWindow::GetInstance ()->SetDisplayMode (enabled ? vtkOutputWindow::DEFAULT : vtkOutputWindow::NEVER);
 }
 
-/** \brief Silences PCL's console for its lifetime, unless setVtkMessages (true) asked for the
-  * readers' messages: pcl::io::vtk2mesh reports a failed VTK read with PCL_ERROR. */
-class QuietPclConsole
-{
-public:
-  QuietPclConsole () : level_ (pcl::console::getVerbosityLevel ()), quiet_ (!g_vtk_messages)
-  {
-    if (quiet_)
-      pcl::console::setVerbosityLevel (pcl::console::L_ALWAYS);
-  }
-  ~QuietPclConsole ()
-  {
-    if (quiet_)
-      pcl::console::setVerbosityLevel (level_);
-  }
-  QuietPclConsole (const QuietPclConsole&) = delete;
-  QuietPclConsole& operator= (const QuietPclConsole&) = delete;
-
-private:
-  pcl::console::VERBOSITY_LEVEL level_;
-  bool quiet_;
-};
 } // namespace
+
+bool
+readerMessagesShown ()
+{
+  return g_vtk_messages;
+}
 
 void
 setVtkMessages (bool enabled)
@@ -116,15 +103,25 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
     const auto& v = mesh.vertices[i];
     return std::isfinite (v[0]) && std::isfinite (v[1]) && std::isfinite (v[2]);
   };
-  for (const pcl::Vertices& polygon : polygon_mesh.polygons)
+  // The readers give 0-based indices (OBJ's 1-based ones converted) as unsigned: an index is
+  // named as the file counts it, and one below zero as negative.
+  const bool one_based = ext == "obj";
+  for (std::size_t face = 0; face < polygon_mesh.polygons.size (); ++face)
   {
-    const auto& idx = polygon.vertices;
+    const auto& idx = polygon_mesh.polygons[face].vertices;
     for (const std::uint32_t i : idx)
     {
       if (i >= mesh.vertices.size ())
       {
-        error = "'" + path + "': a face refers to vertex " + std::to_string (i) + " of " +
-                std::to_string (mesh.vertices.size ());
+        const std::string where = "'" + path + "': face " + std::to_string (face + 1);
+        const auto as_signed = static_cast<std::int32_t> (i);
+        if (as_signed < 0)
+          error = where + (one_based ? " has a vertex index below 1 (relative, negative OBJ indices are not read)"
+                                     : " has a negative vertex index (" + std::to_string (as_signed) + ")");
+        else
+          error = where + " refers to vertex " + std::to_string (one_based ? std::uint64_t{i} + 1 : std::uint64_t{i}) +
+                  (one_based ? " (counting from 1, as OBJ does)" : " (counting from 0)") + " but the file has " +
+                  std::to_string (mesh.vertices.size ()) + " vertices";
         return false;
       }
     }

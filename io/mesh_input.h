@@ -26,7 +26,8 @@ struct TriangleMesh
   * whole process (unless setVtkMessages() chose first), and PCL's console during the read. */
 bool loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& error);
 
-/** \brief Shows (true) or silences (false, the default) the messages of VTK and of PCL's VTK
-  * bridge, process-wide, for every later load (pcd_collision -v shows them). */
+/** \brief Shows (true) or silences (false, the default) the messages of VTK and of PCL's
+  * readers (its VTK bridge, its PCD and PLY readers behind loadCloud), process-wide, for every
+  * later load (pcd_collision -v shows them). */
 void setVtkMessages (bool enabled);
 } // namespace pcl_probcollision::io

@@ -330,6 +330,9 @@ toPose (const py::object& obj, const char* arg)
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         m (i, j) = r (i, j);
+    // A NaN anywhere is said as such, before the last row's test that it would fail too.
+    if (!m.allFinite ())
+      throw py::value_error (std::string (arg) + ": the pose is not finite (NaN or infinite entries)");
     if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
       throw py::value_error (std::string (arg) + ": the last row of a 4x4 pose must be [0, 0, 0, 1]");
   }
@@ -384,6 +387,8 @@ collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, 
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         m (i, j) = p (k, i, j);
+    if (!m.allFinite ())
+      throw py::value_error ("poses[" + std::to_string (k) + "]: the pose is not finite (NaN or infinite entries)");
     if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
       throw py::value_error ("poses[" + std::to_string (k) + "]: the last row of a 4x4 pose must be [0, 0, 0, 1]");
     T[static_cast<std::size_t> (k)].matrix () = m;
@@ -981,8 +986,10 @@ PYBIND11_MODULE (_core, m)
                      "surface bridges (an occlusion shadow), or behind a scanned sheet whose far side was never seen.\n"
                      "P and the verdict then say what the bridged or occupied surface implies; a planner may treat\n"
                      "such a pose as unknown. Always False without request.surface.")
-      .def_readonly ("witness_side", &CollisionResult::witness_side)
-      .def_readonly ("witness_index", &CollisionResult::witness_index)
+      .def_readonly ("witness_side", &CollisionResult::witness_side,
+                     "Which input holds the point attaining P: +1 a (the moved one), -1 b, 0 none.")
+      .def_readonly ("witness_index", &CollisionResult::witness_index,
+                     "That point's index in its own input (-1 when none).")
       .def_property_readonly ("witness_point", [] (const CollisionResult& r) { return vec3 (r.witness_point); })
       .def_property_readonly ("witness_normal", [] (const CollisionResult& r) { return vec3 (r.witness_normal); })
       .def_readonly ("points_a", &CollisionResult::points_a)

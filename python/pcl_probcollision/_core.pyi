@@ -137,9 +137,11 @@ class CollisionResult:
         """True when the surface layer's answer rests on surface the samples do not show (a bridged hole or
         occlusion shadow, or space behind a scanned sheet); always False without request.surface."""
     @property
-    def witness_side(self) -> int: ...
+    def witness_side(self) -> int:
+        """Which input holds the point attaining P: +1 a (the moved one), -1 b, 0 none."""
     @property
-    def witness_index(self) -> int: ...
+    def witness_index(self) -> int:
+        """That point's index in its own input (-1 when none)."""
     @property
     def witness_point(self) -> npt.NDArray[np.float64]: ...
     @property

@@ -82,3 +82,33 @@ TEST_F (MeshInput, VtkPrintsNothing)
     }
   }
 }
+
+// A face's vertex index outside the file is named as the file counts it: OBJ from 1, PLY from 0,
+// and one below zero as negative (the readers hand them over as unsigned 32-bit numbers).
+TEST_F (MeshInput, BadVertexIndicesAreNamedAsTheFileCountsThem)
+{
+  const std::string ply_header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                 "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                                 "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const struct
+  {
+    const char* name;
+    std::string content;
+    const char* message;
+  } cases[] = {
+      {"past.obj", obj + "f 1 2 7\n", "past.obj': face 2 refers to vertex 7 (counting from 1, as OBJ does) but the file has 3 vertices"},
+      {"below.obj", obj + "f 1 2 -9\n", "below.obj': face 2 has a vertex index below 1"},
+      {"past.ply", ply_header + "3 0 1 5\n", "past.ply': face 2 refers to vertex 5 (counting from 0) but the file has 3 vertices"},
+      {"negative.ply", ply_header + "3 0 1 -5\n", "negative.ply': face 2 has a negative vertex index (-5)"},
+  };
+  for (const auto& c : cases)
+  {
+    SCOPED_TRACE (c.name);
+    test_files::writeFile (dir_ / c.name, c.content);
+    TriangleMesh mesh;
+    std::string error;
+    EXPECT_FALSE (pcl_probcollision::io::loadTriangleMesh ((dir_ / c.name).string (), mesh, error));
+    EXPECT_NE (error.find (c.message), std::string::npos) << error;
+  }
+}

@@ -263,7 +263,10 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   });
   if (points.empty ())
   {
-    err << name << " cloud has no finite point (" << n << " given, " << skipped << " non-finite)";
+    // Every finite point was dropped for its covariance (given NaN, a missing value): say so,
+    // rather than blame the positions.
+    err << name << " cloud has no finite point with a finite covariance (" << n << " given, " << n - finite_points
+        << " non-finite, " << skipped - (n - finite_points) << " with a non-finite covariance)";
     throw pcl::BadArgumentException (err.str ());
   }
   // What the points took over is freed before the hierarchy's build, which is the peak of memory
