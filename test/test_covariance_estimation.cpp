@@ -364,6 +364,29 @@ TEST (CovarianceEstimation, SurfaceProjectionDenoisesAFlatPatchAndShrinksItsSpre
   EXPECT_NEAR (xx_after / n, sigma * sigma, 0.3 * sigma * sigma);
 }
 
+// Neighbours on one line fix no plane: a point is not slid along its own surface onto their line.
+// A three-point cloud (each point's two neighbours) and the end of an L of samples, both flat in
+// z = 0, keep every point where it was (the normal was any direction across the line before, and
+// a triangle's corner moved 0.15 of its 1 m side).
+TEST (CovarianceEstimation, SurfaceProjectionDoesNotSlideAPointOntoCollinearNeighbours)
+{
+  Cloud::Ptr triangle (new Cloud);
+  triangle->push_back (pcl::PointXYZ (0.086f, 0.237f, 0.0f));
+  triangle->push_back (pcl::PointXYZ (0.9f, 0.1f, 0.0f));
+  triangle->push_back (pcl::PointXYZ (0.3f, 0.8f, 0.0f));
+  const Projected p = project (triangle, SensorNoiseModel::isotropic (0.01));
+  ASSERT_EQ (p.displacements.size (), 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_LT (p.displacements[i].norm (), 1e-12) << i << ": " << p.displacements[i].transpose ();
+  // A row of ten samples and one beside its end: the lone point's ten neighbours are the row.
+  Cloud::Ptr row (new Cloud);
+  for (int j = 0; j < 10; ++j)
+    row->push_back (pcl::PointXYZ (0.01f * static_cast<float> (j), 0.0f, 0.0f));
+  row->push_back (pcl::PointXYZ (0.0f, 0.01f, 0.0f));
+  const Projected q = project (row, SensorNoiseModel::isotropic (0.002));
+  EXPECT_LT (q.displacements[10].norm (), 1e-12) << q.displacements[10].transpose ();
+}
+
 // Without a sensor model nothing is projected: the output equals the measured model's.
 TEST (CovarianceEstimation, SurfaceProjectionWithoutSensorNoiseChangesNothing)
 {

@@ -396,12 +396,29 @@ CovarianceEstimation<PointInT, PointOutT>::projectOntoSurface (const Eigen::Vect
                                                              Eigen::Vector3d& displacement, Eigen::Matrix3d& psi,
                                                              Eigen::Vector3d& normal, double& shrink)
 {
+  // Neighbours whose scatter's middle eigenvalue is at most this share of the two larger ones'
+  // sum lie on a line, to rounding (exactly collinear samples give 0; a noisy row of samples
+  // about (noise / extent)^2, far above it, and is projected as before).
+  constexpr double kCollinearNeighbours = 1e-9;
   // Scatter of the neighbours (the point itself excluded, so that its own error does not pull
   // the plane) about their weighted centroid; its weakest direction is the local normal.
   const Eigen::Matrix3d scatter = second_moment - mean_offset * mean_offset.transpose ();
+  const Eigen::Matrix3d sym = 0.5 * (scatter + scatter.transpose ());
   Eigen::Vector3d n;
   double lambda;
-  detail::smallestEigenpair (0.5 * (scatter + scatter.transpose ()), lambda, n);
+  detail::smallestEigenpair (sym, lambda, n);
+  // Neighbours on one line (two of them, in a three-point cloud; a straight row of samples) fix
+  // no plane: its normal is then any direction across the line, and the projection would slide
+  // the point along its own surface onto the line (a three-point cloud's witness was reported
+  // 0.15 away from every sample). The middle eigenvalue, from the trace and the sum of the
+  // principal 2 x 2 minors once the smallest is known, says whether they do.
+  const double rest = sym.trace () - lambda;  // the two larger eigenvalues' sum
+  const double minors = sym (0, 0) * sym (1, 1) - sym (0, 1) * sym (0, 1) + sym (0, 0) * sym (2, 2) -
+                        sym (0, 2) * sym (0, 2) + sym (1, 1) * sym (2, 2) - sym (1, 2) * sym (1, 2);
+  const double product = minors - lambda * rest;  // theirs
+  const double middle = 0.5 * (rest - std::sqrt (std::max (0.0, rest * rest - 4.0 * product)));
+  if (!(middle > kCollinearNeighbours * rest))
+    return false;
   lambda = std::max (lambda, 0.0);
   const double s2 = n.dot (sensor_cov * n);
   if (!(s2 > 0.0) || !(k_eff > 1.0))
