@@ -452,6 +452,26 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path):
                        (["--scheduler", "local:1", "-sigma", "0x1p-3"], "not a number")):
         with pytest.raises(cli.Usage, match=words):
             cli.parse(args + bad)
+    # pcd_collision's usage errors, found by parsing alone (before the cluster starts, exit 2): an
+    # input type read from its name, a noise model given to a mesh, this command's own bad values.
+    # A bare address (localhost:8786) is left to the connection.
+    for bad, words in (([str(DATA / "gripper.obj"), str(DATA / "table_mug.xyz"), str(poses), "--scheduler", "local"],
+                        "unsupported file type"),
+                       (args + ["--scheduler", "local", "-sigma_a", "0.01"], r"option -sigma_a: <a> '.*gripper\.obj' is a mesh"),
+                       (args + ["--scheduler", "local", "-sensor_a", "kinect"], "option -sensor_a: <a>"),
+                       (args + ["--scheduler", "local:0"], "local:N needs a whole number N >= 1"),
+                       (args + ["--scheduler", "local:x"], "local:N needs a whole number"),
+                       (args + ["--scheduler", "local", "--chunk-size", "0"], "option --chunk-size: must be >= 1"),
+                       (args + ["--scheduler", "local", "--scheduler", "local"], "option --scheduler given twice"),
+                       (args + ["--scheduler", "local", "-o", "x.pcd"], "per-point results stay on the workers")):
+        with pytest.raises(cli.Usage, match=words):
+            cli.parse(bad)
+    assert cli.parse(args + ["--scheduler", "localhost:8786"])[2]["scheduler"] == "localhost:8786"
+    assert cli._as_flag_message("[pcl_probcollision::BVHParams::validate] epsilon 0.7 outside [0, 0.5)") == \
+        "option -epsilon: 0.7 outside [0, 0.5)"
+    assert cli._as_flag_message("option threads: must be >= 0") == "option -threads: must be >= 0"
+    with pytest.raises(SystemExit):  # -h wins over an unknown option, as in pcd_collision
+        cli.parse(["-sigm", "-h"])
     with pytest.raises(ValueError, match="threads"):
         pcd.resolve_options({"threads": pc._core.MAX_THREADS + 1})
     # Both command lines refuse the same malformed values as usage errors (exit 2), before any work.

@@ -218,6 +218,8 @@ def prepare_input(x, name: Optional[str] = None, normals: bool = False) -> Dict[
         return x
     if isinstance(x, (str, os.PathLike)):
         path = os.fspath(x)
+        if os.path.isdir(path):
+            raise IsADirectoryError(21, "Is a directory", path)
         if not os.path.isfile(path):
             raise FileNotFoundError(2, "No such file", path)
         low = path.lower()

@@ -32,6 +32,10 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   -epsilon -split -mesh_density -json (accepted; the output is always JSON lines) -v. A value is
   the next argument or follows '='. -surface (experimental) adds the signed distance between the
   surfaces.
+
+Exit status, as pcd_collision's: 0 every pose answered, 1 a runtime failure (an unreadable input,
+a malformed poses file, a failed query), 2 a usage error (a bad option or value, an unsupported
+input type), found before the scheduler is reached.
 """
 
 _VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
@@ -47,6 +51,39 @@ _FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")  # A
 _INT = re.compile(r"[+-]?[0-9]+\Z")
 
 
+_MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtk")
+
+
+def _faceless_ply(path):
+    """A .ply without faces is a cloud (pcd_collision reads the header; a missing file is left to
+    the loading, which names it)."""
+    try:
+        return core.is_faceless_ply(path)
+    except (OSError, ValueError, RuntimeError):
+        return False
+
+
+def _non_finite_word(text):
+    """nan, inf, infinity with a sign or not: numbers to float(), but not finite ones."""
+    try:
+        return not math.isfinite(float(text))
+    except ValueError:
+        return False
+
+
+def _as_flag_message(message):
+    """The library's and collide_poses' messages in this command line's words: no C++ scope
+    ("[pcl_probcollision::BVHParams::validate] "), and an option named with its dash."""
+    message = re.sub(r"^\[[^\]]*\] ", "", message)
+    match = re.match(r"option (?!-)(\w+)", message)
+    if match:
+        return "option " + _flag(match.group(1)) + message[match.end():]
+    match = re.match(r"(\w+) ", message)  # "epsilon 0.7 outside [0, 0.5)"
+    if match and match.group(1) in _VALUE:
+        return "option " + _flag(match.group(1)) + ": " + message[match.end():]
+    return message
+
+
 class Usage(Exception):
     pass
 
@@ -55,17 +92,22 @@ class Failure(Exception):
     pass
 
 
+def _flag(name):
+    """A flag as written on this command line: pcd_collision's with one dash, its own with two."""
+    return ("--" if name in _OWN else "-") + name
+
+
 def _number(flag, text, kind):
     if kind is float:
         if not _FLOAT.match(text):
-            raise Usage(f"option -{flag}: '{text}' is not a number")
+            raise Usage(f"option {_flag(flag)}: '{text}' is not a number")
         return float(text)
     if kind is int or kind == "u64":
         if not _INT.match(text):
-            raise Usage(f"option -{flag}: '{text}' is not an integer")
+            raise Usage(f"option {_flag(flag)}: '{text}' is not an integer")
         v = int(text)
         if kind == "u64" and not 0 <= v < 2 ** 64:
-            raise Usage(f"option -{flag}: '{text}' is out of range")
+            raise Usage(f"option {_flag(flag)}: '{text}' is out of range")
         return v
     if kind == "pair":
         parts = text.split(",")
@@ -81,6 +123,9 @@ def _number(flag, text, kind):
 def parse(argv):
     """(positional, options for collide_poses, own options) or Usage."""
     positional, options, own, seen = [], {}, {"scheduler": None, "timeout": 10.0, "chunk-size": None}, set()
+    # -h wins over every other argument, as in pcd_collision (an unknown option beside it too).
+    if any(a in ("-h", "-help", "--help") for a in argv[:argv.index("--") if "--" in argv else len(argv)]):
+        raise SystemExit(print(USAGE, end="") or 0)
     i, only_positional = 0, False
     while i < len(argv):
         arg = argv[i]
@@ -94,18 +139,21 @@ def parse(argv):
         if arg in ("-h", "-help", "--help"):
             raise SystemExit(print(USAGE, end="") or 0)
         name, eq, value = arg.lstrip("-").partition("=")
-        if name in ("pose", "poses", "o"):
+        if name in ("pose", "poses"):
             raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
+        if name == "o":
+            raise Usage("option -o is not supported here: the per-point results stay on the workers (use "
+                        "pcd_collision -pose ... -o FILE for one pose)")
         dashes = len(arg) - len(arg.lstrip("-"))
         # pcd_collision's options take one dash, as there; this command's own take two.
         if dashes != (2 if name in _OWN else 1):
             raise Usage(f"unknown option '{arg.partition('=')[0]}'")
         if name in seen:
-            raise Usage(f"option -{name} given twice")
+            raise Usage(f"option {_flag(name)} given twice")
         seen.add(name)
         if name in _SWITCH:
             if eq:
-                raise Usage(f"option -{name} takes no value")
+                raise Usage(f"option {_flag(name)} takes no value")
             if name not in ("json", "v"):
                 options[name] = True
             continue
@@ -114,7 +162,7 @@ def parse(argv):
             raise Usage(f"unknown option '{arg}'")
         if not eq:
             if i >= len(argv):
-                raise Usage(f"option -{name} needs a value")
+                raise Usage(f"option {_flag(name)} needs a value")
             value = argv[i]
             i += 1
         v = _number(name, value, kind)
@@ -124,8 +172,27 @@ def parse(argv):
             options[name] = v
     if len(positional) != 3:
         raise Usage(f"expected <a> <b> <poses.txt>, got {len(positional)} argument(s)")
+    # pcd_collision's rules on the inputs' types, read from their names as there.
+    for side, path in zip("ab", positional[:2]):
+        low = path.lower()
+        if not low.endswith((".pcd",) + _MESH_SUFFIXES):
+            raise Usage(f"input '{path}': unsupported file type (expected .pcd, .ply, .obj, .stl or .vtk)")
+        mesh = low.endswith(_MESH_SUFFIXES) and not (low.endswith(".ply") and _faceless_ply(path))
+        for flag in ("sigma_" + side, "sensor_" + side):
+            if mesh and flag in options:
+                raise Usage(f"option -{flag}: <{side}> '{path}' is a mesh, sampled exactly with no sensor noise; "
+                            f"the option applies to a cloud")
     if own["scheduler"] is None:
         raise Usage("--scheduler ADDRESS|local[:N] is required")
+    scheduler = own["scheduler"]  # an address (tcp://host:8786, localhost:8786) is checked by connecting
+    if scheduler.startswith("local:"):
+        count = scheduler[len("local:"):]
+        if not (_INT.match(count) and int(count) >= 1):
+            raise Usage(f"option --scheduler: local:N needs a whole number N >= 1, got '{scheduler}'")
+    if own["chunk-size"] is not None and own["chunk-size"] < 1:
+        raise Usage(f"option --chunk-size: must be >= 1, got {own['chunk-size']}")
+    if not own["timeout"] > 0:
+        raise Usage(f"option --timeout: must be > 0, got {own['timeout']}")
     if "k" in options and options["k"] < 1:
         raise Usage(f"option -k: must be >= 1, got {options['k']}")
     for flag in ("sigma", "sigma_a", "sigma_b", "sigma_max"):
@@ -174,7 +241,7 @@ def read_poses(path):
         if why is None and tokens:
             bad = [t for t in tokens if not _FLOAT.match(t)]
             if bad:
-                why = f"'{bad[0]}' is not a number"
+                why = f"'{bad[0]}' is not {'a finite number' if _non_finite_word(bad[0]) else 'a number'}"
             else:
                 huge = [t for t in tokens if not math.isfinite(float(t))]  # 1e999 matches _FLOAT
                 if huge:
@@ -292,13 +359,15 @@ def main(argv):
         try:  # option values pcd_collision refuses are usage errors (exit 2), found before any work
             resolve_options(options)
         except (TypeError, ValueError) as e:
-            raise Usage(str(e)) from None
+            raise Usage(_as_flag_message(str(e))) from None
         pose_rows = read_poses(poses_path)  # a malformed file fails before the (slow) loading
         try:
             # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
             stored = bool(options.get("surface") or options.get("surface_pooled") or options.get("surface_ladder")) and not options.get("ignore_normals")
             a = prepare_input(path_a, "a", stored)
             b = prepare_input(path_b, "b", stored)
+        except IsADirectoryError as e:
+            raise Failure(f"cannot read '{e.filename}': is a directory") from None
         except FileNotFoundError as e:
             raise Failure(f"cannot read '{e.filename}': No such file or directory") from None
         except ValueError as e:
