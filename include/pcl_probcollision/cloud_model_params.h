@@ -64,6 +64,9 @@ orientationName (NormalOrientation orientation)
 constexpr NormalOrientation kNormalOrientations[] = {NormalOrientation::Auto, NormalOrientation::PointNormals,
                                                      NormalOrientation::Viewpoint, NormalOrientation::Propagate};
 
+/** \brief How one cloud is modelled: its covariance estimation, sensor noise, hierarchy and
+  * (optionally) surface model, with their documented defaults (README, "Choosing a setting").
+  * validate() throws pcl::BadArgumentException naming the first member out of range. */
 struct CloudModelParams
 {
   /** \brief Neighbours of the covariance estimation (Pauly et al.), >= 1. Default 10. */

@@ -126,7 +126,10 @@ struct CollisionRequest
   /** \brief The separator fitted at each leaf pair (ClassifierParams' defaults). */
   ClassifierParams classifier;
 
+  /** \brief Throws pcl::BadArgumentException naming the first member out of range (the
+    * classifier's included). */
   void validate () const;
+  /** \brief Every member equal (the classifier's parameters included). */
   bool operator== (const CollisionRequest& o) const;
   bool operator!= (const CollisionRequest& o) const { return !(*this == o); }
 };

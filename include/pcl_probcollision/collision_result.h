@@ -38,6 +38,7 @@ const char* answeredByName (AnsweredBy answered_by);
 /** \brief Outcome of a query. Anything not computed is NaN (numbers) or Unknown. */
 struct CollisionResult
 {
+  /** \brief Whether the query answered; otherwise message says why. */
   enum class Status
   {
     Ok,
@@ -92,7 +93,10 @@ struct CollisionResult
     * left unfitted: P (and lower_bound) is the largest over the pairs fitted, nearest first; the
     * pairs left could only raise it. */
   bool budget_exhausted = false;
-  /** \brief True when no leaf pair was reached: the boxes never came near (P = 0). */
+  /** \brief True when no leaf pair was tested (P = 0): every pair of boxes the traversal met was
+    * disjoint, and its reach weight (METHOD.md 6.3) fell under CollisionRequest::rho_min (in
+    * Stochastic mode: its draw failed). The objects may still lie within a few noise deviations
+    * of each other: boxes of projected points are tight across their surface. */
   bool no_leaf_tested = false;
   /** \brief True when the answer rests on surface the samples do not show (the surface layer
     * only; docs/SURFACE.md): the deciding point lies over a hole in the other cloud's samples
@@ -150,6 +154,7 @@ struct CollisionResult
   std::vector<float> probabilities_a;
   std::vector<float> probabilities_b;
 
+  /** \brief True when the query answered (status Ok). */
   bool ok () const { return status == Status::Ok; }
 };
 } // namespace pcl_probcollision

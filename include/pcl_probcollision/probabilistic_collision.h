@@ -59,6 +59,8 @@ public:
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
   using CovarianceCloudConstPtr = pcl::PointCloud<Covariance>::ConstPtr;
 
+  /** \brief No clouds yet; both models' parameters and the request are their defaults
+    * (CloudModelParams, CollisionRequest). Each getter below returns what its setter set. */
   ProbabilisticCollision ();
 
   /** \brief Object A; marks its model for rebuild (even for the same pointer). */

@@ -88,8 +88,13 @@ public:
   /** \brief The same covariance for every point; must be symmetric positive semi-definite
     * and finite (throws otherwise). */
   static SensorNoiseModel anisotropic (const Eigen::Matrix3d& covariance);
+  /** \brief A Kinect v1's depth noise (KinectParams), growing with depth and the surface's tilt
+    * to the line of sight; needs the sensor pose and the surface normal. */
   static SensorNoiseModel kinect (const KinectParams& params = KinectParams ());
+  /** \brief A stereo camera's depth noise (StereoParams), growing with depth squared along the
+    * line of sight; needs the sensor pose. */
   static SensorNoiseModel stereo (const StereoParams& params = StereoParams ());
+  /** \brief A lidar's range and angular noise (LidarParams); needs the sensor pose. */
   static SensorNoiseModel lidar (const LidarParams& params = LidarParams ());
   /** \brief The sigma fromName() gives "isotropic" when none is given (data units). */
   static constexpr double kDefaultIsotropicSigma = 0.005;
@@ -97,7 +102,9 @@ public:
     * (isotropic uses sigma); throws pcl::BadArgumentException naming the value otherwise. */
   static SensorNoiseModel fromName (const std::string& name, double sigma = kDefaultIsotropicSigma);
 
+  /** \brief Which model this is. */
   Type type () const { return type_; }
+  /** \brief Its name as fromName() reads it ("none", "isotropic", "kinect", ...). */
   const char* name () const;
   /** \brief True when the model depends on the sensor pose (the depth models). */
   bool usesSensorPose () const;
