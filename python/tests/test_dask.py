@@ -100,6 +100,10 @@ def test_options_are_pcd_collision_flags():
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sigm=0.01)
     with pytest.raises(ValueError, match="isotropic"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor="kinect", sigma=0.01)
+    with pytest.raises(ValueError, match=r"^option sensor_b: unknown sensor model 'sonar'"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor_b="sonar")
+    with pytest.raises(ValueError, match=r"^option sensor: unknown sensor model 'sonar'"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor="sonar")
     with pytest.raises(ValueError, match=r"\(M, 4, 4\) or \(M, 6\)"):
         pcd.collide_poses(patch(), patch(), np.zeros((3, 5)))
     with pytest.raises(ValueError, match="last row"):

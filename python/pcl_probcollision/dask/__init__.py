@@ -143,7 +143,11 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
     o["sensor_b"] = o["sensor_b"] or o["sensor"]
     for side in "ab":
-        core.SensorNoiseModel.from_name(o["sensor_" + side])  # ValueError naming a bad model
+        try:
+            core.SensorNoiseModel.from_name(o["sensor_" + side])
+        except ValueError as e:  # named by the option that gave it, without the C++ scope
+            flag = "sensor_" + side if options.get("sensor_" + side) is not None else "sensor"
+            raise ValueError(f"option {flag}: {str(e).split('] ', 1)[-1]}") from None
     iso = "isotropic"
     if o["sigma"] is not None and (o["sensor_a"] != iso or o["sensor_b"] != iso):
         raise ValueError(f"option sigma needs the isotropic model for both inputs (got {o['sensor_a']} for <a>, "
