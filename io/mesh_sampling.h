@@ -38,6 +38,16 @@ pcl::PointCloud<pcl::PointNormal> sampleMeshWithNormals (const TriangleMesh& mes
 /** \brief Total triangle area. */
 double meshArea (const TriangleMesh& mesh);
 
+/** \brief Two meshes' sample spacing: 1/100 of the smaller bounding-box diagonal, so that the
+  * smaller object (the robot, the part) is resolved whatever the scene around it; widened to
+  * the spacing at which both meshes together expect kMeshPairSamples samples when it would
+  * exceed that (a gripper against a room). 0 when both have no area. */
+double meshPairSpacing (const TriangleMesh& a, const TriangleMesh& b);
+/** \brief meshPairSpacing's share of the smaller diagonal. */
+constexpr double kMeshPairFraction = 0.01;
+/** \brief meshPairSpacing's bound on the two meshes' expected samples together. */
+constexpr double kMeshPairSamples = 500000.0;
+
 /** \brief Diagonal of the axis-aligned bounding box of the vertices used by triangles. */
 double meshDiagonal (const TriangleMesh& mesh);
 

@@ -1226,6 +1226,14 @@ PYBIND11_MODULE (_core, m)
          "sample_mesh()'s points (the same ones) with outward unit normals, float32 (N, 3) each: a sample's is its\n"
          "triangle's, a vertex's the area-weighted mean of its triangles' (faces wound counter-clockwise seen from\n"
          "outside). pcd_collision's mesh input with -surface: build_model(points, zeros, params, normals=normals).");
+  m.def ("mesh_pair_spacing",
+         [] (const py::object& vertices_a, const py::object& triangles_a, const py::object& vertices_b,
+             const py::object& triangles_b) {
+           return pcl_probcollision::io::meshPairSpacing (meshOf (vertices_a, triangles_a), meshOf (vertices_b, triangles_b));
+         },
+         py::arg ("vertices_a"), py::arg ("triangles_a"), py::arg ("vertices_b"), py::arg ("triangles_b"),
+         "pcd_collision's sample spacing when both inputs are meshes: 1/100 of the smaller bounding-box diagonal,\n"
+         "or wider so that both together expect 500,000 samples.");
   m.def ("mesh_diagonal",
          [] (const py::object& vertices, const py::object& triangles) {
            return pcl_probcollision::io::meshDiagonal (meshOf (vertices, triangles));

@@ -681,9 +681,8 @@ helpText ()
     << D::split
     << "\n"
        "  -mesh_density S = median nearest-neighbour spacing of the other cloud\n"
-       "                  (both meshes: "
-    << fmt (D::mesh_spacing_fraction)
-    << " x the larger bounding-box diagonal); mesh sample spacing,\n"
+       "                  (both meshes: 1/100 of the smaller bounding-box diagonal, or wider\n"
+       "                  for 500000 samples); mesh sample spacing,\n"
        "                  data units: samples uniform by area (fixed seed) plus every vertex\n"
        "\n"
        "Output:\n"

@@ -58,9 +58,6 @@ struct Defaults
   static inline const double epsilon = model.hierarchy.epsilon;
   static inline const char* const split =
       model.hierarchy.split_style == pcl_probcollision::BVHParams::SplitStyle::Octree ? "octree" : "pca";
-  /** \brief Mesh spacing when both inputs are meshes: this fraction of the larger bounding-box
-    * diagonal. */
-  static constexpr double mesh_spacing_fraction = 0.01;
   /** \brief -threads: one worker per hardware thread (CloudModelParams's and collideBatch's 0). */
   static inline const int threads = model.threads;
   /** \brief Seed of the mesh surface sampling (fixed; -seed does not change it). */

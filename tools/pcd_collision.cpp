@@ -48,6 +48,7 @@ using pcl_probcollision::io::loadCloud;
 using pcl_probcollision::io::loadCloudWithNormals;
 using pcl_probcollision::io::loadTriangleMesh;
 using pcl_probcollision::io::meshDiagonal;
+using pcl_probcollision::io::meshPairSpacing;
 using pcl_probcollision::io::medianSpacing;
 using pcl_probcollision::io::sampleMesh;
 using pcl_probcollision::io::sampleMeshWithNormals;
@@ -835,8 +836,8 @@ run (int argc, char** argv)
       sampleInput (*m, spacing, "median nearest-neighbour spacing of '" + other.path + "'", log);
     }
     else
-      sampleInput (*m, Defaults::mesh_spacing_fraction * std::max (meshDiagonal (a.mesh), meshDiagonal (b.mesh)),
-                   "both inputs are meshes: 1/100 of the larger bounding-box diagonal", log);
+      sampleInput (*m, meshPairSpacing (a.mesh, b.mesh),
+                   "both inputs are meshes: 1/100 of the smaller bounding-box diagonal, or wider for 500000 samples", log);
   }
 
   pcl_probcollision::ProbabilisticCollision<pcl::PointXYZ> pc;
@@ -934,7 +935,7 @@ run (int argc, char** argv)
   };
   // Two meshes are sampled exactly (zero covariance), so nothing models the surface between
   // their samples: a thin part through a thin wall can pass between the samples of both and read
-  // free (FCL's piano legs, 40 mm across, through its 9 mm floor at the default 90 mm spacing).
+  // free (FCL's piano legs, 40 mm across, through its 9 mm floor at a 90 mm spacing).
   // A free answer whose samples came within reach of each other (leaf pairs were fitted) says
   // so, once a run.
   const bool both_meshes = a.kind == InputKind::Mesh && b.kind == InputKind::Mesh;

@@ -917,24 +917,27 @@ TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
 
 // Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass
 // between the samples. FCL's piano (legs 40 mm across, through the 9 mm floor at the identity)
-// reads free at the default spacing, 90 mm, and the tool says why it may be wrong.
+// reads free at 90 mm (1/100 of the room's diagonal, the default before), and the tool says why
+// it may be wrong; at the default, 1/100 of the piano's diagonal widened to 20.4 mm for 500,000
+// samples, it reads collision.
 TEST_F (PcdCollisionTool, TwoMeshesWarnWhereAFreeAnswerCameWithinReach)
 {
   const std::string shared = PCL_PROBCOLLISION_SHARED_DATA;
   const std::string piano = shared + "/meshes/piano_room_rob.obj", room = shared + "/meshes/piano_room_env.obj";
-  const ToolRun through = run ({piano, room});
+  const ToolRun through = run ({piano, room, "-mesh_density", "90"});
   ASSERT_EQ (through.status, 0) << through.err;
   EXPECT_NE (through.out.find ("free"), std::string::npos) << through.out;  // the miss this warns of
-  EXPECT_NE (through.err.find ("pcd_collision: warning: the pose reads free, but both inputs are meshes sampled 90.01"),
+  EXPECT_NE (through.err.find ("pcd_collision: warning: the pose reads free, but both inputs are meshes sampled 90 apart"),
              std::string::npos) << through.err;
   EXPECT_NE (through.err.find ("-mesh_density"), std::string::npos) << through.err;
-  // Sampled finely enough, the legs cross the floor's samples: collision, nothing to warn of.
-  const ToolRun fine = run ({piano, room, "-mesh_density", "45"});
+  // At the default spacing the legs cross the floor's samples: collision, nothing to warn of.
+  const ToolRun fine = run ({piano, room});
   ASSERT_EQ (fine.status, 0) << fine.err;
   EXPECT_NE (fine.out.find ("collision"), std::string::npos) << fine.out;
+  EXPECT_NE (fine.err.find ("at spacing 20.36"), std::string::npos) << fine.err;
   EXPECT_EQ (fine.err.find ("warning"), std::string::npos) << fine.err;
   // Far apart: free without a leaf pair, no warning.
-  const ToolRun far = run ({piano, room, "-pose", "0,0,30000,0,0,0"});
+  const ToolRun far = run ({piano, room, "-pose", "0,0,30000,0,0,0", "-mesh_density", "90"});
   ASSERT_EQ (far.status, 0) << far.err;
   EXPECT_NE (far.out.find ("free"), std::string::npos) << far.out;
   EXPECT_EQ (far.err.find ("warning"), std::string::npos) << far.err;
@@ -1128,10 +1131,12 @@ TEST_F (PcdCollisionTool, MeshFormatsAndDensity)
   EXPECT_EQ (d3[0]["inputs"]["a"]["spacing"].number, d1[0]["inputs"]["a"]["spacing"].number);
   EXPECT_EQ (d3[0]["points_a"].number, d1[0]["points_a"].number);
   EXPECT_EQ (d3[0]["probability"].text, d1[0]["probability"].text);
-  // Two meshes: 1/100 of the larger bounding-box diagonal.
+  // Two meshes: 1/100 of the smaller bounding-box diagonal (the quad's, 0.141 against the
+  // gripper's 0.147), both together far under 500,000 expected samples.
   const auto mm = runJson ({kGripper.string (), (dir_ / "quad.ply").string (), "-pose", "0,0,0.5,0,0,0"});
   ASSERT_EQ (mm.size (), 1u);
-  EXPECT_NEAR (mm[0]["inputs"]["a"]["spacing"].number, 0.01 * std::sqrt (0.12 * 0.12 + 0.03 * 0.03 + 0.08 * 0.08), 1e-6);
+  EXPECT_NEAR (mm[0]["inputs"]["a"]["spacing"].number, 0.01 * std::sqrt (0.1 * 0.1 + 0.1 * 0.1), 1e-6);
+  EXPECT_EQ (mm[0]["inputs"]["b"]["spacing"].number, mm[0]["inputs"]["a"]["spacing"].number);
 }
 
 // A normal run prints its stage lines on stderr and nothing else: no VTK or PCL warning.

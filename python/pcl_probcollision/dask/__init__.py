@@ -273,9 +273,8 @@ def _sample_meshes(a: Dict[str, Any], b: Dict[str, Any], o: Dict[str, Any]) -> N
             spacing = core.median_spacing(other["points"])
             source = f"median nearest-neighbour spacing of '{other['path'] or other['name']}'"
         else:
-            spacing = 0.01 * max(core.mesh_diagonal(a["vertices"], a["triangles"]),
-                                 core.mesh_diagonal(b["vertices"], b["triangles"]))
-            source = "both inputs are meshes: 1/100 of the larger bounding-box diagonal"
+            spacing = core.mesh_pair_spacing(a["vertices"], a["triangles"], b["vertices"], b["triangles"])
+            source = "both inputs are meshes: 1/100 of the smaller bounding-box diagonal, or wider for 500000 samples"
         if not (spacing > 0.0 and math.isfinite(spacing)):
             raise ValueError(f"cannot choose a sample spacing for mesh '{m['path']}' ({source} is 0); give -mesh_density")
         if o["surface"]:
