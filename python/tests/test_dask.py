@@ -2,6 +2,7 @@
 """pcl_probcollision.dask: the same answers as one process and as pcd_collision (issue #18)."""
 import json
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -441,7 +442,7 @@ def test_cli_errors_match_pcd_collision(tmp_path):
             assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1]
 
 
-def test_cli_reads_options_as_pcd_collision_does(tmp_path):
+def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
     """One dash for pcd_collision's options and two for this command's own (found in review: any
     number of dashes was taken, `--sigma` too), decimal numbers only in both (pcd_collision took
     hex floats), and pcd_collision's -threads, checked against the library's cap."""
@@ -461,8 +462,6 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path):
     # A bare address (localhost:8786) is left to the connection.
     for bad, words in (([str(DATA / "gripper.obj"), str(DATA / "table_mug.xyz"), str(poses), "--scheduler", "local"],
                         "unsupported file type"),
-                       (args + ["--scheduler", "local", "-sigma_a", "0.01"], r"option -sigma_a: <a> '.*gripper\.obj' is a mesh"),
-                       (args + ["--scheduler", "local", "-sensor_a", "kinect"], "option -sensor_a: <a>"),
                        (args + ["--scheduler", "local:0"], "local:N needs a whole number N >= 1"),
                        (args + ["--scheduler", "local:x"], "local:N needs a whole number"),
                        (args + ["--scheduler", "local", "--chunk-size", "0"], "option --chunk-size: must be >= 1"),
@@ -470,6 +469,12 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path):
                        (args + ["--scheduler", "local", "-o", "x.pcd"], "per-point results stay on the workers")):
         with pytest.raises(cli.Usage, match=words):
             cli.parse(bad)
+    # A noise model given to a mesh: found once the inputs are read, still before the scheduler.
+    for flag, value, words in (("-sigma_a", "0.01", r"option -sigma_a: <a> '.*gripper\.obj' is a mesh"),
+                               ("-sensor_a", "kinect", "option -sensor_a: <a>")):
+        assert cli.main(args + ["--scheduler", "local", flag, value]) == 2
+        err = capsys.readouterr().err
+        assert re.search(words, err) and "Scheduler" not in err, err
     assert cli.parse(args + ["--scheduler", "localhost:8786"])[2]["scheduler"] == "localhost:8786"
     assert cli._as_flag_message("[pcl_probcollision::BVHParams::validate] epsilon 0.7 outside [0, 0.5)") == \
         "option -epsilon: 0.7 outside [0, 0.5)"

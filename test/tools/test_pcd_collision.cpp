@@ -1137,6 +1137,8 @@ TEST_F (PcdCollisionTool, MeshFormatsAndDensity)
   ASSERT_EQ (mm.size (), 1u);
   EXPECT_NEAR (mm[0]["inputs"]["a"]["spacing"].number, 0.01 * std::sqrt (0.1 * 0.1 + 0.1 * 0.1), 1e-6);
   EXPECT_EQ (mm[0]["inputs"]["b"]["spacing"].number, mm[0]["inputs"]["a"]["spacing"].number);
+  // Both models are built by the tool from the samples: their build counts (it read 0 before).
+  EXPECT_GT (mm[0]["build_ms"].number, 0.0);
 }
 
 // A normal run prints its stage lines on stderr and nothing else: no VTK or PCL warning.

@@ -259,6 +259,16 @@ def prepare_input(x, name: Optional[str] = None, normals: bool = False) -> Dict[
     raise TypeError(f"expected a file path, an (N, 3) numpy array or an Open3D PointCloud, got {type(x).__name__}")
 
 
+def check_mesh_noise(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, Any]) -> None:
+    """pcd_collision's rule: a mesh is sampled exactly, so a noise model or sigma given to it alone
+    would be ignored (sensor and sigma, for both inputs, apply to the clouds among them): ValueError."""
+    for side, spec in (("a", a), ("b", b)):
+        for flag in ("sigma_" + side, "sensor_" + side):
+            if spec["kind"] == "mesh" and options.get(flag) is not None:
+                raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
+                                 f"with no sensor noise; the option applies to a cloud")
+
+
 def _sample_meshes(a: Dict[str, Any], b: Dict[str, Any], o: Dict[str, Any]) -> None:
     """pcd_collision's MeshSampled mode: spacing from mesh_density, the other cloud, or the meshes'
     size; the samples become the input's points (exact: zero covariance). With surface, the
@@ -534,13 +544,7 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
     T = as_pose_matrices(poses)
     stored = o["surface"] and not o["ignore_normals"]
     A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
-    # pcd_collision's rule: a mesh is sampled exactly, so a noise model or sigma given to it alone
-    # would be ignored (sensor and sigma, for both inputs, apply to the clouds among them).
-    for side, spec in (("a", A), ("b", B)):
-        for flag in ("sigma_" + side, "sensor_" + side):
-            if spec["kind"] == "mesh" and options.get(flag) is not None:
-                raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
-                                 f"with no sensor noise; the option applies to a cloud")
+    check_mesh_noise(A, B, options)
     _sample_meshes(A, B, o)
     sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)

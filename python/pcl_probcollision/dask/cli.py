@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from .. import _core as core
-from . import collide_poses, connect, prepare_input, resolve_options
+from . import _MESH_EXTENSIONS, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
@@ -49,18 +49,6 @@ _SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kerne
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
 _FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")  # ASCII digits, as pcd_collision
 _INT = re.compile(r"[+-]?[0-9]+\Z")
-
-
-_MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtk")
-
-
-def _faceless_ply(path):
-    """A .ply without faces is a cloud (pcd_collision reads the header; a missing file is left to
-    the loading, which names it)."""
-    try:
-        return core.is_faceless_ply(path)
-    except (OSError, ValueError, RuntimeError):
-        return False
 
 
 def _non_finite_word(text):
@@ -136,8 +124,6 @@ def parse(argv):
         if arg == "--":
             only_positional = True
             continue
-        if arg in ("-h", "-help", "--help"):
-            raise SystemExit(print(USAGE, end="") or 0)
         name, eq, value = arg.lstrip("-").partition("=")
         if name in ("pose", "poses"):
             raise Usage(f"option -{name} is not supported here: the poses file is the third argument")
@@ -172,16 +158,10 @@ def parse(argv):
             options[name] = v
     if len(positional) != 3:
         raise Usage(f"expected <a> <b> <poses.txt>, got {len(positional)} argument(s)")
-    # pcd_collision's rules on the inputs' types, read from their names as there.
-    for side, path in zip("ab", positional[:2]):
-        low = path.lower()
-        if not low.endswith((".pcd",) + _MESH_SUFFIXES):
+    # pcd_collision's rule on the inputs' types, read from their names as there.
+    for path in positional[:2]:
+        if not path.lower().endswith((".pcd",) + _MESH_EXTENSIONS):
             raise Usage(f"input '{path}': unsupported file type (expected .pcd, .ply, .obj, .stl or .vtk)")
-        mesh = low.endswith(_MESH_SUFFIXES) and not (low.endswith(".ply") and _faceless_ply(path))
-        for flag in ("sigma_" + side, "sensor_" + side):
-            if mesh and flag in options:
-                raise Usage(f"option -{flag}: <{side}> '{path}' is a mesh, sampled exactly with no sensor noise; "
-                            f"the option applies to a cloud")
     if own["scheduler"] is None:
         raise Usage("--scheduler ADDRESS|local[:N] is required")
     scheduler = own["scheduler"]  # an address (tcp://host:8786, localhost:8786) is checked by connecting
@@ -366,6 +346,10 @@ def main(argv):
             stored = bool(options.get("surface") or options.get("surface_pooled") or options.get("surface_ladder")) and not options.get("ignore_normals")
             a = prepare_input(path_a, "a", stored)
             b = prepare_input(path_b, "b", stored)
+            try:  # a noise model given to a mesh: a usage error, still before the scheduler
+                check_mesh_noise(a, b, options)
+            except ValueError as e:
+                raise Usage(_as_flag_message(str(e))) from None
         except IsADirectoryError as e:
             raise Failure(f"cannot read '{e.filename}': is a directory") from None
         except FileNotFoundError as e:
