@@ -136,7 +136,7 @@ CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
   {
     std::ostringstream out;
     out.precision (3);
-    out << name << " cloud: coordinates up to " << max_abs_coordinate << " have a float spacing of " << spacing
+    out << name << ": coordinates up to " << max_abs_coordinate << " have a float spacing of " << spacing
         << ", more than a tenth of the points' typical standard deviation " << sigma
         << ": the input lost precision before the library saw it (store the cloud about a local origin)";
     warning_ = out.str ();

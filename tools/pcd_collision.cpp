@@ -470,8 +470,12 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bo
   // not the deepest: say so, as "P >=" says it of P.
   char distance[128] = "";
   if (std::isfinite (r.signed_distance))
-    std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", r.signed_distance, r.signed_distance_std,
+  {
+    // Under the printed precision the sign is noise: "+0.0000", never "-0.0000" (JSON keeps the value).
+    const double d = std::abs (r.signed_distance) < 5e-5 ? 0.0 : r.signed_distance;
+    std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", d, r.signed_distance_std,
                    r.lower_bound ? " (first deciding point)" : r.sample_distance ? " (nearest samples)" : "");
+  }
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
   const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";

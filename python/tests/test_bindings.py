@@ -644,8 +644,8 @@ GOOD = patch(5)
     (GOOD.astype(">f8"), None, TypeError, "points"),                        # foreign byte order
     (GOOD[:, :2], None, ValueError, "points"),                              # (N, 2)
     (GOOD.ravel(), None, ValueError, "points"),                             # 1-D
-    (np.zeros((0, 3)), None, ValueError, "no finite point"),                # empty
-    (np.full((4, 3), np.nan), None, ValueError, "no finite point"),         # all NaN
+    (np.zeros((0, 3)), None, ValueError, "^cloud has no finite point"),     # empty
+    (np.full((4, 3), np.nan), None, ValueError, "^cloud has no finite point"),  # all NaN
     (GOOD, np.full((len(GOOD), 3, 3), np.nan), ValueError,                  # all covariances missing
      r"with a finite covariance \(\d+ given, 0 non-finite, \d+ with a non-finite covariance\)"),
     (np.array([[1e300, 0, 0]] + [[0, 0, 0]] * 3), None, ValueError, "float range"),

@@ -76,7 +76,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   // empty!" on stderr for an empty cloud.
   if (finite_points == 0)
   {
-    err << name << " cloud has no finite point (" << n << " given, " << n << " non-finite)";
+    err << name << " has no finite point (" << n << " given, " << n << " non-finite)";
     throw pcl::BadArgumentException (err.str ());
   }
 
@@ -265,7 +265,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   {
     // Every finite point was dropped for its covariance (given NaN, a missing value): say so,
     // rather than blame the positions.
-    err << name << " cloud has no finite point with a finite covariance (" << n << " given, " << n - finite_points
+    err << name << " has no finite point with a finite covariance (" << n << " given, " << n - finite_points
         << " non-finite, " << skipped - (n - finite_points) << " with a non-finite covariance)";
     throw pcl::BadArgumentException (err.str ());
   }
