@@ -24,9 +24,6 @@ namespace pcl_probcollision
 {
 namespace io
 {
-namespace
-{
-/** \brief One field value as double, whatever its PCD type. */
 double
 readField (const std::uint8_t* p, std::uint8_t datatype)
 {
@@ -44,6 +41,8 @@ readField (const std::uint8_t* p, std::uint8_t datatype)
   }
 }
 
+namespace
+{
 std::size_t
 fieldSize (std::uint8_t datatype)
 {

@@ -9,6 +9,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <cstdint>
 #include <string>
 
 namespace pcl_probcollision
@@ -31,6 +32,10 @@ bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, 
   * missing field when only some of the three are there (e.g. normal_x alone). Curvature is 0. */
 bool loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,
                            std::string& error);
+
+/** \brief One value of a PCLPointCloud2 field as double, whatever its numeric type (NaN for an
+  * unknown type): the one reader of stored x y z (and normals) for clouds and meshes. */
+double readField (const std::uint8_t* p, std::uint8_t datatype);
 
 /** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,

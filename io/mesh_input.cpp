@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "mesh_input.h"
+#include "cloud_input.h"
 #include "quiet_pcl_console.h"
 
 #include <pcl/PolygonMesh.h>
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
-#include <pcl/conversions.h>
+#include <pcl/io/ply_io.h>
 #include <pcl/io/vtk_lib_io.h>
-#include <pcl/point_types.h>
 
 #include <vtkObject.h>
 #include <vtkOutputWindow.h>
@@ -16,7 +16,10 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <charconv>
 #include <cstdint>
+#include <fstream>
+#include <exception>
 #include <mutex>
 #include <string>
 
@@ -36,6 +39,78 @@ applyVtkMessages (bool enabled)
   vtkOutputWindow::GetInstance ()->SetDisplayMode (enabled ? vtkOutputWindow::DEFAULT : vtkOutputWindow::NEVER);
 }
 
+
+/** \brief An OBJ file's vertices ("v x y z [w]") and faces ("f" with "i", "i/j", "i//k" or
+  * "i/j/k"; a negative index counts back from the last vertex read, as the format says), as
+  * 0-based indices; every other statement (vt, vn, g, o, s, usemtl, comments) is skipped.
+  * Written here because both readers at hand crash on malformed files: VTK's on a face "1/1/1"
+  * without texture coordinates, PCL's on a vertex line with two numbers (found in review). On
+  * the bundled gripper and FCL's piano and room it gives VTK's vertices (as float, as every
+  * reader stores them) and faces, bit for bit. False with the file, line and reason. */
+bool
+readObj (const std::string& path, std::vector<std::array<double, 3>>& vertices, std::vector<std::vector<long long>>& faces,
+         std::string& error)
+{
+  std::ifstream in (path, std::ios::binary);
+  if (!in)
+  {
+    error = "'" + path + "' is not a readable obj mesh (cannot open it)";
+    return false;
+  }
+  std::string line;
+  std::size_t number = 0;
+  auto fail = [&] (const std::string& why) {
+    error = "'" + path + "' line " + std::to_string (number) + ": " + why;
+    return false;
+  };
+  while (std::getline (in, line))
+  {
+    ++number;
+    const char* p = line.c_str ();
+    const char* end = p + line.size ();
+    auto skipBlanks = [&] { while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p; };
+    skipBlanks ();
+    if (end - p < 2 || (p[1] != ' ' && p[1] != '\t') || (p[0] != 'v' && p[0] != 'f'))
+      continue;  // not a vertex or a face (vt, vn, comments, groups, materials, blank lines)
+    const char kind = p[0];
+    p += 2;
+    if (kind == 'v')
+    {
+      std::array<double, 3> v;
+      for (int k = 0; k < 3; ++k)
+      {
+        skipBlanks ();
+        float value = 0.0f;
+        const auto [next, ec] = std::from_chars (p, end, value);
+        if (ec != std::errc () || (next < end && *next != ' ' && *next != '\t' && *next != '\r'))
+          return fail ("a vertex needs three numbers x y z");
+        v[static_cast<std::size_t> (k)] = value;
+        p = next;
+      }
+      vertices.push_back (v);
+      continue;
+    }
+    std::vector<long long> face;
+    for (skipBlanks (); p < end; skipBlanks ())
+    {
+      long long i = 0;
+      const auto [next, ec] = std::from_chars (p, end, i);
+      if (ec != std::errc () || i == 0)
+        return fail ("a face's vertex index must be a non-zero integer");
+      p = next;
+      while (p < end && *p != ' ' && *p != '\t' && *p != '\r')  // "/j", "//k", "/j/k": not read
+        ++p;
+      face.push_back (i > 0 ? i - 1 : static_cast<long long> (vertices.size ()) + i);
+    }
+    faces.push_back (std::move (face));
+  }
+  if (vertices.empty ())
+  {
+    error = "'" + path + "' is not a readable obj mesh (no vertex)";
+    return false;
+  }
+  return true;
+}
 } // namespace
 
 bool
@@ -63,65 +138,97 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
                                                                                : path.find_last_of ('.') + 1);
   std::transform (ext.begin (), ext.end (), ext.begin (),
                   [] (unsigned char c) { return static_cast<char> (std::tolower (c)); });
-
-  pcl::PolygonMesh polygon_mesh;
-  int vertices_read = 0;
-  if (ext == "obj")
-    vertices_read = pcl::io::loadPolygonFileOBJ (path, polygon_mesh);
-  else if (ext == "ply")
-    vertices_read = pcl::io::loadPolygonFilePLY (path, polygon_mesh);
-  else if (ext == "stl")
-    vertices_read = pcl::io::loadPolygonFileSTL (path, polygon_mesh);
-  else if (ext == "vtk")
-    vertices_read = pcl::io::loadPolygonFileVTK (path, polygon_mesh);
-  else
+  if (ext != "obj" && ext != "ply" && ext != "stl" && ext != "vtk")
   {
     error = "'" + path + "': unsupported mesh type (expected .ply, .obj, .stl or .vtk)";
     return false;
   }
-  const std::size_t n = static_cast<std::size_t> (polygon_mesh.cloud.width) * polygon_mesh.cloud.height;
-  if (vertices_read <= 0 || n == 0)
-  {
-    error = "'" + path + "' is not a readable " + ext + " mesh (no vertex read)";
-    return false;
-  }
-  bool has_xyz = true;
-  for (const char* name : {"x", "y", "z"})
-    has_xyz = has_xyz && pcl::getFieldIndex (polygon_mesh.cloud, name) >= 0;
-  if (!has_xyz)
-  {
-    error = "'" + path + "': mesh vertices have no x y z";
-    return false;
-  }
-  pcl::PointCloud<pcl::PointXYZ> vertices;
-  pcl::fromPCLPointCloud2 (polygon_mesh.cloud, vertices);
-  mesh.vertices.reserve (vertices.size ());
-  for (const auto& p : vertices.points)
-    mesh.vertices.push_back ({static_cast<double> (p.x), static_cast<double> (p.y), static_cast<double> (p.z)});
 
-  auto finite = [&] (std::uint32_t i) {
-    const auto& v = mesh.vertices[i];
+  // Faces as 0-based indices, signed: an index is named as the file counts it (OBJ from 1, the
+  // others from 0), and one below zero as negative.
+  std::vector<std::vector<long long>> faces;
+  const bool one_based = ext == "obj";
+  if (ext == "obj")
+  {
+    if (!readObj (path, mesh.vertices, faces, error))
+      return false;
+  }
+  else
+  {
+    // PLY goes through PCL's own reader, which reports a malformed file; VTK's crashed on some (a
+    // PLY declaring faces and no vertex, a truncated one: segmentation faults and double frees,
+    // found in review). On the FCL meshes written as ASCII and binary PLY both give the same
+    // vertices and faces, bit for bit. STL and legacy VTK files have no reader besides VTK's.
+    pcl::PolygonMesh polygon_mesh;
+    bool read = false;
+    try
+    {
+      if (ext == "ply")
+        read = pcl::io::loadPLYFile (path, polygon_mesh) >= 0;
+      else if (ext == "stl")
+        read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
+      else
+        read = pcl::io::loadPolygonFileVTK (path, polygon_mesh) > 0;
+    }
+    catch (const std::exception& e)  // PCL's PLY reader throws std::bad_alloc on a negative count
+    {
+      error = "'" + path + "' is not a readable " + ext + " mesh (malformed: " + e.what () + ")";
+      return false;
+    }
+    const pcl::PCLPointCloud2& cloud = polygon_mesh.cloud;
+    const std::size_t n = static_cast<std::size_t> (cloud.width) * cloud.height;
+    if (!read || n == 0 || cloud.data.size () < n * cloud.point_step)
+    {
+      error = "'" + path + "' is not a readable " + ext + " mesh (" + (read && n == 0 ? "no vertex" : "malformed or truncated") + ")";
+      return false;
+    }
+    int xyz[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      xyz[k] = pcl::getFieldIndex (cloud, std::string (1, static_cast<char> ('x' + k)));
+      if (xyz[k] < 0)
+      {
+        error = "'" + path + "': mesh vertices have no x y z";
+        return false;
+      }
+    }
+    // Any numeric type (a PLY may store double x y z; PCL's reader keeps the file's type).
+    mesh.vertices.resize (n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+      {
+        const pcl::PCLPointField& f = cloud.fields[static_cast<std::size_t> (xyz[k])];
+        mesh.vertices[i][static_cast<std::size_t> (k)] = readField (cloud.data.data () + i * cloud.point_step + f.offset, f.datatype);
+      }
+    // The readers hand indices over as unsigned 32-bit numbers: a negative one wraps.
+    faces.reserve (polygon_mesh.polygons.size ());
+    for (const auto& polygon : polygon_mesh.polygons)
+    {
+      faces.emplace_back ();
+      for (const std::uint32_t i : polygon.vertices)
+        faces.back ().push_back (static_cast<std::int32_t> (i));
+    }
+  }
+
+  auto finite = [&] (long long i) {
+    const auto& v = mesh.vertices[static_cast<std::size_t> (i)];
     return std::isfinite (v[0]) && std::isfinite (v[1]) && std::isfinite (v[2]);
   };
-  // The readers give 0-based indices (OBJ's 1-based ones converted) as unsigned: an index is
-  // named as the file counts it, and one below zero as negative.
-  const bool one_based = ext == "obj";
-  for (std::size_t face = 0; face < polygon_mesh.polygons.size (); ++face)
+  const auto count = static_cast<long long> (mesh.vertices.size ());
+  for (std::size_t face = 0; face < faces.size (); ++face)
   {
-    const auto& idx = polygon_mesh.polygons[face].vertices;
-    for (const std::uint32_t i : idx)
+    const auto& idx = faces[face];
+    for (const long long i : idx)
     {
-      if (i >= mesh.vertices.size ())
+      if (i < 0 || i >= count)
       {
         const std::string where = "'" + path + "': face " + std::to_string (face + 1);
-        const auto as_signed = static_cast<std::int32_t> (i);
-        if (as_signed < 0)
-          error = where + (one_based ? " has a vertex index below 1 (relative, negative OBJ indices are not read)"
-                                     : " has a negative vertex index (" + std::to_string (as_signed) + ")");
+        if (i < 0)
+          error = where + (one_based ? " has a vertex index below 1" : " has a negative vertex index (" + std::to_string (i) + ")");
         else
-          error = where + " refers to vertex " + std::to_string (one_based ? std::uint64_t{i} + 1 : std::uint64_t{i}) +
+          error = where + " refers to vertex " + std::to_string (one_based ? i + 1 : i) +
                   (one_based ? " (counting from 1, as OBJ does)" : " (counting from 0)") + " but the file has " +
-                  std::to_string (mesh.vertices.size ()) + " vertices";
+                  std::to_string (count) + " vertices";
         return false;
       }
     }

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-// Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. Loading goes
-// through PCL's VTK readers (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its
-// headers are heavy.
+// Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. OBJ and PLY go
+// through PCL's own readers, STL and VTK through PCL's VTK bridge (pcl/io/vtk_lib_io.h), kept in
+// mesh_input.cpp alone because its headers are heavy.
 
 #include <array>
 #include <string>
@@ -19,8 +19,9 @@ struct TriangleMesh
 };
 
 /** \brief Loads a .ply, .obj, .stl or .vtk mesh (extension case-insensitive). False with a
-  * reason in error (naming the file) when the file cannot be read, has no vertex or no triangle,
-  * or refers to a missing vertex. Triangles with a non-finite vertex are dropped.
+  * reason in error (naming the file) when the file cannot be read, is malformed or truncated, has
+  * no vertex or no triangle, or refers to a missing vertex. Vertex coordinates of any numeric type
+  * are converted. Triangles with a non-finite vertex are dropped.
   *
   * The readers print nothing: the first call silences VTK's warnings and output window for the
   * whole process (unless setVtkMessages() chose first), and PCL's console during the read. */

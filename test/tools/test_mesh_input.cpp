@@ -112,3 +112,57 @@ TEST_F (MeshInput, BadVertexIndicesAreNamedAsTheFileCountsThem)
     EXPECT_NE (error.find (c.message), std::string::npos) << error;
   }
 }
+
+// Malformed OBJ and PLY files are refused with a reason naming the file, never a crash: VTK's
+// readers, used for these formats before, died on several of them (a PLY declaring a face and no
+// vertex: segmentation fault; truncated: double free; an OBJ face "1/1/1" without texture
+// coordinates: segmentation fault; found in review). Well-formed variants read as the file says.
+TEST_F (MeshInput, MalformedObjAndPlyFilesAreRefusedNotCrashedOn)
+{
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+  const struct
+  {
+    const char* name;
+    std::string content;
+    const char* message;  ///< nullptr: read, one triangle
+  } cases[] = {
+      {"novertex.ply", "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + faces + "end_header\n3 0 1 2\n", "is not a readable ply mesh"},
+      {"truncated.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "end_header\n0 0 0\n1 0 0\n",
+       "is not a readable ply mesh (malformed or truncated)"},
+      {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "is not a readable ply mesh (malformed or truncated)"},
+      {"negative_count.ply", "ply\nformat ascii 1.0\nelement vertex -3\n" + xyz + faces + "end_header\n3 0 1 2\n",
+       "is not a readable ply mesh"},
+      {"short_vertex.obj", "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex needs three numbers x y z"},
+      {"letters.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf a b c\n", "line 4: a face's vertex index must be a non-zero integer"},
+      {"slashes.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n", nullptr},
+      {"relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", nullptr},
+      {"double.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n" + faces +
+           "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       nullptr},
+  };
+  for (const auto& c : cases)
+  {
+    SCOPED_TRACE (c.name);
+    test_files::writeFile (dir_ / c.name, c.content);
+    TriangleMesh mesh;
+    std::string error;
+    const bool ok = pcl_probcollision::io::loadTriangleMesh ((dir_ / c.name).string (), mesh, error);
+    if (c.message)
+    {
+      EXPECT_FALSE (ok);
+      EXPECT_NE (error.find (std::string (c.name) + "' " + c.message), std::string::npos) << error;
+    }
+    else
+    {
+      ASSERT_TRUE (ok) << error;
+      ASSERT_EQ (mesh.triangles.size (), 1u);
+      ASSERT_EQ (mesh.vertices.size (), 3u);
+      EXPECT_EQ (mesh.triangles[0], (std::array<int, 3>{0, 1, 2}));
+      EXPECT_EQ (mesh.vertices[1], (std::array<double, 3>{1.0, 0.0, 0.0}));  // double x y z converted
+      EXPECT_EQ (mesh.vertices[2], (std::array<double, 3>{0.0, 1.0, 0.0}));
+    }
+  }
+}
