@@ -35,6 +35,17 @@ CloudModel::CloudModel (UncertainCloud points, const BVHParams& hierarchy, std::
 {
   if (points.empty ())
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CloudModel] no point given");
+  // Per-point results are scattered by these indices into arrays of source_size: one outside
+  // would write past them (found in review: a negative index crashed a per_point query).
+  for (std::size_t j = 0; j < points.source_indices.size (); ++j)
+  {
+    const int i = points.source_indices[j];
+    if (i < 0 || (source_size > 0 && static_cast<std::size_t> (i) >= source_size))
+      PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                           "[pcl_probcollision::CloudModel] source index " << i << " of point " << j
+                               << (i < 0 ? std::string (" is negative")
+                                         : " is outside the source cloud's " + std::to_string (source_size) + " points (source_size)"));
+  }
   const auto start = std::chrono::steady_clock::now ();
   params_.hierarchy = hierarchy;
   buildLocal (std::move (points), hierarchy, source_size);

@@ -263,6 +263,14 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
     fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
     return false;
   }
+  // A classifier carries its parameters (and its random-feature draw): one built with others
+  // would answer for them, not for the request (found in review: P 0.39 became 1).
+  if (classifier && classifier->getParams () != request.classifier)
+  {
+    fail (result, CollisionResult::Status::InvalidInput,
+          "the classifier given was built with parameters other than request.classifier's");
+    return false;
+  }
   const std::string pose_error = detail::poseError (T_a_b, "T_a_b");
   if (!pose_error.empty ())
   {

@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -204,6 +206,35 @@ TEST (CloudModel, BadInputIsRefusedByName)
   empty.push_back (pcl::PointXYZ (NAN, 0.0f, 0.0f));
   EXPECT_THROW (buildCloudModel (empty), pcl::BadArgumentException);
   EXPECT_THROW (CloudModel {UncertainCloud ()}, pcl::BadArgumentException);
+
+  // Points given directly: a source index outside the source cloud is refused (per-point results
+  // are scattered by it: a negative one crashed a per_point query, found in review).
+  auto points = [] (int last_index) {
+    UncertainCloud u;
+    for (int i = 0; i < 30; ++i)
+    {
+      u.means.emplace_back (0.01 * i, 0.0, 0.0);
+      u.covariances.push_back (1e-6 * Eigen::Matrix3d::Identity ());
+      u.source_indices.push_back (i == 29 ? last_index : i);
+    }
+    return u;
+  };
+  for (const auto& [index, source_size, words] :
+       {std::tuple<int, std::size_t, const char*>{-7, 0, "source index -7 of point 29 is negative"},
+        {290, 30, "source index 290 of point 29 is outside the source cloud's 30 points"}})
+  {
+    try
+    {
+      CloudModel m (points (index), BVHParams (), source_size);
+      ADD_FAILURE () << "source index " << index << " was accepted";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find (words), std::string::npos) << e.what ();
+    }
+  }
+  EXPECT_EQ (CloudModel (points (290)).sourceSize (), 291u);  // no source_size: one past the largest
+  EXPECT_EQ (CloudModel (points (29), BVHParams (), 30).sourceSize (), 30u);
 }
 
 // The build's threads (covariance estimation and hierarchy) change nothing in the model, so

@@ -101,6 +101,21 @@ TEST (Collide, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
     th.join ();
   for (std::size_t i = 0; i < poses.size (); ++i)
     EXPECT_EQ (serial[i], parallel[i]) << i;
+
+  // A classifier built with other parameters than the request's is refused, not used (it
+  // answered for its own: P 0.39 read 1, found in review), by collide() and collideBatch().
+  ClassifierParams other_params = request.classifier;
+  other_params.C *= 0.01;
+  const RobustClassifier other (other_params);
+  CollisionResult r;
+  EXPECT_FALSE (collide (*a, *b, poses[0], request, r, &other));
+  EXPECT_EQ (r.status, CollisionResult::Status::InvalidInput);
+  EXPECT_NE (r.message.find ("request.classifier"), std::string::npos) << r.message;
+  std::vector<CollisionResult> batch;
+  collideBatch (*a, *b, poses, request, batch, 1, &other);
+  ASSERT_EQ (batch.size (), poses.size ());
+  for (const CollisionResult& q : batch)
+    EXPECT_EQ (q.status, CollisionResult::Status::InvalidInput);
 }
 
 // Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum

@@ -74,7 +74,10 @@ public:
     *            results are index-aligned with it); 0 means points.size() (or one past the
     *            largest source index, when there are any)
     * \throws pcl::BadArgumentException for invalid parameters, sizes that disagree or
-    *         non-finite values (ProbabilisticBVH::build), or no point at all. */
+    *         non-finite values (ProbabilisticBVH::build), a source index below 0 or at least
+    *         source_size (when given), or no point at all. The model carries no surface
+    *         (CollisionRequest::surface is then answered by the separators); buildCloudModel()
+    *         builds one. */
   explicit CloudModel (UncertainCloud points, const BVHParams& hierarchy = BVHParams (), std::size_t source_size = 0);
 
   /** \brief The hierarchy, in the local frame (cloud frame = local + origin()). */

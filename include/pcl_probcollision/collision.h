@@ -30,8 +30,9 @@ namespace pcl_probcollision
   *             message holds the models' warnings (CloudModel::warning()) on success
   * \param[in] classifier a prebuilt classifier with request.classifier's parameters to reuse
   *            its random-feature draw across queries (optional)
-  * \return result.ok(); false with status and message for a non-finite or non-rigid T_a_b or
-  *         invalid request parameters.
+  * \return result.ok(); false with status and message for a non-finite or non-rigid T_a_b,
+  *         invalid request parameters, or a classifier built with other parameters than
+  *         request.classifier (InvalidInput).
   * \note Thread safety: any number of calls may share the same models and classifier.
   */
 bool collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b,
