@@ -876,7 +876,7 @@ run (int argc, char** argv)
   double models_build_ms = 0.0;
   // The other clouds' models are built here too (or taken from their early build), so that every
   // model gets its stage line (a 5,000,000-point cloud takes seconds); a build that fails is
-  // left to compute(), which builds it again and reports the error as before.
+  // reported with the file's name.
   auto cloudModel = [&] (const Input& in, const std::shared_future<pcl_probcollision::CloudModel::ConstPtr>& early,
                          const std::string& sensor, double sigma, bool input) {
     if (in.oriented)
@@ -888,8 +888,10 @@ run (int argc, char** argv)
       input ? pc.setInputModel (built) : pc.setTargetModel (built);
       models_build_ms += built->buildMilliseconds ();
     }
-    catch (const pcl::PCLException&)
+    catch (const pcl::PCLException& e)
     {
+      // The library names the cloud by its role ("target point 0 at ..."); the user knows files.
+      throw Failure{kRuntimeFailure, "'" + in.path + "' (" + (input ? "<a>" : "<b>") + "): " + pcl_probcollision::errorMessage (e)};
     }
   };
   cloudModel (a, early_a, o.sensor_a, o.sigma_a, true);

@@ -348,6 +348,8 @@ def test_cli_closed_equals_pcd_collision(tmp_path):
     assert verdicts == {False: ["free", "free"], True: ["collision", "free"]}
     with pytest.raises(ValueError, match="need surface"):
         pcd.resolve_options({"closed": True})
+    with pytest.raises(ValueError, match="surface_calibrated needs surface"):
+        pcd.resolve_options({"surface_calibrated": True})
     o = pcd.resolve_options({"closed": True, "surface_ladder": True})
     assert o["closed_a"] and o["closed_b"]
     assert pcd.model_params(o, "a", exact=False).closed_objects

@@ -149,6 +149,9 @@ TEST (CliOptions, ClosedMarksTheInputsClosedSolids)
   EXPECT_FALSE (b.options.closed_a);
   EXPECT_TRUE (b.options.closed_b);
   expectUsageError ({"-closed_a"}, "need -surface");
+  // -surface_calibrated maps the surface layer's P: alone it was silently ignored (found in review).
+  expectUsageError ({"-surface_calibrated"}, "-surface_calibrated needs -surface");
+  EXPECT_EQ (parse ({"-surface_ladder", "-surface_calibrated"}).kind, Kind::Run);
   expectUsageError ({"-surface", "-closed=1"}, "-closed");
   expectUsageError ({"-surface", "-closed_b", "-closed_b"}, "-closed_b");
 }

@@ -260,6 +260,17 @@ TEST_F (CliReliability, InfCoordinatesAreSkipped)
   expectError ({kGripper.string (), (dir_ / "inf_ascii.pcd").string ()}, 1, "inf_ascii.pcd");
 }
 
+// A cloud the library refuses (a coordinate beyond +-1e15) is named by its file and side, not by
+// the library's role name alone ("query failed: target point 0 ...", found in review).
+TEST_F (CliReliability, ACloudTheLibraryRefusesIsNamedByItsFile)
+{
+  Cloud c = grid (3, 3, 0.01, 0.0);
+  c[0].x = 1e16f;
+  const std::string huge = save ("huge.pcd", c);
+  expectError ({kGripper.string (), huge}, 1, "'" + huge + "' (<b>): target point 0 at");
+  expectError ({huge, kScene.string ()}, 1, "'" + huge + "' (<a>): input point 0 at");
+}
+
 TEST_F (CliReliability, TinyAndDegenerateClouds)
 {
   Cloud one;

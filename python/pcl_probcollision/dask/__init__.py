@@ -124,6 +124,9 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
     if (o["closed_a"] or o["closed_b"]) and not o["surface"]:
         raise ValueError("options closed, closed_a and closed_b need surface (or surface_pooled, surface_ladder): they "
                          "say where the surface layer's inside is")
+    if o["surface_calibrated"] and not o["surface"]:
+        raise ValueError("option surface_calibrated needs surface (or surface_pooled, surface_ladder): it maps the "
+                         "surface layer's probability")
     if any(o[k] is not None for k in ("orientation", "orientation_a", "orientation_b")) and not o["surface"]:
         raise ValueError("options orientation, orientation_a and orientation_b need surface (or surface_pooled, "
                          "surface_ladder): they orient the surface layer's surfaces")
