@@ -757,7 +757,8 @@ PYBIND11_MODULE (_core, m)
             py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
             py::arg ("surface") = dp.surface, py::arg ("orientation") = dp.orientation,
             py::arg ("closed_objects") = dp.closed_objects,
-            "Every argument defaults to the C++ CloudModelParams default.")
+            "Every argument defaults to the C++ CloudModelParams default. The other members (threads,\n"
+            "noise_resolution and its gate, keep_full_resolution, noise_stop, split) are set as attributes.")
       .def_readwrite ("k", &CloudModelParams::k)
       .def_readwrite ("noise", &CloudModelParams::noise)
       .def_readwrite ("surface_projection", &CloudModelParams::surface_projection)

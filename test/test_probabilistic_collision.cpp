@@ -440,6 +440,15 @@ TEST (ProbabilisticCollision, UnusableInputsFailWithAMessage)
   EXPECT_TRUE (pc.compute (r)) << r.message;
   EXPECT_THROW (pc.setProbabilityThreshold (1.5), pcl::BadArgumentException);
   EXPECT_THROW (pc.setThresholds (0.6, 0.4), pcl::BadArgumentException);
+  try  // a NaN threshold is named as out of range, not as out of order (found in review)
+  {
+    pc.setThresholds (std::nan (""), 0.9);
+    ADD_FAILURE () << "a NaN threshold was accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("free_below nan outside [0, 0.5]"), std::string::npos) << e.what ();
+  }
   EXPECT_THROW (pc.setKSearch (0), pcl::BadArgumentException);
 }
 

@@ -120,7 +120,9 @@ struct CollisionResult
   int witness_index = -1;
   /** \brief Its position and the separator's unit normal there (pointing toward A's side).
     * The position is the model's: with CloudModelParams::surface_projection (the default) the
-    * sample moved onto its neighbours' plane, not the stored point (witness_index's). Both are
+    * sample moved onto its neighbours' plane, with CloudModelParams::noise_resolution the merged
+    * point (the mean of the samples merged into it, witness_index one of them), not the stored
+    * point (witness_index's). Both are
     * in the query frame: the frame the query's pose maps the other object into. That is
     * A's frame for collide (a, b, T_a_b, ...) and the target's (B's) for
     * ProbabilisticCollision::compute (T_target_input, ...); this is the one place the rule is

@@ -70,6 +70,7 @@ class CloudModelParams:
     noise_resolution_gated: bool
     noise_resolution_whole_cloud: bool
     noise_stop: float
+    keep_full_resolution: bool
     threads: int
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
