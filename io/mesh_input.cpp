@@ -80,6 +80,8 @@ readObj (const std::string& path, std::vector<std::array<double, 3>>& vertices, 
       for (int k = 0; k < 3; ++k)
       {
         skipBlanks ();
+        if (p + 1 < end && *p == '+' && p[1] != '-')  // "+1.5": from_chars takes no plus sign
+          ++p;
         float value = 0.0f;
         const auto [next, ec] = std::from_chars (p, end, value);
         if (ec != std::errc () || (next < end && *next != ' ' && *next != '\t' && *next != '\r'))

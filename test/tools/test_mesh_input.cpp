@@ -138,6 +138,7 @@ TEST_F (MeshInput, MalformedObjAndPlyFilesAreRefusedNotCrashedOn)
       {"letters.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf a b c\n", "line 4: a face's vertex index must be a non-zero integer"},
       {"slashes.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n", nullptr},
       {"relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", nullptr},
+      {"signs_crlf.obj", "# exported\r\nvn 0 0 1\r\nv 0 0 0\r\nv\t+1 0 0 1\r\nv 0 1e0 -0\r\ng part\r\nf 1//1 2//1 3//1\r\n", nullptr},
       {"double.ply",
        "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n" + faces +
            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
