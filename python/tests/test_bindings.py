@@ -730,6 +730,25 @@ def test_bad_files(tmp_path):
         pc.load_model(garbage)
 
 
+def test_malformed_mesh_files(tmp_path, capfd):
+    # VTK's readers crashed the interpreter on these (found in review); now a ValueError naming the file.
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    faces = "element face 1\nproperty list uchar int vertex_indices\n"
+    cases = {
+        "novertex.ply": "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + faces + "end_header\n3 0 1 2\n",
+        "truncated.ply": "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "end_header\n0 0 0\n",
+        "short.obj": "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    }
+    for name, text in cases.items():
+        (tmp_path / name).write_text(text)
+        with pytest.raises(ValueError, match=name):
+            pc.read_mesh(tmp_path / name)
+    (tmp_path / "slashes.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n")
+    V, F = pc.read_mesh(tmp_path / "slashes.obj")
+    assert V.shape == (3, 3) and F.tolist() == [[0, 1, 2]]
+    assert capfd.readouterr().err == ""
+
+
 def test_malformed_pcd_files(tmp_path, table_path, capfd):
     header = b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 10\nHEIGHT 1\nPOINTS 10\nDATA binary\n"
     cases = {
