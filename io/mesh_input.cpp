@@ -18,7 +18,9 @@
 #include <cmath>
 #include <charconv>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <exception>
 #include <mutex>
 #include <string>
@@ -113,6 +115,218 @@ readObj (const std::string& path, std::vector<std::array<double, 3>>& vertices, 
   }
   return true;
 }
+
+/** \brief A legacy VTK file's POLYDATA points and polygons (ASCII or BINARY; the cell layout of
+  * versions up to 4.2, "n size" then size integers, and of 5.x, OFFSETS and CONNECTIVITY), as
+  * 0-based indices. Vertices, lines and triangle strips are read past and not kept (VTK's bridge
+  * kept none either); reading stops at POINT_DATA, CELL_DATA or FIELD. Written here because
+  * VTK's reader crashes on a truncated cell list (ASCII or binary; found in review). On the
+  * gripper and FCL's room written by VTK's writer in both encodings and both layouts it gives
+  * VTK's vertices and faces, bit for bit. False with the file and the reason. */
+bool
+readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vertices,
+               std::vector<std::vector<long long>>& faces, std::string& error)
+{
+  std::ifstream in (path, std::ios::binary);
+  const std::string text ((std::istreambuf_iterator<char> (in)), std::istreambuf_iterator<char> ());
+  std::size_t at = 0;
+  auto fail = [&] (const std::string& why) {
+    error = "'" + path + "' is not a readable vtk mesh (" + why + ")";
+    return false;
+  };
+  auto line = [&] {
+    const std::size_t end = std::min (text.find ('\n', at), text.size ());
+    std::string l = text.substr (at, end - at);
+    at = std::min (end + 1, text.size ());
+    if (!l.empty () && l.back () == '\r')
+      l.pop_back ();
+    return l;
+  };
+  auto isBlank = [] (char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  auto token = [&] {
+    while (at < text.size () && isBlank (text[at]))
+      ++at;
+    const std::size_t start = at;
+    while (at < text.size () && !isBlank (text[at]))
+      ++at;
+    return text.substr (start, at - start);
+  };
+  if (line ().rfind ("# vtk DataFile Version", 0) != 0)
+    return fail ("no '# vtk DataFile Version' line");
+  line ();  // the title
+  std::string encoding = line ();
+  while (!encoding.empty () && isBlank (encoding.back ()))
+    encoding.pop_back ();
+  if (encoding != "ASCII" && encoding != "BINARY")
+    return fail ("expected ASCII or BINARY on line 3");
+  const bool binary = encoding == "BINARY";
+  if (token () != "DATASET" || token () != "POLYDATA")
+    return fail ("only DATASET POLYDATA is read as a mesh");
+
+  // One value of a data type: ASCII as text, BINARY big-endian.
+  auto value = [&] (const std::string& type, double& v) {
+    if (!binary)
+    {
+      const std::string t = token ();
+      if (t.empty ())
+        return false;
+      const char* first = t.data ();
+      const char* last = first + t.size ();
+      std::from_chars_result r;
+      if (type == "float")
+      {
+        float f = 0.0f;
+        r = std::from_chars (first, last, f);
+        v = f;
+      }
+      else if (type == "double")
+        r = std::from_chars (first, last, v);
+      else
+      {
+        long long i = 0;
+        r = std::from_chars (first, last, i);
+        v = static_cast<double> (i);
+      }
+      return r.ec == std::errc () && r.ptr == last;
+    }
+    std::size_t size = 0;
+    if (type == "char" || type == "unsigned_char")
+      size = 1;
+    else if (type == "short" || type == "unsigned_short")
+      size = 2;
+    else if (type == "int" || type == "unsigned_int" || type == "float" || type == "vtktypeint32")
+      size = 4;
+    else if (type == "long" || type == "unsigned_long" || type == "double" || type == "vtktypeint64")
+      size = 8;
+    if (size == 0 || text.size () - at < size)
+      return false;
+    unsigned char b[8];
+    for (std::size_t k = 0; k < size; ++k)  // big-endian in the file
+      b[k] = static_cast<unsigned char> (text[at + size - 1 - k]);
+    at += size;
+    const bool is_unsigned = type.rfind ("unsigned", 0) == 0;
+    if (type == "float")
+    {
+      float f;
+      std::memcpy (&f, b, 4);
+      v = f;
+    }
+    else if (type == "double")
+      std::memcpy (&v, b, 8);
+    else
+    {
+      std::uint64_t u = 0;
+      std::memcpy (&u, b, size);
+      if (!is_unsigned && size < 8 && (u >> (8 * size - 1)) != 0)
+        u |= ~std::uint64_t{0} << (8 * size);  // sign extension
+      v = is_unsigned ? static_cast<double> (u) : static_cast<double> (static_cast<std::int64_t> (u));
+    }
+    return true;
+  };
+  auto count = [&] (const std::string& t, long long& n) {
+    const auto r = std::from_chars (t.data (), t.data () + t.size (), n);
+    return r.ec == std::errc () && r.ptr == t.data () + t.size () && n >= 0;
+  };
+  bool points_read = false;
+  for (std::string key = token (); !key.empty (); key = token ())
+  {
+    if (key == "POINT_DATA" || key == "CELL_DATA" || key == "FIELD")
+      break;  // attributes: not read
+    if (key == "METADATA")
+    {
+      // Ends at an empty line.
+      line ();
+      while (at < text.size () && !line ().empty ())
+        ;
+      continue;
+    }
+    long long n = 0, size = 0;
+    if (key == "POINTS")
+    {
+      const bool counted = count (token (), n);
+      const std::string type = token ();
+      // Each value takes a byte at least: a count beyond the file is refused before any allocation.
+      if (!counted || n <= 0 || type.empty () || static_cast<std::size_t> (n) > (text.size () - at) / 3)
+        return fail ("a bad POINTS header");
+      if (binary)
+        line ();  // the header's end: the values start on the next line
+      vertices.resize (static_cast<std::size_t> (n));
+      for (auto& v : vertices)
+        for (double& c : v)
+          if (!value (type, c))
+            return fail ("POINTS: truncated or not numbers");
+      points_read = true;
+      continue;
+    }
+    if (key != "VERTICES" && key != "LINES" && key != "POLYGONS" && key != "TRIANGLE_STRIPS")
+      return fail ("unknown section '" + key + "'");
+    if (!count (token (), n) || !count (token (), size) || static_cast<std::size_t> (n) > text.size () - at ||
+        static_cast<std::size_t> (size) > text.size () - at)
+      return fail (key + ": a bad header");
+    if (binary)
+      line ();
+    std::vector<std::vector<long long>> cells;
+    const std::size_t mark = at;
+    if (token () == "OFFSETS")  // 5.x: n offsets, then size indices
+    {
+      const std::string offset_type = token ();
+      if (binary)
+        line ();
+      std::vector<long long> offsets (static_cast<std::size_t> (n));
+      double v = 0.0;
+      for (auto& o : offsets)
+      {
+        if (!value (offset_type, v))
+          return fail (key + ": truncated offsets");
+        o = static_cast<long long> (v);
+      }
+      if (token () != "CONNECTIVITY")
+        return fail (key + ": no CONNECTIVITY after its offsets");
+      const std::string index_type = token ();
+      if (binary)
+        line ();
+      std::vector<long long> connectivity (static_cast<std::size_t> (size));
+      for (auto& c : connectivity)
+      {
+        if (!value (index_type, v))
+          return fail (key + ": truncated connectivity");
+        c = static_cast<long long> (v);
+      }
+      for (std::size_t c = 0; c + 1 < offsets.size (); ++c)
+      {
+        if (offsets[c] < 0 || offsets[c] > offsets[c + 1] || offsets[c + 1] > size)
+          return fail (key + ": offsets out of order or beyond the connectivity");
+        cells.emplace_back (connectivity.begin () + offsets[c], connectivity.begin () + offsets[c + 1]);
+      }
+    }
+    else  // up to 4.2: n cells in size integers, each its point count then its indices
+    {
+      at = mark;
+      double v = 0.0;
+      long long used = 0;
+      for (long long c = 0; c < n; ++c)
+      {
+        if (!value ("int", v) || v < 0 || used + 1 + static_cast<long long> (v) > size)
+          return fail (key + ": a cell's point count beyond the declared size, or truncated");
+        used += 1 + static_cast<long long> (v);
+        cells.emplace_back (static_cast<std::size_t> (v));
+        for (long long& i : cells.back ())
+        {
+          if (!value ("int", v))
+            return fail (key + ": truncated");
+          i = static_cast<long long> (v);
+        }
+      }
+      if (used != size)
+        return fail (key + ": its cells do not fill the declared size");
+    }
+    if (key == "POLYGONS")
+      faces.insert (faces.end (), std::make_move_iterator (cells.begin ()), std::make_move_iterator (cells.end ()));
+  }
+  if (!points_read || vertices.empty ())
+    return fail ("no vertex");
+  return true;
+}
 } // namespace
 
 bool
@@ -150,9 +364,9 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
   // others from 0), and one below zero as negative.
   std::vector<std::vector<long long>> faces;
   const bool one_based = ext == "obj";
-  if (ext == "obj")
+  if (ext == "obj" || ext == "vtk")
   {
-    if (!readObj (path, mesh.vertices, faces, error))
+    if (!(ext == "obj" ? readObj (path, mesh.vertices, faces, error) : readVtkLegacy (path, mesh.vertices, faces, error)))
       return false;
   }
   else
@@ -160,17 +374,15 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
     // PLY goes through PCL's own reader, which reports a malformed file; VTK's crashed on some (a
     // PLY declaring faces and no vertex, a truncated one: segmentation faults and double frees,
     // found in review). On the FCL meshes written as ASCII and binary PLY both give the same
-    // vertices and faces, bit for bit. STL and legacy VTK files have no reader besides VTK's.
+    // vertices and faces, bit for bit. STL has no reader besides VTK's.
     pcl::PolygonMesh polygon_mesh;
     bool read = false;
     try
     {
       if (ext == "ply")
         read = pcl::io::loadPLYFile (path, polygon_mesh) >= 0;
-      else if (ext == "stl")
-        read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
       else
-        read = pcl::io::loadPolygonFileVTK (path, polygon_mesh) > 0;
+        read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
     }
     catch (const std::exception& e)  // PCL's PLY reader throws std::bad_alloc on a negative count
     {

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 
-// Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. OBJ and PLY go
-// through PCL's own readers, STL and VTK through PCL's VTK bridge (pcl/io/vtk_lib_io.h), kept in
-// mesh_input.cpp alone because its headers are heavy.
+// Triangle-mesh input, shared by pcd_collision, the benchmarks and the evaluation. PLY goes through
+// PCL's own reader, OBJ and legacy VTK through readers of our own (VTK's crash on malformed files),
+// STL through PCL's VTK bridge (pcl/io/vtk_lib_io.h), kept in mesh_input.cpp alone because its
+// headers are heavy.
 
 #include <array>
 #include <string>

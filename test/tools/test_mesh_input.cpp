@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
+#include <initializer_list>
 #include <filesystem>
 #include <string>
 
@@ -117,7 +119,7 @@ TEST_F (MeshInput, BadVertexIndicesAreNamedAsTheFileCountsThem)
 // readers, used for these formats before, died on several of them (a PLY declaring a face and no
 // vertex: segmentation fault; truncated: double free; an OBJ face "1/1/1" without texture
 // coordinates: segmentation fault; found in review). Well-formed variants read as the file says.
-TEST_F (MeshInput, MalformedObjAndPlyFilesAreRefusedNotCrashedOn)
+TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
 {
   const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
   const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
@@ -144,6 +146,53 @@ TEST_F (MeshInput, MalformedObjAndPlyFilesAreRefusedNotCrashedOn)
            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
        nullptr},
   };
+  // Legacy VTK (read by a reader of our own too: VTK's crashed on a truncated cell list).
+  auto big_endian = [] (std::initializer_list<std::uint32_t> words) {
+    std::string bytes;
+    for (const std::uint32_t w : words)
+      for (int shift = 24; shift >= 0; shift -= 8)
+        bytes.push_back (static_cast<char> ((w >> shift) & 0xffu));
+    return bytes;
+  };
+  const std::uint32_t one = 0x3f800000u;  // 1.0f
+  const std::string vtk_points = big_endian ({0, 0, 0, one, 0, 0, 0, one, 0});
+  const std::string ascii = "# vtk DataFile Version 4.2\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
+  const std::string bin = "# vtk DataFile Version 4.2\nt\nBINARY\nDATASET POLYDATA\nPOINTS 3 float\n" + vtk_points + "\n";
+  const struct
+  {
+    const char* name;
+    std::string content;
+    const char* message;
+  } vtk_cases[] = {
+      {"ascii.vtk", ascii + "POLYGONS 1 4\n3 0 1 2\n", nullptr},
+      {"ascii51.vtk", "# vtk DataFile Version 5.1\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                      "METADATA\nINFORMATION 0\n\nPOLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 2\n",
+       nullptr},
+      {"binary.vtk", bin + "POLYGONS 1 4\n" + big_endian ({3, 0, 1, 2}) + "\n", nullptr},
+      {"truncated_cells.vtk", ascii + "POLYGONS 1 4\n3 0 1\n", "is not a readable vtk mesh (POLYGONS: truncated)"},
+      {"truncated_binary.vtk", bin + "POLYGONS 1 4\n" + big_endian ({3, 0}), "is not a readable vtk mesh (POLYGONS: truncated)"},
+      {"short_points.vtk", "# vtk DataFile Version 4.2\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\nPOLYGONS 1 4\n3 0 1 2\n",
+       "is not a readable vtk mesh (POINTS: truncated or not numbers)"},
+  };
+  for (const auto& c : vtk_cases)
+  {
+    SCOPED_TRACE (c.name);
+    test_files::writeFile (dir_ / c.name, c.content);
+    TriangleMesh mesh;
+    std::string error;
+    const bool ok = pcl_probcollision::io::loadTriangleMesh ((dir_ / c.name).string (), mesh, error);
+    if (c.message)
+    {
+      EXPECT_FALSE (ok);
+      EXPECT_NE (error.find (std::string (c.name) + "' " + c.message), std::string::npos) << error;
+      continue;
+    }
+    ASSERT_TRUE (ok) << error;
+    ASSERT_EQ (mesh.triangles.size (), 1u);
+    EXPECT_EQ (mesh.triangles[0], (std::array<int, 3>{0, 1, 2}));
+    EXPECT_EQ (mesh.vertices[1], (std::array<double, 3>{1.0, 0.0, 0.0}));
+    EXPECT_EQ (mesh.vertices[2], (std::array<double, 3>{0.0, 1.0, 0.0}));
+  }
   for (const auto& c : cases)
   {
     SCOPED_TRACE (c.name);
