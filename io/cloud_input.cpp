@@ -17,8 +17,10 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -102,6 +104,107 @@ isPly (const std::string& path)
   return ext == ".ply";
 }
 } // namespace
+
+bool
+checkPlyHeader (const std::string& path, std::string& error)
+{
+  std::ifstream in (path, std::ios::binary);
+  in.seekg (0, std::ios::end);
+  const auto file_size = static_cast<long long> (in.tellg ());
+  in.seekg (0);
+  auto fail = [&] (std::size_t line, const std::string& why) {
+    error = "'" + path + "' is not a readable PLY file (header line " + std::to_string (line) + ": " + why + ")";
+    return false;
+  };
+  static const std::set<std::string> kTypes = {"char",  "uchar",  "short",  "ushort",  "int",     "uint",   "float",
+                                               "double", "int8", "uint8", "int16", "uint16", "int32", "uint32",
+                                               "float32", "float64"};
+  std::string line, element;
+  long long element_count = 0;
+  std::set<std::string> names;             // the current element's properties
+  std::vector<std::string> colours;        // the vertex element's colour properties, in order
+  std::size_t number = 0;
+  // A header has a few dozen lines; the bound stops at a binary file that only starts with "ply".
+  while (number < 10000 && std::getline (in, line))
+  {
+    ++number;
+    if (!line.empty () && line.back () == '\r')
+      line.pop_back ();
+    std::istringstream words (line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;)
+      w.push_back (word);
+    if (number == 1)
+    {
+      if (line != "ply")
+        return fail (number, "the first line is not 'ply'");
+      continue;
+    }
+    if (w.empty ())
+      return fail (number, "an empty line");
+    if (line[0] == ' ' || line[0] == '\t')  // PCL's reader asserts on " obj_info" (found by fuzzing)
+      return fail (number, "a line starting with a blank");
+    const std::string& key = w[0];
+    if (key == "comment" || key == "obj_info")
+      continue;
+    if (key == "format")
+    {
+      if (w.size () != 3 || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian") ||
+          w[2] != "1.0")
+        return fail (number, "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      continue;
+    }
+    if (key == "element")
+    {
+      if (w.size () != 3 || !(std::istringstream (w[2]) >> element_count) || element_count < 0 ||
+          std::to_string (element_count) != w[2])
+        return fail (number, "expected 'element NAME COUNT' with a count >= 0");
+      element = w[1];
+      names.clear ();
+      continue;
+    }
+    if (key == "property")
+    {
+      if (element.empty ())
+        return fail (number, "a property before any element");
+      const bool list = w.size () == 5 && w[1] == "list";
+      if (!(list && kTypes.count (w[2]) && kTypes.count (w[3])) && !(w.size () == 3 && kTypes.count (w[1])))
+        return fail (number, "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME' with PLY types");
+      const std::string& name = w.back ();
+      if (!names.insert (name).second)
+        return fail (number, "property '" + name + "' given twice in element '" + element + "'");
+      // PCL's reader sizes a vertex list by the first vertex and writes later, longer ones past
+      // its buffer (an assertion, an abort); and it packs red, green and blue into one field
+      // by their order: other orders or a missing one write past it (found by fuzzing).
+      if (element == "vertex" && list)
+        return fail (number, "a list property in the vertex element ('" + name + "') is not read");
+      if (element == "vertex")
+        for (const std::string prefix : {"", "diffuse_"})
+          for (const char* c : {"red", "green", "blue", "alpha"})
+            if (name == prefix + c)
+            {
+              if (w[1] != "uchar" && w[1] != "uint8")
+                return fail (number, "colour property '" + name + "' must be uchar");
+              colours.push_back (c);
+            }
+      // Each value takes a byte at least: a count beyond the file is refused before any allocation.
+      if (element_count > file_size)
+        return fail (number, "element '" + element + "' declares " + std::to_string (element_count) +
+                                 " entries, more than the file's bytes");
+      continue;
+    }
+    if (key == "end_header")
+    {
+      if (!colours.empty () && colours != std::vector<std::string>{"red", "green", "blue"} &&
+          colours != std::vector<std::string>{"red", "green", "blue", "alpha"})
+        return fail (number, "vertex colours must be red, green, blue (and alpha), in that order");
+      return true;
+    }
+    return fail (number, "unknown keyword '" + key + "'");
+  }
+  error = "'" + path + "' is not a readable PLY file (no end_header)";
+  return false;
+}
 
 bool
 isFacelessPly (const std::string& path)
@@ -192,6 +295,8 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
   const char* format = ply ? "PLY" : "PCD";
   if (ply)
   {
+    if (!checkPlyHeader (path, error))
+      return false;
     pcl::PLYReader reader;
     int version = 0;
     if (reader.read (path, blob, file.origin, file.orientation, version) < 0)

@@ -37,6 +37,14 @@ bool loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNo
   * unknown type): the one reader of stored x y z (and normals) for clouds and meshes. */
 double readField (const std::uint8_t* p, std::uint8_t datatype);
 
+/** \brief A PLY header PCL's reader can take without failing an assertion: well-formed lines
+  * (format, element, property with PLY types, comment, obj_info, end_header), no property twice
+  * in an element, no list property in the vertex element, vertex colours as uchar red, green,
+  * blue (and alpha) in that order, no element count beyond the file's bytes. False with the
+  * file, the header line and the reason. PCL's reader aborted on each of these (found by
+  * fuzzing); the cloud and the mesh readers check it first. */
+bool checkPlyHeader (const std::string& path, std::string& error);
+
 /** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,
   * which reports it. Reads the header only. */

@@ -380,7 +380,11 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
     try
     {
       if (ext == "ply")
+      {
+        if (!checkPlyHeader (path, error))
+          return false;
         read = pcl::io::loadPLYFile (path, polygon_mesh) >= 0;
+      }
       else
         read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
     }

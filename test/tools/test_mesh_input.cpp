@@ -133,9 +133,22 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
       {"truncated.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "end_header\n0 0 0\n1 0 0\n",
        "is not a readable ply mesh (malformed or truncated)"},
       {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
-       "is not a readable ply mesh (malformed or truncated)"},
+       "is not a readable PLY file (header line 9: unknown keyword '0')"},
       {"negative_count.ply", "ply\nformat ascii 1.0\nelement vertex -3\n" + xyz + faces + "end_header\n3 0 1 2\n",
-       "is not a readable ply mesh"},
+       "is not a readable PLY file (header line 3: expected 'element NAME COUNT' with a count >= 0)"},
+      // Headers on which PCL's PLY reader aborts (found by fuzzing): refused before it reads them.
+      {"green_first.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+           "property uchar green\nproperty uchar blue\n" + faces + "end_header\n0 0 0 1 2\n1 0 0 1 2\n0 1 0 1 2\n3 0 1 2\n",
+       "is not a readable PLY file (header line 11: vertex colours must be red, green, blue (and alpha), in that order)"},
+      {"vertex_list.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "property list uchar int extra\n" + faces +
+           "end_header\n0 0 0 1 5\n1 0 0 2 5 6\n0 1 0 0\n3 0 1 2\n",
+       "is not a readable PLY file (header line 7: a list property in the vertex element ('extra') is not read)"},
+      {"blank_obj_info.ply", "ply\nformat ascii 1.0\n obj_info x\nend_header\n",
+       "is not a readable PLY file (header line 3: a line starting with a blank)"},
+      {"coloured.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+           "property uchar red\nproperty uchar green\nproperty uchar blue\n" + faces +
+           "end_header\n0 0 0 1 2 3\n1 0 0 1 2 3\n0 1 0 1 2 3\n3 0 1 2\n",
+       nullptr},
       {"short_vertex.obj", "v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex needs three numbers x y z"},
       {"letters.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf a b c\n", "line 4: a face's vertex index must be a non-zero integer"},
       {"slashes.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3\n", nullptr},
