@@ -74,7 +74,7 @@ fuzz_one () {  # target corpus-name [more input directories...]
   grep -E '^stat::number_of_executed_units|^stat::new_units_added|^stat::peak_rss_mb' "$work/log.txt" || true
 }
 fuzz_all () {
-  [ -x "$asan_dir/fuzz/fuzz_collide" ] || asan_build
+  [ -x "$asan_dir/fuzz/fuzz_collide" ] && [ -x "$asan_dir/fuzz/fuzz_mesh_file" ] || asan_build
   # Each fuzzer is single-threaded: run the two side by side, one per core.
   fuzz_one fuzz_collide collide fuzz/regressions &  # regressions replayed first, like the seeds
   local collide=$!
@@ -82,6 +82,7 @@ fuzz_all () {
   local cli=$! rc=0
   wait "$collide" || rc=1
   wait "$cli" || rc=1
+  fuzz_one fuzz_mesh_file mesh || rc=1  # the mesh readers (OBJ, PLY header check, legacy VTK)
   return "$rc"
 }
 
