@@ -144,6 +144,9 @@ checkPlyHeader (const std::string& path, std::string& error)
       return fail (number, "an empty line");
     if (line[0] == ' ' || line[0] == '\t')  // PCL's reader asserts on " obj_info" (found by fuzzing)
       return fail (number, "a line starting with a blank");
+    for (const char c : line)
+      if (!(c == '\t' || (c >= ' ' && c <= '~')))
+        return fail (number, "a character that is not printable ASCII");
     const std::string& key = w[0];
     if (key == "comment" || key == "obj_info")
       continue;
@@ -154,11 +157,18 @@ checkPlyHeader (const std::string& path, std::string& error)
         return fail (number, "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
       continue;
     }
+    // An element of entries without properties takes no bytes: PCL's reader then steps through
+    // any count, 6 billion in a fuzzed file (a spin).
+    if ((key == "element" || key == "end_header") && !element.empty () && element_count > 0 && names.empty ())
+      return fail (number, "element '" + element + "' has entries but no property");
     if (key == "element")
     {
       if (w.size () != 3 || !(std::istringstream (w[2]) >> element_count) || element_count < 0 ||
           std::to_string (element_count) != w[2])
         return fail (number, "expected 'element NAME COUNT' with a count >= 0");
+      // Each entry takes a byte at least: a count beyond the file is refused before any allocation.
+      if (element_count > file_size)
+        return fail (number, "element '" + w[1] + "' declares " + w[2] + " entries, more than the file's bytes");
       element = w[1];
       names.clear ();
       continue;
@@ -187,10 +197,6 @@ checkPlyHeader (const std::string& path, std::string& error)
                 return fail (number, "colour property '" + name + "' must be uchar");
               colours.push_back (c);
             }
-      // Each value takes a byte at least: a count beyond the file is refused before any allocation.
-      if (element_count > file_size)
-        return fail (number, "element '" + element + "' declares " + std::to_string (element_count) +
-                                 " entries, more than the file's bytes");
       continue;
     }
     if (key == "end_header")

@@ -145,6 +145,10 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
        "is not a readable PLY file (header line 7: a list property in the vertex element ('extra') is not read)"},
       {"blank_obj_info.ply", "ply\nformat ascii 1.0\n obj_info x\nend_header\n",
        "is not a readable PLY file (header line 3: a line starting with a blank)"},
+      {"empty_entries.ply", "ply\nformat binary_little_endian 1.0\nelement x 6429429493\nelement vertex 3\n" + xyz + faces + "end_header\n",
+       "is not a readable PLY file (header line 3: element 'x' declares 6429429493 entries, more than the file's bytes)"},
+      {"no_property.ply", "ply\nformat binary_little_endian 1.0\nelement x 5\nelement vertex 3\n" + xyz + faces + "end_header\n",
+       "is not a readable PLY file (header line 4: element 'x' has entries but no property)"},
       {"coloured.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
            "property uchar red\nproperty uchar green\nproperty uchar blue\n" + faces +
            "end_header\n0 0 0 1 2 3\n1 0 0 1 2 3\n0 1 0 1 2 3\n3 0 1 2\n",
