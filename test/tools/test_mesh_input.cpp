@@ -123,6 +123,18 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
 {
   const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
   const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+  // Legacy VTK (read by a reader of our own too: VTK's crashed on a truncated cell list).
+  auto big_endian = [] (std::initializer_list<std::uint32_t> words) {
+    std::string bytes;
+    for (const std::uint32_t w : words)
+      for (int shift = 24; shift >= 0; shift -= 8)
+        bytes.push_back (static_cast<char> ((w >> shift) & 0xffu));
+    return bytes;
+  };
+  const std::uint32_t one = 0x3f800000u;  // 1.0f
+  const std::string vtk_points = big_endian ({0, 0, 0, one, 0, 0, 0, one, 0});
+  const std::string ascii = "# vtk DataFile Version 4.2\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
+  const std::string bin = "# vtk DataFile Version 4.2\nt\nBINARY\nDATASET POLYDATA\nPOINTS 3 float\n" + vtk_points + "\n";
   const struct
   {
     const char* name;
@@ -162,25 +174,6 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
        "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\n" + faces +
            "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
        nullptr},
-  };
-  // Legacy VTK (read by a reader of our own too: VTK's crashed on a truncated cell list).
-  auto big_endian = [] (std::initializer_list<std::uint32_t> words) {
-    std::string bytes;
-    for (const std::uint32_t w : words)
-      for (int shift = 24; shift >= 0; shift -= 8)
-        bytes.push_back (static_cast<char> ((w >> shift) & 0xffu));
-    return bytes;
-  };
-  const std::uint32_t one = 0x3f800000u;  // 1.0f
-  const std::string vtk_points = big_endian ({0, 0, 0, one, 0, 0, 0, one, 0});
-  const std::string ascii = "# vtk DataFile Version 4.2\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n";
-  const std::string bin = "# vtk DataFile Version 4.2\nt\nBINARY\nDATASET POLYDATA\nPOINTS 3 float\n" + vtk_points + "\n";
-  const struct
-  {
-    const char* name;
-    std::string content;
-    const char* message;
-  } vtk_cases[] = {
       {"ascii.vtk", ascii + "POLYGONS 1 4\n3 0 1 2\n", nullptr},
       {"ascii51.vtk", "# vtk DataFile Version 5.1\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
                       "METADATA\nINFORMATION 0\n\nPOLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 2\n",
@@ -191,25 +184,6 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
       {"short_points.vtk", "# vtk DataFile Version 4.2\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0\nPOLYGONS 1 4\n3 0 1 2\n",
        "is not a readable vtk mesh (POINTS: truncated or not numbers)"},
   };
-  for (const auto& c : vtk_cases)
-  {
-    SCOPED_TRACE (c.name);
-    test_files::writeFile (dir_ / c.name, c.content);
-    TriangleMesh mesh;
-    std::string error;
-    const bool ok = pcl_probcollision::io::loadTriangleMesh ((dir_ / c.name).string (), mesh, error);
-    if (c.message)
-    {
-      EXPECT_FALSE (ok);
-      EXPECT_NE (error.find (std::string (c.name) + "' " + c.message), std::string::npos) << error;
-      continue;
-    }
-    ASSERT_TRUE (ok) << error;
-    ASSERT_EQ (mesh.triangles.size (), 1u);
-    EXPECT_EQ (mesh.triangles[0], (std::array<int, 3>{0, 1, 2}));
-    EXPECT_EQ (mesh.vertices[1], (std::array<double, 3>{1.0, 0.0, 0.0}));
-    EXPECT_EQ (mesh.vertices[2], (std::array<double, 3>{0.0, 1.0, 0.0}));
-  }
   for (const auto& c : cases)
   {
     SCOPED_TRACE (c.name);
