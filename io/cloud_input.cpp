@@ -106,7 +106,7 @@ isPly (const std::string& path)
 } // namespace
 
 bool
-checkPlyHeader (const std::string& path, std::string& error)
+checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
 {
   std::ifstream in (path, std::ios::binary);
   in.seekg (0, std::ios::end);
@@ -171,6 +171,10 @@ checkPlyHeader (const std::string& path, std::string& error)
         return fail (number, "element '" + w[1] + "' declares " + w[2] + " entries, more than the file's bytes");
       element = w[1];
       names.clear ();
+      if (counts && element == "vertex")
+        counts->vertices = element_count;
+      if (counts && element == "face")
+        counts->faces = element_count;
       continue;
     }
     if (key == "property")
@@ -215,31 +219,10 @@ checkPlyHeader (const std::string& path, std::string& error)
 bool
 isFacelessPly (const std::string& path)
 {
-  if (!isPly (path))
-    return false;
-  std::ifstream in (path, std::ios::binary);
-  std::string line;
-  bool vertices = false;
-  // A header has a few dozen lines; the bound stops at a binary file that only starts with "ply".
-  for (int n = 0; n < 10000 && std::getline (in, line); ++n)
-  {
-    if (!line.empty () && line.back () == '\r')
-      line.pop_back ();
-    if (n == 0 && line != "ply")
-      return false;
-    if (line == "end_header")
-      return vertices;
-    std::istringstream words (line);
-    std::string keyword, element;
-    long long count = 0;
-    if (words >> keyword >> element >> count && keyword == "element")
-    {
-      if (element == "face" && count > 0)
-        return false;
-      vertices = vertices || (element == "vertex" && count > 0);
-    }
-  }
-  return false;  // no end_header: not a PLY header the tool understands
+  PlyCounts counts;
+  std::string unused;
+  // An unreadable header is left to the mesh loader, which reports it (the same check, the same words).
+  return isPly (path) && checkPlyHeader (path, unused, &counts) && counts.vertices > 0 && counts.faces == 0;
 }
 
 namespace

@@ -42,8 +42,14 @@ double readField (const std::uint8_t* p, std::uint8_t datatype);
   * in an element, no list property in the vertex element, vertex colours as uchar red, green,
   * blue (and alpha) in that order, no element count beyond the file's bytes. False with the
   * file, the header line and the reason. PCL's reader aborted on each of these (found by
-  * fuzzing); the cloud and the mesh readers check it first. */
-bool checkPlyHeader (const std::string& path, std::string& error);
+  * fuzzing); the cloud and the mesh readers check it first. counts, when given, gets the
+  * vertex and face element counts (isFacelessPly). */
+struct PlyCounts
+{
+  long long vertices = 0;  ///< entries of the element "vertex"
+  long long faces = 0;     ///< entries of the element "face"
+};
+bool checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts = nullptr);
 
 /** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,

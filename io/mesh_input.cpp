@@ -20,8 +20,8 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 #include <exception>
+#include <iterator>
 #include <mutex>
 #include <string>
 
@@ -364,9 +364,14 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
   // others from 0), and one below zero as negative.
   std::vector<std::vector<long long>> faces;
   const bool one_based = ext == "obj";
-  if (ext == "obj" || ext == "vtk")
+  if (ext == "obj")
   {
-    if (!(ext == "obj" ? readObj (path, mesh.vertices, faces, error) : readVtkLegacy (path, mesh.vertices, faces, error)))
+    if (!readObj (path, mesh.vertices, faces, error))
+      return false;
+  }
+  else if (ext == "vtk")
+  {
+    if (!readVtkLegacy (path, mesh.vertices, faces, error))
       return false;
   }
   else
@@ -388,7 +393,7 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
       else
         read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
     }
-    catch (const std::exception& e)  // PCL's PLY reader throws std::bad_alloc on a negative count
+    catch (const std::exception& e)  // e.g. std::bad_alloc (a negative count did it before the header check)
     {
       error = "'" + path + "' is not a readable " + ext + " mesh (malformed: " + e.what () + ")";
       return false;

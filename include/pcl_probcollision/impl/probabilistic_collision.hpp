@@ -115,12 +115,7 @@ ProbabilisticCollision<PointT>::setThresholds (double free_below, double collisi
   CollisionRequest r = request_;
   r.free_below = free_below;
   r.collision_above = collision_above;
-  // A NaN is validate()'s to name ("free_below nan outside [0, 1]"), not an order to compare.
-  if (free_below == free_below && collision_above == collision_above && !(free_below <= collision_above))
-    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
-                         "[pcl_probcollision::ProbabilisticCollision::setThresholds] free_below "
-                             << free_below << " exceeds collision_above " << collision_above);
-  r.validate ();
+  r.validate ();  // its ranges, [0, 0.5] and [0.5, 1], also keep the two in order; a NaN is named
   request_ = r;
 }
 
