@@ -120,6 +120,49 @@ TEST (Collide, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
 
 // Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
 // so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
+// docs/RELIABILITY.md: a sensor noise far under the spacing made a 1 mm clearance a sure
+// collision. A 20 cm box's surface sampled every 1 cm, 1 mm above a 30 cm plate sampled every
+// 1 cm: the separator of a box edge's leaf (whose samples keep about a spacing of spread along
+// their tilted normals) and the plate's tilts, and an almost exact plate sample on its wrong
+// side read P = 1 (RobustClassifier, kPreciseFraction). Now the edge's spread decides: contact.
+TEST (Collide, NoiseFarUnderTheSpacingDoesNotTurnAClearanceIntoACollision)
+{
+  pcl::PointCloud<pcl::PointXYZ> box, plate;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j)
+      for (int k = 0; k <= 20; ++k)
+        if (i == 0 || i == 20 || j == 0 || j == 20 || k == 0 || k == 20)
+          box.push_back (pcl::PointXYZ (0.01f * i, 0.01f * j, 0.01f * k));
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j)
+      plate.push_back (pcl::PointXYZ (0.01f * i, 0.01f * j, 0.0f));
+  for (const double sigma : {1e-9, 1e-6})
+  {
+    CloudModelParams params;
+    params.noise = SensorNoiseModel::isotropic (sigma);
+    const auto a = buildCloudModel (box, params);
+    const auto b = buildCloudModel (plate, params);
+    for (const double gap : {0.001, 0.03})
+    {
+      Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity ();
+      T_a_b.translation ().z () = -gap;
+      const CollisionRequest request;
+      CollisionResult result;
+      ASSERT_TRUE (collide (*a, *b, T_a_b, request, result)) << result.message;
+      expectSane (result, true, request);
+      SCOPED_TRACE ("sigma " + std::to_string (sigma) + ", gap " + std::to_string (gap));
+      // Before the fix: P = 1 at 1 mm for both noises. The box's own edges, about a spacing
+      // uncertain along their tilted normals, keep 1 mm at contact (and 1 cm, P 0.13-0.15);
+      // 3 cm is free.
+      EXPECT_LT (result.probability, gap < 0.005 ? 0.9 : 0.1);
+      if (gap < 0.005)
+      {
+        EXPECT_GT (result.probability, 0.1);
+      }
+    }
+  }
+}
+
 TEST (Collide, SkippingDominatedPairsKeepsProbabilityAndWitness)
 {
   const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 31));
@@ -703,4 +746,26 @@ TEST (VerdictFor, DefaultRequestGivesTheDocumentedBands)
   EXPECT_EQ (verdictFor (0.9, request), Verdict::InContact);
   EXPECT_EQ (verdictFor (0.95, request), Verdict::InCollision);
   EXPECT_EQ (verdictFor (-std::numeric_limits<double>::quiet_NaN (), request), Verdict::Unknown);
+}
+
+TEST (VerdictFor, ThresholdsOutOfRangeAreRefusedByName)
+{
+  CollisionRequest request;
+  request.free_below = 0.6;  // above collision_above's range: every P would read free or collision
+  EXPECT_THROW (
+      {
+        try
+        {
+          verdictFor (0.7, request);
+        }
+        catch (const pcl::BadArgumentException& e)
+        {
+          EXPECT_NE (std::string (e.what ()).find ("free_below 0.6"), std::string::npos) << e.what ();
+          throw;
+        }
+      },
+      pcl::BadArgumentException);
+  request = CollisionRequest ();
+  request.collision_above = std::numeric_limits<double>::quiet_NaN ();
+  EXPECT_THROW (verdictFor (0.7, request), pcl::BadArgumentException);
 }

@@ -894,6 +894,48 @@ TEST (RobustClassifier, ExactPointsStayOutOfTheMaximumByDefault)
   EXPECT_EQ (exact_only.probability, 1.0);
 }
 
+// A point far more precise along the separator than the pair's least precise one counts as
+// exact for the maximum (kPreciseFraction, 0.03 of the largest spread): the same scene with A's
+// grid given a spread of sigma / 1000 instead of none.
+TEST (RobustClassifier, PrecisePointsStayOutOfTheMaximumAsExactOnesDo)
+{
+  const double sigma = 0.01;
+  std::vector<Eigen::Vector3d> ma, mb;
+  std::vector<Eigen::Matrix3d> ca, cb;
+  for (int j = 0; j < 11; ++j)
+    for (int i = 0; i < 11; ++i)
+    {
+      ma.emplace_back (0.1 * i, 0.1 * j, (i == 5 && j == 5) ? 1.5 * sigma : 0.0);
+      ca.push_back (1e-6 * sigma * sigma * Eigen::Matrix3d::Identity ());
+      mb.emplace_back (0.1 * i, 0.1 * j, sigma);
+      cb.push_back (sigma * sigma * Eigen::Matrix3d::Identity ());
+    }
+  ClassifierParams params;
+  params.kernel = KernelMode::Linear;
+  params.C = 1e6;
+  ClassifierResult graded, all;
+  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), graded));
+  params.exact_points_in_maximum = true;
+  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), all));
+  EXPECT_EQ (graded.probabilities_a, all.probabilities_a);
+  EXPECT_EQ (graded.probabilities_b, all.probabilities_b);
+  // The raised sample, 0.5 sigma over B's plane and a thousand of its own spreads past the
+  // separator, reads 1 and is the maximum only when precise points count.
+  EXPECT_EQ (all.probability, 1.0);
+  EXPECT_EQ (all.witness_side, 1);
+  EXPECT_EQ (graded.witness_side, -1);
+  EXPECT_GE (graded.probability, normalCdf (-1.0) - 1e-12);
+  EXPECT_LT (graded.probability, 0.9);
+  // At a tenth of B's spread A's points are not precise: the raised sample stays the maximum.
+  for (Eigen::Matrix3d& c : ca)
+    c = 0.01 * sigma * sigma * Eigen::Matrix3d::Identity ();
+  params.exact_points_in_maximum = false;
+  ClassifierResult tenth;
+  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), tenth));
+  EXPECT_EQ (tenth.witness_side, 1);
+  EXPECT_GT (tenth.probability, 0.9);
+}
+
 TEST (RobustClassifier, AKernelSolveStalledAtRoundingStops)
 {
   // A leaf pair recorded from pcd_collision on the evaluation's W1 scans at 0.5 % (seed 2's

@@ -64,7 +64,9 @@ struct ClassifierParams
     * a separator fitted to noisy data would make P = 1 for surfaces that merely touch. false
     * (default, METHOD.md 9: "only the cloud's points contribute graded probabilities"): the
     * maximum runs over the points with uncertainty, and over all points only when every point
-    * is exact. Per-point values are reported either way. */
+    * is exact. Points nearly as sure count as exact too: a spread along the fitted surface's
+    * gradient under 3 % of the pair's largest (a sensor noise far under the sample spacing,
+    * docs/RELIABILITY.md). Per-point values are reported either way. */
   bool exact_points_in_maximum = false;
   /** \brief Newton iteration cap of the linear rung (>= 1). The RFF rung runs L-BFGS, whose
     * iterations are much cheaper and less effective; it gets 10 * max_iterations. */
