@@ -1148,7 +1148,8 @@ PYBIND11_MODULE (_core, m)
          "Returns a list of M CollisionResult in pose order, each equal to collide(a, b, poses[i], request)\n"
          "(timings aside). ValueError naming the first invalid pose.");
   m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
-         "The verdict of a probability under a request's thresholds (Unknown for NaN).");
+         "The verdict of a probability under a request's thresholds (Unknown for NaN). ValueError naming\n"
+         "free_below or collision_above when out of range.");
 
   // --- file input and poses as pcd_collision reads them (io/, used by pcl_probcollision.dask) ------
   m.def ("read_cloud", &readCloud, py::arg ("path"),

@@ -235,6 +235,7 @@ sampleDistance (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
 Verdict
 verdictFor (double probability, const CollisionRequest& request)
 {
+  request.validateThresholds ();
   if (std::isnan (probability))
     return Verdict::Unknown;
   if (probability < request.free_below)

@@ -9,7 +9,7 @@
 namespace pcl_probcollision
 {
 void
-CollisionRequest::validate () const
+CollisionRequest::validateThresholds () const
 {
   const char* where = "[pcl_probcollision::CollisionRequest::validate] ";
   if (!(free_below >= 0.0 && free_below <= 0.5))
@@ -17,6 +17,13 @@ CollisionRequest::validate () const
   if (!(collision_above >= 0.5 && collision_above <= 1.0))
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          where << "collision_above " << collision_above << " outside [0.5, 1]");
+}
+
+void
+CollisionRequest::validate () const
+{
+  const char* where = "[pcl_probcollision::CollisionRequest::validate] ";
+  validateThresholds ();
   if (!(rho_min >= 0.0 && rho_min <= 1.0))
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "rho_min " << rho_min << " outside [0, 1]");
   if (!(expanded_k_sigma >= 0.0 && std::isfinite (expanded_k_sigma)))

@@ -65,6 +65,7 @@ bool collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<E
                    const RobustClassifier* classifier = nullptr);
 
 /** \brief The verdict of a probability under a request's thresholds (Unknown for NaN): the one
-  * rule every verdict, label and colour of the library and its tools derives from. */
+  * rule every verdict, label and colour of the library and its tools derives from.
+  * \throws pcl::BadArgumentException for thresholds validate() refuses (validateThresholds()). */
 Verdict verdictFor (double probability, const CollisionRequest& request);
 } // namespace pcl_probcollision

@@ -129,6 +129,8 @@ struct CollisionRequest
   /** \brief Throws pcl::BadArgumentException naming the first member out of range (the
     * classifier's included). */
   void validate () const;
+  /** \brief The part of validate() that verdictFor() needs: free_below and collision_above. */
+  void validateThresholds () const;
   /** \brief Every member equal (the classifier's parameters included). */
   bool operator== (const CollisionRequest& o) const;
   bool operator!= (const CollisionRequest& o) const { return !(*this == o); }

@@ -302,6 +302,8 @@ def test_result_repr_and_verdict_enum(table, gripper_patch):
     r = pc.collide(table, gripper_patch, translation(0.1, 0.1, 0.03))
     assert isinstance(r.verdict, pc.Verdict) and r.verdict == pc.Verdict.Free
     assert r.verdict == pc.verdict_for(r.probability, pc.CollisionRequest())
+    with pytest.raises(ValueError, match="collision_above 1.5"):
+        pc.verdict_for(0.5, pc.CollisionRequest(collision_above=1.5))
     text = repr(r)
     assert text.startswith("CollisionResult(status=Ok, verdict=Verdict.Free, probability=0.0")
     assert r.ok and r.status == pc.CollisionResult.Status.Ok
