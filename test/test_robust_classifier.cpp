@@ -855,85 +855,59 @@ TEST (RobustClassifier, ConcurrentClassifyOnOneInstance)
 }
 
 // Exact points (mesh samples, zero covariance) only say which side of the fitted surface they
-// fall on; by default the maximum runs over the uncertain points (METHOD.md 9).
-TEST (RobustClassifier, ExactPointsStayOutOfTheMaximumByDefault)
+// fall on; by default the maximum runs over the uncertain points (METHOD.md 9). Points far more
+// precise along the separator than the pair's least precise one count as exact too
+// (kPreciseFraction, 3 % of the largest spread).
+TEST (RobustClassifier, ExactAndPrecisePointsStayOutOfTheMaximumByDefault)
 {
   const double sigma = 0.01;
+  // A: a grid on z = 0 with one sample raised above B's plane, spread spread_a (0: exact).
+  // B: uncertain samples on z = sigma, over the same grid.
   std::vector<Eigen::Vector3d> ma, mb;
   std::vector<Eigen::Matrix3d> ca, cb;
   for (int j = 0; j < 11; ++j)
     for (int i = 0; i < 11; ++i)
     {
-      // A: an exact grid on z = 0 with one sample raised above B's plane.
       ma.emplace_back (0.1 * i, 0.1 * j, (i == 5 && j == 5) ? 1.5 * sigma : 0.0);
-      ca.push_back (Eigen::Matrix3d::Zero ());
-      // B: uncertain samples on z = sigma, over the same grid.
       mb.emplace_back (0.1 * i, 0.1 * j, sigma);
       cb.push_back (sigma * sigma * Eigen::Matrix3d::Identity ());
     }
   ClassifierParams params;
   params.kernel = KernelMode::Linear;
   params.C = 1e6;  // the hard-margin limit: the plane lies between the two grids
-  ClassifierResult uncertain_max, all_max;
-  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), uncertain_max));
-  params.exact_points_in_maximum = true;
-  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), all_max));
-  // Same fit, same per-point values; only the maximum differs.
-  EXPECT_EQ (uncertain_max.probabilities_a, all_max.probabilities_a);
-  EXPECT_EQ (uncertain_max.probabilities_b, all_max.probabilities_b);
-  EXPECT_EQ (all_max.probability, 1.0);
-  EXPECT_EQ (all_max.witness_side, 1);
-  EXPECT_EQ (uncertain_max.witness_side, -1);
-  // B's points sit one sigma above A's plane and the separator lies between: P_i >= Phi(-1).
-  EXPECT_GE (uncertain_max.probability, normalCdf (-1.0) - 1e-12);
-  EXPECT_LT (uncertain_max.probability, 0.9);  // nothing says penetration
+  const auto classify = [&] (double spread_a, bool exact_in_maximum) {
+    ca.assign (ma.size (), spread_a * spread_a * Eigen::Matrix3d::Identity ());
+    params.exact_points_in_maximum = exact_in_maximum;
+    ClassifierResult r;
+    EXPECT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), r));
+    return r;
+  };
+  for (const double spread_a : {0.0, 1e-3 * sigma})
+  {
+    SCOPED_TRACE ("A's spread " + std::to_string (spread_a));
+    const ClassifierResult graded = classify (spread_a, false), all = classify (spread_a, true);
+    // Same fit, same per-point values; only the maximum differs.
+    EXPECT_EQ (graded.probabilities_a, all.probabilities_a);
+    EXPECT_EQ (graded.probabilities_b, all.probabilities_b);
+    // The raised sample, past the separator by hundreds of its spreads or exactly, reads 1 and
+    // is the maximum only when exact and precise points count.
+    EXPECT_EQ (all.probability, 1.0);
+    EXPECT_EQ (all.witness_side, 1);
+    EXPECT_EQ (graded.witness_side, -1);
+    // B's points sit one sigma above A's plane and the separator lies between: P_i >= Phi(-1).
+    EXPECT_GE (graded.probability, normalCdf (-1.0) - 1e-12);
+    EXPECT_LT (graded.probability, 0.9);  // nothing says penetration
+  }
+  // At a tenth of B's spread A's points are not precise: the raised sample stays the maximum.
+  const ClassifierResult tenth = classify (0.1 * sigma, false);
+  EXPECT_EQ (tenth.witness_side, 1);
+  EXPECT_GT (tenth.probability, 0.9);
   // Every point exact: the maximum falls back to all points.
   ClassifierResult exact_only;
   std::vector<Eigen::Matrix3d> zero (cb.size (), Eigen::Matrix3d::Zero ());
+  ca.assign (ma.size (), Eigen::Matrix3d::Zero ());
   ASSERT_TRUE (RobustClassifier (ClassifierParams ()).classify (PointSetView (ma, ca), PointSetView (mb, zero), exact_only));
   EXPECT_EQ (exact_only.probability, 1.0);
-}
-
-// A point far more precise along the separator than the pair's least precise one counts as
-// exact for the maximum (kPreciseFraction, 0.03 of the largest spread): the same scene with A's
-// grid given a spread of sigma / 1000 instead of none.
-TEST (RobustClassifier, PrecisePointsStayOutOfTheMaximumAsExactOnesDo)
-{
-  const double sigma = 0.01;
-  std::vector<Eigen::Vector3d> ma, mb;
-  std::vector<Eigen::Matrix3d> ca, cb;
-  for (int j = 0; j < 11; ++j)
-    for (int i = 0; i < 11; ++i)
-    {
-      ma.emplace_back (0.1 * i, 0.1 * j, (i == 5 && j == 5) ? 1.5 * sigma : 0.0);
-      ca.push_back (1e-6 * sigma * sigma * Eigen::Matrix3d::Identity ());
-      mb.emplace_back (0.1 * i, 0.1 * j, sigma);
-      cb.push_back (sigma * sigma * Eigen::Matrix3d::Identity ());
-    }
-  ClassifierParams params;
-  params.kernel = KernelMode::Linear;
-  params.C = 1e6;
-  ClassifierResult graded, all;
-  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), graded));
-  params.exact_points_in_maximum = true;
-  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), all));
-  EXPECT_EQ (graded.probabilities_a, all.probabilities_a);
-  EXPECT_EQ (graded.probabilities_b, all.probabilities_b);
-  // The raised sample, 0.5 sigma over B's plane and a thousand of its own spreads past the
-  // separator, reads 1 and is the maximum only when precise points count.
-  EXPECT_EQ (all.probability, 1.0);
-  EXPECT_EQ (all.witness_side, 1);
-  EXPECT_EQ (graded.witness_side, -1);
-  EXPECT_GE (graded.probability, normalCdf (-1.0) - 1e-12);
-  EXPECT_LT (graded.probability, 0.9);
-  // At a tenth of B's spread A's points are not precise: the raised sample stays the maximum.
-  for (Eigen::Matrix3d& c : ca)
-    c = 0.01 * sigma * sigma * Eigen::Matrix3d::Identity ();
-  params.exact_points_in_maximum = false;
-  ClassifierResult tenth;
-  ASSERT_TRUE (RobustClassifier (params).classify (PointSetView (ma, ca), PointSetView (mb, cb), tenth));
-  EXPECT_EQ (tenth.witness_side, 1);
-  EXPECT_GT (tenth.probability, 0.9);
 }
 
 TEST (RobustClassifier, AKernelSolveStalledAtRoundingStops)
