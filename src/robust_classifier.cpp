@@ -142,45 +142,6 @@ makeProblem (const PointSetView& a, const PointSetView& b, const UnitCubeTransfo
   * noise on seed 3 (0.1 made a collision 2 sigma deep read free), where 0.03 moved 2 answers
   * of 19,600 on seeds 2-8 (docs/RELIABILITY.md). */
 constexpr double kPreciseFraction = 0.03;
-
-/** \brief in_maximum (every point when null) less the points whose spread along the fit's
-  * gradient is under kPreciseFraction of the pair's largest, written into marks (which may be
-  * *in_maximum) and returned; in_maximum itself when that leaves out no point or every point. */
-const std::vector<bool>*
-excludePrecise (const detail::SeparatorProblem& p, const detail::RungFit& fit, const std::vector<bool>* in_maximum,
-                std::vector<bool>& marks)
-{
-  const std::size_t n = static_cast<std::size_t> (p.n);
-  thread_local std::vector<double> spread2;  // sigma_i^2 along the unit gradient, -1 if collapsed
-  spread2.assign (n, -1.0);
-  double largest = 0.0;
-  const double plane_norm = fit.isPlane () ? fit.plane_gradient.norm () : 0.0;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const Eigen::Index k = static_cast<Eigen::Index> (i);
-    const double norm = fit.isPlane () ? plane_norm : detail::gradientNorm (fit, k);
-    if (!(norm >= detail::kCollapse))
-      continue;
-    spread2[i] = detail::quadraticForm (p, fit, k) / (norm * norm);
-    largest = std::max (largest, spread2[i]);
-  }
-  const double floor2 = kPreciseFraction * kPreciseFraction * largest;
-  const auto before = [&] (std::size_t i) { return !in_maximum || (*in_maximum)[i]; };
-  const auto precise = [&] (std::size_t i) { return spread2[i] >= 0.0 && spread2[i] < floor2; };
-  bool any_left = false, any_out = false;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    any_left |= before (i) && !precise (i);
-    any_out |= before (i) && precise (i);
-  }
-  if (!any_out || !any_left)
-    return in_maximum;
-  // marks may be *in_maximum itself: each entry is read before it is written
-  marks.resize (n);
-  for (std::size_t i = 0; i < n; ++i)
-    marks[i] = before (i) && !precise (i);
-  return &marks;
-}
 } // namespace
 
 void
@@ -371,18 +332,23 @@ RobustClassifier::classify (const PointSetView& a, const PointSetView& b, Classi
     for (std::size_t i = 0; i < n; ++i)
       (i < na ? result.probabilities_a[i] : result.probabilities_b[i - na]) = normalCdf (best.z (static_cast<Eigen::Index> (i)));
   }
-  // Points far more precise along the fitted gradient than the pair's least precise one count
-  // as exact too (kPreciseFraction): their P_i is a property of the fit.
-  if (!params_.exact_points_in_maximum)
-    in_maximum = excludePrecise (p, best, in_maximum, uncertain);
   // The maximum and its witness, the first point that reaches it. P_i = Phi(z_i) rises with z_i,
   // so a point whose z_i is not above every z_j before it cannot raise the maximum: a normal
-  // tail is taken only at a new largest z_i (a few per pair), not at every point.
+  // tail is taken only at a new largest z_i (a few per pair), not at every point. Points far
+  // more precise along the fitted gradient than the pair's least precise one count as exact too
+  // (kPreciseFraction), tested at those candidates only; the least precise point itself is
+  // never left out, so some point always remains.
+  const double precise_below = params_.exact_points_in_maximum ? 0.0 : kPreciseFraction * best.largest_spread;
+  const auto precise = [&] (Eigen::Index i) {
+    const double norm = best.isPlane () ? best.plane_gradient.norm () : detail::gradientNorm (best, i);
+    return norm >= detail::kCollapse && std::sqrt (detail::quadraticForm (p, best, i)) / norm < precise_below;
+  };
   Eigen::Index witness = -1;
   result.probability = -1.0;
   double largest = -std::numeric_limits<double>::infinity ();
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index> (n); ++i)
-    if ((!in_maximum || uncertain[static_cast<std::size_t> (i)]) && (witness < 0 || best.z (i) > largest))
+    if ((!in_maximum || uncertain[static_cast<std::size_t> (i)]) && (witness < 0 || best.z (i) > largest) &&
+        !precise (i))
     {
       largest = best.z (i);
       const double p_i = normalCdf (largest);

@@ -118,8 +118,6 @@ TEST (Collide, ConcurrentCollideOnSharedHierarchiesMatchesSerial)
     EXPECT_EQ (q.status, CollisionResult::Status::InvalidInput);
 }
 
-// Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
-// so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
 // docs/RELIABILITY.md: a sensor noise far under the spacing made a 1 mm clearance a sure
 // collision. A 20 cm box's surface sampled every 1 cm, 1 mm above a 30 cm plate sampled every
 // 1 cm: the separator of a box edge's leaf (whose samples keep about a spacing of spread along
@@ -163,6 +161,8 @@ TEST (Collide, NoiseFarUnderTheSpacingDoesNotTurnAClearanceIntoACollision)
   }
 }
 
+// Without per-point values the traversal skips pairs whose reach weight cannot beat the maximum
+// so far (issue #8): the answer must be the one of the full traversal, with fewer fits.
 TEST (Collide, SkippingDominatedPairsKeepsProbabilityAndWitness)
 {
   const CloudModel a (randomSheet (600, 0.2, 0.0, 0.002, 31));

@@ -2,6 +2,8 @@
 // Per-point collision probabilities of a fitted rung (METHOD.md 6.1).
 #include <pcl_probcollision/detail/point_probabilities.h>
 
+#include <algorithm>
+
 namespace pcl_probcollision
 {
 namespace detail
@@ -12,6 +14,7 @@ assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
   const Eigen::Index n = p.n;
   fit.z.resize (n);
   fit.misclassified = 0;
+  fit.largest_spread = 0.0;
   Eigen::Index collapsed = 0;
   // Point by point: no temporary arrays (this runs for every leaf pair's fit).
   const double plane_norm = fit.isPlane () ? fit.plane_gradient.norm () : 0.0;
@@ -29,6 +32,7 @@ assessFit (const SeparatorProblem& p, double depth_sigmas, RungFit& fit)
     else
     {
       fit.z (i) = pointZ (u, sigma);
+      fit.largest_spread = std::max (fit.largest_spread, sigma);
       fit.misclassified += sigma < kNoSpread ? u < -kNoSpread : u < -depth_sigmas * sigma;
     }
   }

@@ -55,7 +55,7 @@ pointZ (double u, double sigma)
 }
 
 /** \brief METHOD.md 6.1 for every point, and the ladder's misclassification count: fills
-  * fit.z (P_i = Phi(z_i)), fit.misclassified and fit.degenerate. With u_i = c_i f_i / |g_i| and
+  * fit.z (P_i = Phi(z_i)), fit.misclassified, fit.largest_spread and fit.degenerate. With u_i = c_i f_i / |g_i| and
   * sigma_i = sqrt(g_i^T Sigma_i g_i) / |g_i|: |g_i| < kCollapse gives P_i = 0.5 (collapsed,
   * counted as misclassified); sigma_i < kNoSpread gives 1, 0.5 or 0 by the sign of u_i
   * (tolerance kNoSpread); otherwise Phi(-u_i / sigma_i), misclassified when

@@ -35,6 +35,8 @@ struct RungFit
     * gradient): the normal tails are taken only where they are needed. */
   Eigen::ArrayXd z;
   std::size_t misclassified = 0;
+  /** \brief max_i sigma_i, the standard deviation along the gradient (collapsed points aside). */
+  double largest_spread = 0.0;
   bool degenerate = false;
 
   bool isPlane () const { return gx.size () == 0; }
