@@ -799,6 +799,57 @@ closedObjects (CloudModelParams p)
 }
 } // namespace
 
+// A sheet seen edge-on as in SurfaceModel.ASheetSeenEdgeOnIsTwoSided, with a coarser noise (2 mm
+// at 1 cm spacing, drawn in all three coordinates) and the sensor at three places in the sheet's
+// plane, eight draws each; a 20 cm box sampled every 1 cm with the same noise held 3 cm above it
+// or under it. The noise tilts whole patches
+// of normals (they share their neighbours) toward the sensor or away: neighbour pairs rarely
+// point apart, but the patches disagree once one orientation is propagated over the sheet
+// (27-50 % of the facing points). Before 2026-12-02 (neighbour pairs counted) 6 of these 24
+// kept the viewpoint, and each of them read the box 3 cm clear on one side as inside, P = 1.
+TEST (SurfaceModel, ASheetSeenEdgeOnThroughCoarseNoiseIsTwoSided)
+{
+  const auto box = buildCloudModel (boxSurface (Eigen::Vector3d (0, 0, 0.1), Eigen::Vector3d::Constant (0.1), 0.01, 0.002, 1), noisy (0.002));
+  CloudModelParams p = noisy (0.002);
+  p.orientation = NormalOrientation::Viewpoint;
+  for (const Eigen::Vector3f& view : {Eigen::Vector3f (1, 0, 0), Eigen::Vector3f (0, 0, 0), Eigen::Vector3f (0.3f, 0.3f, 0)})
+    for (unsigned draw = 0; draw < 8; ++draw)
+    {
+      std::mt19937 rng (draw);
+      std::normal_distribution<float> noise (0.0f, 0.002f);
+      auto cloud = sheet (0.3, 0.01, 0.0, view);
+      for (auto& q : cloud)
+        q.getVector3fMap () += Eigen::Vector3f (noise (rng), noise (rng), noise (rng));
+      const auto edge_on = buildCloudModel (cloud, p);
+      EXPECT_EQ (edge_on->surface ().orientation (), NormalOrientation::Propagate) << view.transpose () << ", draw " << draw;
+      for (const double z : {-0.03, 0.23})  // the sheet 3 cm under the box's bottom, then over its top
+      {
+        CollisionResult r;
+        ASSERT_TRUE (collide (*box, *edge_on, shift (0, 0, z), surfaceRequest (), r)) << r.message;
+        EXPECT_EQ (r.verdict, Verdict::Free) << view.transpose () << ", draw " << draw << ", " << z << " m: P " << r.probability;
+      }
+    }
+}
+
+// A closed object's samples (a 20 cm box, 1 cm spacing, 2 mm noise) with a viewpoint outside it,
+// Viewpoint asked for: the far faces face the sensor from behind, and turned toward it they would
+// point inward (Auto refuses such a viewpoint by the points it hides). Their side disagrees with
+// the near faces' once one orientation is carried over the box, so the viewpoint orients nothing.
+// Before 2026-12-02 it did, and a sheet 3 cm under the box read as inside it (P = 1).
+TEST (SurfaceModel, AViewpointThatSeesAClosedObjectFromOutsideOrientsNothing)
+{
+  auto cloud = boxSurface (Eigen::Vector3d (0, 0, 0.1), Eigen::Vector3d::Constant (0.1), 0.01, 0.002, 1);
+  cloud.sensor_origin_ = Eigen::Vector4f (1.0f, 0.2f, 0.5f, 0.0f);
+  CloudModelParams p = noisy (0.002);
+  p.orientation = NormalOrientation::Viewpoint;
+  const auto box = buildCloudModel (cloud, p);
+  EXPECT_EQ (box->surface ().orientation (), NormalOrientation::Propagate);
+  const auto floor = buildCloudModel (sheet (0.3, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.002));
+  CollisionResult r;
+  ASSERT_TRUE (collide (*box, *floor, shift (0, 0, -0.03), surfaceRequest (), r)) << r.message;
+  EXPECT_EQ (r.verdict, Verdict::Free) << "P " << r.probability;
+}
+
 // Declared closed objects (CloudModelParams::closed_objects), a propagated orientation is checked
 // by the winding number in front of and behind its samples: a sphere and a noisy box check out
 // and are trusted (the box's edge samples' probes behind come out of it: fewer read inside); an

@@ -600,12 +600,12 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
     why = hidden > pcl_probcollision::SurfaceModel::kMaxHiddenShare
               ? "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
                     " % of the points lie behind others (one scan hides none)"
-              : std::string ("; not toward its VIEWPOINT, which sees it edge-on");
+              : std::string ("; not toward its VIEWPOINT, which sees it edge-on or not as one scan does");
   // -orientation asked for a rule that could not orient this input (SurfaceModel falls back to
   // propagation): say which, and why.
   const pcl_probcollision::NormalOrientation asked = model.params ().orientation;
   if (asked == pcl_probcollision::NormalOrientation::Viewpoint && orientation != asked)
-    why = "; -orientation viewpoint refused: its VIEWPOINT sees it edge-on (or is not finite)";
+    why = "; -orientation viewpoint refused: its VIEWPOINT sees it edge-on or not as one scan does (or is not finite)";
   else if (asked == pcl_probcollision::NormalOrientation::PointNormals && orientation != asked)
     why = "; -orientation point_normals refused: it has no normals";
   // -closed: whether the winding number confirmed a closed solid, so that the surface has an inside.

@@ -35,9 +35,11 @@ enum class NormalOrientation
   /** \brief Toward the sensor origin (sensor_origin_): a scan sees the outside of what it
     * scans. Trusted only where the surface faces the sensor (|cos| >= 0.2); grazing points take
     * their orientation from their neighbours. A viewpoint that sees the cloud edge-on (under 1 %
-    * of the points facing it, or over a quarter of their neighbour pairs oriented apart: a sheet
-    * in the sensor's plane, whose noise tilts its normals either way) orients nothing, and the
-    * surface is propagated instead (SurfaceModel::orientation() says Propagate). */
+    * of the points facing it, or over a tenth of them on the other side from the rest of their
+    * part once one orientation is carried over it: a sheet in the sensor's plane, whose noise
+    * tilts patches of its normals either way, or a closed object's far side, which faces it from
+    * behind) orients nothing, and the surface is propagated instead (SurfaceModel::orientation()
+    * says Propagate). */
   Viewpoint,
   /** \brief Propagated over the neighbour graph (Hoppe et al. 1992) from the point farthest
     * from the centroid, pointing away from it; then each connected part is flipped if needed so
