@@ -694,7 +694,8 @@ PYBIND11_MODULE (_core, m)
       "PointNormals: the given normals, taken as outward; points without one are oriented from their neighbours\n"
       "    (none given at all: Propagate).\n"
       "Viewpoint: toward the sensor origin (the viewpoint); grazing points (|cos| < 0.2) from their neighbours;\n"
-      "    a viewpoint that sees the cloud edge-on orients nothing: Propagate (CloudModel.surface_orientation says so).\n"
+      "    a viewpoint that sees the cloud edge-on, or not as one scan does (a closed object's far side facing it\n"
+      "    from behind), orients nothing: Propagate (CloudModel.surface_orientation says so).\n"
       "Propagate: propagated over the neighbour graph from the point farthest from the centroid, then each\n"
       "    connected part flipped so that its enclosed volume is positive (closed objects). Not trusted to say\n"
       "    where the inside is (an open sheet, a room seen from within): the surface layer takes it as two-sided.")
