@@ -583,14 +583,27 @@ void
 reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, FILE* log)
 {
   const pcl_probcollision::NormalOrientation orientation = model.surface ().orientation ();
-  const char* how = "";
+  std::string how;
   switch (orientation)
   {
     case pcl_probcollision::NormalOrientation::PointNormals:
       how = in.kind == InputKind::Mesh ? "its faces' outward normals"
                                        : "the file's normal_x normal_y normal_z, taken as outward";
       break;
-    case pcl_probcollision::NormalOrientation::Viewpoint: how = "toward the sensor origin (VIEWPOINT)"; break;
+    case pcl_probcollision::NormalOrientation::Viewpoint:
+    {
+      // Named, because a cloud moved into another frame keeps the VIEWPOINT it was saved with
+      // (PCL's default 0 0 0): a table in a robot's base frame, oriented toward the base under
+      // it, reads everything above it as behind the table.
+      const Eigen::Vector4f& o = in.cloud->sensor_origin_;
+      char text[200];
+      std::snprintf (text, sizeof text,
+                     "toward the sensor origin, VIEWPOINT %.6g %.6g %.6g (-orientation propagate if the cloud was "
+                     "moved after it was scanned)",
+                     static_cast<double> (o.x ()), static_cast<double> (o.y ()), static_cast<double> (o.z ()));
+      how = text;
+      break;
+    }
     case pcl_probcollision::NormalOrientation::Propagate: how = "propagated over the neighbours"; break;
     case pcl_probcollision::NormalOrientation::Auto: break;
   }
@@ -618,8 +631,8 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
            percent (pcl_probcollision::SurfaceModel::kMinSolidShare) + ")";
   else if (orientation == pcl_probcollision::NormalOrientation::Propagate)
     why += "; two-sided (-closed if it samples closed solids)";
-  std::fprintf (log, "Orienting %s [%s: %s%s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation), how,
-                why.c_str ());
+  std::fprintf (log, "Orienting %s [%s: %s%s]\n", in.path.c_str (), pcl_probcollision::orientationName (orientation),
+                how.c_str (), why.c_str ());
 }
 
 /** \brief Terminal progress lines (Progress, BuildTicker) appear only after this long: short runs
