@@ -253,9 +253,10 @@ private:
   * edge-on has patches tilted toward the sensor and away, each consistent inside (its normals
   * share their neighbours), so neighbour pairs rarely disagree but the patches do. Breadth
   * first, over edges whose normals are within kCarryCosine (not Propagation's most-parallel-first
-  * queue: on a 209,280-point stereo scan that added 12 % to the surface model's build, this 1-4 %). */
+  * queue: on a 209,280-point stereo scan that added 12 % to the surface model's build, this 1-4 %,
+  * measured with a 60-degree limit). */
 double
-viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normals, const std::vector<int>& seeds)
+viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normals, const std::vector<int>& component)
 {
   const std::size_t n = normals.size ();
   std::vector<int> part (n, -1);
@@ -265,7 +266,7 @@ viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normal
   queue.reserve (n);
   for (std::size_t s = 0; s < n; ++s)
   {
-    if (seeds[s] != 0 || part[s] >= 0)
+    if (component[s] != 0 || part[s] >= 0)
       continue;
     const int id = static_cast<int> (votes.size ());
     votes.push_back ({0, 0});
@@ -275,7 +276,7 @@ viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normal
     for (std::size_t head = 0; head < queue.size (); ++head)
     {
       const std::size_t i = static_cast<std::size_t> (queue[head]);
-      if (seeds[i] == 0)
+      if (component[i] == 0)
         ++votes[static_cast<std::size_t> (id)][side[i] > 0 ? 0 : 1];
       for (int e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e)
       {

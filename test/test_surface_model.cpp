@@ -802,10 +802,9 @@ closedObjects (CloudModelParams p)
 // A sheet seen edge-on as in SurfaceModel.ASheetSeenEdgeOnIsTwoSided, with a coarser noise (2 mm
 // at 1 cm spacing, drawn in all three coordinates) and the sensor at three places in the sheet's
 // plane, eight draws each; a 20 cm box sampled every 1 cm with the same noise held 3 cm above it
-// or under it. The noise tilts whole patches
-// of normals (they share their neighbours) toward the sensor or away: neighbour pairs rarely
-// point apart, but the patches disagree once one orientation is propagated over the sheet
-// (27-50 % of the facing points). Before 2026-12-02 (neighbour pairs counted) 6 of these 24
+// or under it. The noise tilts whole patches of normals (they share their neighbours) toward the
+// sensor or away: neighbour pairs rarely point apart, but the patches disagree once one
+// orientation is carried over the sheet (27-50 % of the facing points). Before 2026-12-02 (neighbour pairs counted) 6 of these 24
 // kept the viewpoint, and each of them read the box 3 cm clear on one side as inside, P = 1.
 TEST (SurfaceModel, ASheetSeenEdgeOnThroughCoarseNoiseIsTwoSided)
 {
