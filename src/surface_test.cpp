@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <tuple>
 #include <utility>
 
@@ -116,18 +117,100 @@ sheetThickness (const Sample& s)
   return 0.5 * std::max (s.spacing, 1e-12) + 3.0 * std::sqrt (std::max (s.variance, 0.0));
 }
 
+/** \brief The samples of the surface leaves paired with one query leaf, ordered by their
+  * distance from the leaf's centre (the key), so that a search about a point x can stop early:
+  * |p - x| >= |key(p) - key(x)|. Sorted lazily, as far as the searches have asked: a prefix in
+  * (key, sample) order holding every entry whose key is at most limit(). Where the noise is wide
+  * against the spacing (leaf boxes grown by 3 deviations) a pool holds thousands of samples
+  * while a point's search ends within a few spacings: sorting every pool whole took a third of
+  * the query of a scan against itself. The prefix is always the whole sort's, so every search
+  * visits the samples in the same order as over a sorted pool. */
+class SortedPool
+{
+public:
+  void
+  clear ()
+  {
+    entries_.clear ();
+    sorted_ = 0;
+    limit_ = -std::numeric_limits<double>::infinity ();
+  }
+  void
+  add (double key, int sample)
+  {
+    entries_.emplace_back (key, sample);
+  }
+  bool
+  empty () const
+  {
+    return entries_.empty ();
+  }
+  /** \brief The sorted prefix's length: entries [0, sorted()) are in order. */
+  std::size_t
+  sorted () const
+  {
+    return sorted_;
+  }
+  double
+  key (std::size_t k) const
+  {
+    return entries_[k].first;
+  }
+  int
+  sample (std::size_t k) const
+  {
+    return entries_[k].second;
+  }
+  /** \brief Sorts every entry with key <= limit into the prefix. */
+  void
+  sortThrough (double limit)
+  {
+    if (limit <= limit_ || sorted_ == entries_.size ())
+      return;
+    const auto rest = entries_.begin () + static_cast<std::ptrdiff_t> (sorted_);
+    const auto end = std::partition (rest, entries_.end (), [limit] (const std::pair<double, int>& e) { return e.first <= limit; });
+    std::sort (rest, end);
+    sorted_ = static_cast<std::size_t> (end - entries_.begin ());
+    limit_ = limit;
+  }
+  /** \brief Sorts at least one more entry into the prefix (unless all are), the limit at
+    * least doubled, so that a search that needs many costs a few partitions. */
+  void
+  grow ()
+  {
+    if (sorted_ == entries_.size ())
+      return;
+    double smallest = std::numeric_limits<double>::infinity ();
+    for (std::size_t k = sorted_; k < entries_.size (); ++k)
+      smallest = std::min (smallest, entries_[k].first);
+    sortThrough (std::max (smallest, 2.0 * std::max (limit_, 0.0)));
+  }
+  /** \brief The prefix's entries with keys in [low, high]: [begin, end) indices. */
+  std::pair<std::size_t, std::size_t>
+  window (double low, double high)
+  {
+    sortThrough (high);
+    const auto first = entries_.begin ();
+    const auto last = first + static_cast<std::ptrdiff_t> (sorted_);
+    auto begin = std::lower_bound (first, last, low, [] (const std::pair<double, int>& e, double v) { return e.first < v; });
+    auto end = std::upper_bound (begin, last, high, [] (double v, const std::pair<double, int>& e) { return v < e.first; });
+    return {static_cast<std::size_t> (begin - first), static_cast<std::size_t> (end - first)};
+  }
+
+private:
+  std::vector<std::pair<double, int>> entries_;
+  std::size_t sorted_ = 0;
+  double limit_ = -std::numeric_limits<double>::infinity ();
+};
+
 /** \brief Per-thread buffers: a query allocates nothing once they have grown. */
 struct Scratch
 {
   std::vector<std::uint32_t> pooled, cached;  ///< stamps per point of the surface's model
   std::vector<Sample> cache;                  ///< the surface's samples mapped into A's frame
-  std::vector<int> pool;
+  SortedPool pool;
   std::vector<int> wide;              ///< one leaf's samples within the bridging reach (farRimAnywhere)
   std::vector<std::int32_t> stack;    ///< its hierarchy walk
-  /** \brief Per pool entry, its sample's distance from the query leaf's centre; pool and keys
-    * sorted by it, so that a nearest-sample search can stop early (triangle inequality). */
-  std::vector<double> keys;
-  std::vector<std::pair<double, int>> order;
   std::uint32_t stamp = 0;
   /** \brief The side's surface is two-sided: its orientation does not say where its inside is (SurfaceModel::insideKnown). */
   bool two_sided = false;
@@ -224,31 +307,56 @@ quarterBit (const Eigen::Vector3d& v, const Eigen::Vector3d& u, const Eigen::Vec
   return std::abs (cu) >= std::abs (cw) ? (cu > 0.0 ? 1 : 2) : (cw > 0.0 ? 4 : 8);
 }
 
+/** \brief Candidate samples for a search about a point: any (radius, test) is true when `test`
+  * holds for a candidate; those within `radius` of the point are among the candidates. The
+  * pool's, about a point at x_key from the query leaf's centre: only keys within radius of it. */
+auto
+inPool (SortedPool& pool, double x_key)
+{
+  return [&pool, x_key] (double radius, const auto& test) {
+    const auto range = pool.window (x_key - radius, x_key + radius);
+    for (std::size_t k = range.first; k < range.second; ++k)
+      if (test (pool.sample (k)))
+        return true;
+    return false;
+  };
+}
+
+/** \brief ... every sample of a list. */
+auto
+inList (const std::vector<int>& list)
+{
+  return [&list] (double, const auto& test) {
+    for (const int j : list)
+      if (test (j))
+        return true;
+    return false;
+  };
+}
+
 /** \brief True when samples of the surface lie beyond x, seen from its nearest sample `first`
   * (offset along its normal `along`, `tangential` across it, > 0): in its plane (within half its
   * spacing and the noise), farther along the same direction (within 60 degrees), on the same
   * face, within `reach` of its gaps. x then lies over a hole, not past an edge. */
+template <typename Candidates>
 bool
 farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tangential, double reach,
-        const std::vector<int>& pool, const std::vector<Sample>& samples)
+        const Candidates& candidates, const std::vector<Sample>& samples)
 {
   const Eigen::Vector3d offset = x - first.position;
   const Eigen::Vector3d u = (offset - along * first.normal) / tangential;
   const double reach2 = (reach * first.gap) * (reach * first.gap);
   const double thickness = sheetThickness (first);
-  for (const int j : pool)
-  {
+  return candidates (reach * first.gap, [&] (int j) {
     const Sample& s = samples[static_cast<std::size_t> (j)];
     const Eigen::Vector3d v = s.position - x;
     const double height = first.normal.dot (v);
     // Across the gap: within 60 degrees of u in the plane (a sample off to the side, beside an
     // edge, is not a far rim), on the same face (not the far face of a thin sheet).
-    if (s.normal.dot (first.normal) > kSameFaceCosine &&
-        v.dot (u) > 0.5 * std::sqrt (std::max (0.0, v.squaredNorm () - height * height)) &&
-        std::abs (height + along) < thickness && v.squaredNorm () < reach2)
-      return true;
-  }
-  return false;
+    return s.normal.dot (first.normal) > kSameFaceCosine &&
+           v.dot (u) > 0.5 * std::sqrt (std::max (0.0, v.squaredNorm () - height * height)) &&
+           std::abs (height + along) < thickness && v.squaredNorm () < reach2;
+  });
 }
 
 /** \brief True when samples of the sheet `first` lies on (x's nearest sample, with normal n)
@@ -259,8 +367,9 @@ farRim (const Eigen::Vector3d& x, const Sample& first, double along, double tang
   * about the spacing (the evaluation's piano at 0.5 %), a plane fit's normals scatter by 30-90
   * degrees, and a test within 45 degrees of first's dropped half of the samples around a
   * crossing, which then read as passing beside the sheet's edge. */
+template <typename Candidates>
 bool
-surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const std::vector<int>& pool,
+surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const Candidates& candidates,
             const std::vector<Sample>& samples)
 {
   const double h = std::max (first.spacing, 1e-12);
@@ -273,17 +382,14 @@ surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const s
   const double thickness = sheetThickness (first);
   const double along = n.dot (offset);
   int quarters = 0;
-  for (const int j : pool)
-  {
+  return candidates (reach * h, [&] (int j) {
     const Sample& s = samples[static_cast<std::size_t> (j)];
     const Eigen::Vector3d v = s.position - x;
     if (v.squaredNorm () >= reach2 || std::abs (n.dot (v) + along) >= thickness)
-      continue;
+      return false;
     quarters |= quarterBit (v, u, w);
-    if (quarters == 15)
-      return true;
-  }
-  return false;
+    return quarters == 15;
+  });
 }
 
 /** \brief x against the pool: implicit surface f(x) = sum w_j n_j . (x - p_j) / sum w_j of the
@@ -291,19 +397,30 @@ surrounded (const Eigen::Vector3d& x, const Sample& first, double reach, const s
   * covariance along the normal (variance_of), the fit's error and the discretisation. */
 template <typename VarianceOf>
 bool
-evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vector<double>& keys, double x_key,
-          const std::vector<Sample>& samples, const VarianceOf& variance_of, bool two_sided, Evaluation& out)
+evaluate (const Eigen::Vector3d& x, SortedPool& pool, double x_key, const std::vector<Sample>& samples,
+          const VarianceOf& variance_of, bool two_sided, Evaluation& out)
 {
   std::array<int, kSurfaceNeighbours> nearest;
   std::array<double, kSurfaceNeighbours> d2;
   int found = 0;
-  for (std::size_t k = 0; k < pool.size (); ++k)
+  for (std::size_t k = 0;; ++k)
   {
+    if (k == pool.sorted ())
+    {
+      // Sort on as far as the 8th nearest so far reaches (a hair farther, so that no entry
+      // left out could pass the test below), or further while fewer are found.
+      if (found == kSurfaceNeighbours)
+        pool.sortThrough (x_key + std::sqrt (d2[kSurfaceNeighbours - 1]) * (1.0 + 1e-9) + 1e-300);
+      else
+        pool.grow ();
+      if (k == pool.sorted ())
+        break;
+    }
     // |p - x| >= key(p) - key(x): past this, no sample is nearer than the current 8th.
-    const double bound = keys[k] - x_key;
+    const double bound = pool.key (k) - x_key;
     if (found == kSurfaceNeighbours && bound > 0.0 && bound * bound >= d2[kSurfaceNeighbours - 1])
       break;
-    const int j = pool[k];
+    const int j = pool.sample (k);
     const double d = (samples[static_cast<std::size_t> (j)].position - x).squaredNorm ();
     if (found == kSurfaceNeighbours && d >= d2[kSurfaceNeighbours - 1])
       continue;
@@ -335,7 +452,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   out.first = nearest[0];
   out.tangential = tangential;
   const bool past_edge =
-    tangential > kBridgeSpacings * g || (tangential > g && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples));
+    tangential > kBridgeSpacings * g || (tangential > g && !farRim (x, first, along, tangential, kBridgeSpacings, inPool (pool, x_key), samples));
   out.bridged = !past_edge && tangential > g;
   if (past_edge)
   {
@@ -448,12 +565,11 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
     const double thickness = sheetThickness (s);
     const double reach = kCorroborationGaps * g;
     const double reach2 = reach * reach;
-    // The pool is sorted by key (distance from the query leaf's centre), and |p - x| >=
-    // |key(p) - key(x)|: only keys within reach of x's can hold such a sample.
-    const auto begin = std::lower_bound (keys.begin (), keys.end (), x_key - reach);
-    for (auto it = begin; it != keys.end () && *it <= x_key + reach; ++it)
+    // |p - x| >= |key(p) - key(x)|: only keys within reach of x's can hold such a sample.
+    const auto range = pool.window (x_key - reach, x_key + reach);
+    for (std::size_t k = range.first; k < range.second; ++k)
     {
-      const int j = pool[static_cast<std::size_t> (it - keys.begin ())];
+      const int j = pool.sample (k);
       const Sample& o = samples[static_cast<std::size_t> (j)];
       if (j != lone && o.normal.dot (s.normal) >= kSameFaceCosine && std::abs (s.normal.dot (o.position - s.position)) < thickness &&
           (o.position - x).squaredNorm () < reach2)
@@ -532,7 +648,7 @@ evaluate (const Eigen::Vector3d& x, const std::vector<int>& pool, const std::vec
   const double open_reach = first.open.norm ();
   const bool toward_open = tangential > 0.0 && open_reach > 0.0 && tangential <= open_reach &&
                            first.open.dot (offset - along * first.normal) > first.open_cos * tangential * open_reach;
-  if (!inside_face && toward_open && !farRim (x, first, along, tangential, kBridgeSpacings, pool, samples))
+  if (!inside_face && toward_open && !farRim (x, first, along, tangential, kBridgeSpacings, inPool (pool, x_key), samples))
   {
     const double sigma_plane = std::sqrt (own_var + chosen.fit_var);
     const double p_plane = normalCdf (-chosen.f / std::max (sigma_plane, 1e-300));
@@ -743,8 +859,8 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
   // the point itself is as uncertain as the pair.
   const Eigen::Vector3d x = a.x + (a.distance / (a.distance - g)) * v;
   Evaluation at;
-  if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
-                 [] (const Eigen::Vector3d&) { return 0.0; }, scratch.two_sided, at))
+  const double x_key = (x - center).norm ();
+  if (!evaluate (x, scratch.pool, x_key, scratch.cache, [] (const Eigen::Vector3d&) { return 0.0; }, scratch.two_sided, at))
     return;
   const Sample& first = scratch.cache[static_cast<std::size_t> (at.first)];
   // Where the noise blurs the sheet's edges, the pair's own ends (kCrossingResolvedSigmas).
@@ -762,7 +878,7 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     b_end = &b;
     b_reach = b.distance;
   }
-  if (!surrounded (x, first, kCrossingSpacings, scratch.pool, scratch.cache))
+  if (!surrounded (x, first, kCrossingSpacings, inPool (scratch.pool, x_key), scratch.cache))
   {
     const double h = std::max (first.spacing, 1e-12);
     const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));
@@ -957,7 +1073,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         cacheSample (sj);
         scratch.wide.push_back (j);
       }
-      if (farRim (x, first, along, e.tangential, kBridgeSpacings, scratch.wide, scratch.cache))
+      if (farRim (x, first, along, e.tangential, kBridgeSpacings, inList (scratch.wide), scratch.cache))
         return true;
     }
     return false;
@@ -972,6 +1088,8 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
     const std::int32_t q_leaf = groups[g].first;
     // The pool: every sample of the surface leaves paired with this query leaf, once.
     const std::uint32_t pool_stamp = scratch.next ();
+    // Keyed by distance from the query leaf's centre (sorted as the searches need).
+    const Eigen::Vector3d center = T_q * q_bvh.node (q_leaf).box.center;
     scratch.pool.clear ();
     for (; g < groups.size () && groups[g].first == q_leaf; ++g)
       for (const int j : s_bvh.indices (s_bvh.node (groups[g].second)))
@@ -981,22 +1099,10 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
           continue;
         scratch.pooled[sj] = pool_stamp;
         cacheSample (sj);
-        scratch.pool.push_back (j);
+        scratch.pool.add ((scratch.cache[sj].position - center).norm (), j);
       }
     if (scratch.pool.empty ())
       continue;
-    // The pool sorted by distance from the query leaf's centre.
-    const Eigen::Vector3d center = T_q * q_bvh.node (q_leaf).box.center;
-    scratch.order.clear ();
-    for (const int j : scratch.pool)
-      scratch.order.emplace_back ((scratch.cache[static_cast<std::size_t> (j)].position - center).norm (), j);
-    std::sort (scratch.order.begin (), scratch.order.end ());
-    scratch.keys.resize (scratch.order.size ());
-    for (std::size_t k = 0; k < scratch.order.size (); ++k)
-    {
-      scratch.keys[k] = scratch.order[k].first;
-      scratch.pool[k] = scratch.order[k].second;
-    }
     scratch.outside.clear ();
     for (const int i : q_bvh.indices (q_bvh.node (q_leaf)))
     {
@@ -1004,7 +1110,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const Eigen::Vector3d x = T_q * q_bvh.means ()[qi];
       const PackedCovariance& cov = q_bvh.covariances ()[qi];
       Evaluation e;
-      if (!evaluate (x, scratch.pool, scratch.keys, (x - center).norm (), scratch.cache,
+      if (!evaluate (x, scratch.pool, (x - center).norm (), scratch.cache,
                      [&] (const Eigen::Vector3d& n) { return std::max (0.0, cov.quadratic (R_q.transpose () * n)); },
                      scratch.two_sided, e))
         continue;
@@ -1070,7 +1176,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
 /** \brief Sorts the leaf pairs by their first leaf (ids below `nodes`), keeping the order
   * within a leaf: a counting sort, linear where std::sort cost 5 % of a query. testSide needs
   * them grouped, in ascending order (which leaf comes first decides where decision mode stops);
-  * the order within a group does not matter (the pool is sorted by distance). */
+  * the order within a group does not matter (the pool is ordered by distance). */
 void
 groupByFirst (std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::size_t nodes, Scratch& scratch)
 {
