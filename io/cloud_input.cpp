@@ -379,20 +379,40 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
   return true;
 }
 
-/** \brief x y z of every point, converted from whatever numeric type the file has; organization kept. */
+/** \brief x y z of every point, converted from whatever numeric type the file has; organization
+  * kept. rounding, when given, gets what the conversion to float cost. */
 template <typename PointT>
 void
-copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud)
+copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud, XyzRounding* rounding)
 {
   cloud.resize (file.size);
+  XyzRounding cost;
   for (std::size_t j = 0; j < file.size; ++j)
-  {
-    cloud[j].x = static_cast<float> (file.value (j, file.xyz[0]));
-    cloud[j].y = static_cast<float> (file.value (j, file.xyz[1]));
-    cloud[j].z = static_cast<float> (file.value (j, file.xyz[2]));
-  }
+    for (int i = 0; i < 3; ++i)
+    {
+      const double stored = file.value (j, file.xyz[i]);
+      const float kept = static_cast<float> (stored);
+      cloud[j].data[i] = kept;
+      if (std::isfinite (stored))
+      {
+        cost.largest_change = std::max (cost.largest_change, std::abs (stored - static_cast<double> (kept)));
+        cost.largest_magnitude = std::max (cost.largest_magnitude, std::abs (stored));
+      }
+    }
   cloud.width = file.blob.width;
   cloud.height = file.blob.height;
+  if (rounding)
+    *rounding = cost;
+}
+
+/** \brief Whether the file stores x y z as float32, which PCL's points hold exactly. */
+bool
+xyzAreFloat (const CloudFile& file)
+{
+  bool all_float = true;
+  for (int i = 0; i < 3; ++i)
+    all_float = all_float && file.blob.fields[static_cast<std::size_t> (file.xyz[i])].datatype == pcl::PCLPointField::FLOAT32;
+  return all_float;
 }
 
 /** \brief The viewpoint, a fresh header and is_dense (every x y z finite). */
@@ -411,33 +431,34 @@ finishCloud (const CloudFile& file, pcl::PointCloud<PointT>& cloud)
 } // namespace
 
 bool
-loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error)
+loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error, XyzRounding* rounding)
 {
   cloud.clear ();
+  if (rounding)
+    *rounding = XyzRounding ();
   CloudFile file;
   if (!readCloudFile (path, false, file, error))
     return false;
-  bool all_float = true;
-  for (int i = 0; i < 3; ++i)
-    all_float = all_float && file.blob.fields[static_cast<std::size_t> (file.xyz[i])].datatype == pcl::PCLPointField::FLOAT32;
-  if (all_float)
+  if (xyzAreFloat (file))
     pcl::fromPCLPointCloud2 (file.blob, cloud);
   else
-    copyXyz (file, cloud);
+    copyXyz (file, cloud, rounding);
   finishCloud (file, cloud);
   return true;
 }
 
 bool
 loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,
-                      std::string& error)
+                      std::string& error, XyzRounding* rounding)
 {
   cloud.clear ();
   has_normals = false;
+  if (rounding)
+    *rounding = XyzRounding ();
   CloudFile file;
   if (!readCloudFile (path, true, file, error))
     return false;
-  copyXyz (file, cloud);
+  copyXyz (file, cloud, xyzAreFloat (file) ? nullptr : rounding);
   has_normals = file.normal[0] >= 0;
   const float nan = std::numeric_limits<float>::quiet_NaN ();
   for (std::size_t j = 0; j < file.size; ++j)

@@ -16,12 +16,24 @@ namespace pcl_probcollision
 {
 namespace io
 {
+/** \brief What storing a file's x y z in PCL's float points cost: the largest change of a finite
+  * stored x, y or z by the conversion, and the largest |coordinate| (both 0 when the file stores
+  * them as float32, which converts exactly). A float keeps 24 bits: a float64 cloud 10 km from
+  * its origin is kept to about 0.5 mm, one in UTM coordinates (thousands of km) to metres. */
+struct XyzRounding
+{
+  double largest_change = 0.0;
+  double largest_magnitude = 0.0;
+};
+
 /** \brief Loads any PCD with x y z fields into PointXYZ, keeping width/height (organization),
   * NaN points and the VIEWPOINT (sensor_origin_, sensor_orientation_); a .ply (extension
   * case-insensitive) goes through PCL's PLY reader, its camera element giving the viewpoint. x y z
   * of any numeric type are converted. False with a reason naming the file when the file is
-  * unreadable, malformed or truncated, has no x y z, or has no points. */
-bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error);
+  * unreadable, malformed or truncated, has no x y z, or has no points. rounding, when given,
+  * gets what the conversion to float cost. */
+bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::string& error,
+                XyzRounding* rounding = nullptr);
 
 /** \brief loadCloud (the same reader, checks and messages) with the file's normals: when the file
   * has all of normal_x normal_y normal_z (any numeric type, converted; a PLY's nx ny nz as PCL's
@@ -31,7 +43,7 @@ bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, 
   * has_normals is false and every normal is NaN. False with a reason naming the file and the
   * missing field when only some of the three are there (e.g. normal_x alone). Curvature is 0. */
 bool loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,
-                           std::string& error);
+                           std::string& error, XyzRounding* rounding = nullptr);
 
 /** \brief One value of a PCLPointCloud2 field as double, whatever its numeric type (NaN for an
   * unknown type): the one reader of stored x y z (and normals) for clouds and meshes. */

@@ -93,6 +93,8 @@ struct Input
     * (with -surface) a cloud with the normals its file stores; null for other clouds. */
   pcl::PointCloud<pcl::PointNormal>::Ptr oriented;
   std::size_t finite = 0;
+  /** \brief What holding a cloud file's x y z in float points cost (loadCloud). */
+  pcl_probcollision::io::XyzRounding rounding;
   double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
   std::string spacing_source;
   double load_ms = 0.0;
@@ -139,13 +141,13 @@ loadInput (Input& in, bool with_normals, FILE* log)
     {
       auto oriented = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>> ();
       bool has_normals = false;
-      if (!loadCloudWithNormals (in.path, *oriented, has_normals, error))
+      if (!loadCloudWithNormals (in.path, *oriented, has_normals, error, &in.rounding))
         throw Failure{kRuntimeFailure, error};
       pcl::copyPointCloud (*oriented, *in.cloud);
       if (has_normals)
         in.oriented = oriented;
     }
-    else if (!loadCloud (in.path, *in.cloud, error))
+    else if (!loadCloud (in.path, *in.cloud, error, &in.rounding))
       throw Failure{kRuntimeFailure, error};
     in.finite = countFinite (*in.cloud);
     if (in.finite == 0)
@@ -577,6 +579,36 @@ warnIfNoiseImplausible (const Input& in, double diagonal, const std::string& sen
                   sigma, in.path.c_str (), sigma / diagonal, diagonal);
 }
 
+/** \brief A cloud stored as float64 far from its origin loses its precision in PCL's float
+  * points (24 bits: about 0.5 mm at 10 km). Warn on stderr when the conversion moved a
+  * coordinate by more than CloudModel::kPrecisionWarningRatio (a tenth) of the cloud's isotropic
+  * sigma, or, with a depth sensor's model, by more than kNoiseWarningRatio of its size (no sensor
+  * is that precise): the answer is then for the rounded cloud. The model's own precision warning
+  * (CloudModel::warning) sees only the float points, and judges their spacing against their
+  * spread, discretisation included; this one knows what the file held. diagonal is
+  * inputDiagonal (in). */
+void
+warnIfPrecisionLost (const Input& in, double diagonal, const std::string& sensor, double sigma)
+{
+  const double change = in.rounding.largest_change;
+  if (in.kind != InputKind::Cloud || !(change > 0.0))
+    return;
+  const bool isotropic = sensor == "isotropic";
+  const double limit = isotropic ? pcl_probcollision::CloudModel::kPrecisionWarningRatio * sigma : kNoiseWarningRatio * diagonal;
+  if (!(change > limit))
+    return;
+  char scale[120];
+  if (isotropic)
+    std::snprintf (scale, sizeof scale, "%.2g of its sigma %.6g", change / sigma, sigma);
+  else
+    std::snprintf (scale, sizeof scale, "%.2g of its size, bounding-box diagonal %.6g", change / diagonal, diagonal);
+  std::fprintf (stderr,
+                "pcd_collision: warning: '%s' stores x y z in double precision up to %.6g from its origin; PCL's "
+                "float points keep them to within %.3g (%s), and the answer is for the rounded cloud; move the "
+                "inputs nearer the origin to keep it (docs/CLI.md, \"Coordinates far from the origin\")\n",
+                in.path.c_str (), in.rounding.largest_magnitude, change, scale);
+}
+
 /** \brief The stage line of -surface that says where an input's surface normals got their
   * orientation (NormalOrientation, resolved by the model's build). */
 void
@@ -792,6 +824,8 @@ run (int argc, char** argv)
   warnIfScalesDiffer (a, diagonal_a, b, diagonal_b);
   warnIfNoiseImplausible (a, diagonal_a, o.sensor_a, o.sigma_a);
   warnIfNoiseImplausible (b, diagonal_b, o.sensor_b, o.sigma_b);
+  warnIfPrecisionLost (a, diagonal_a, o.sensor_a, o.sigma_a);
+  warnIfPrecisionLost (b, diagonal_b, o.sensor_b, o.sigma_b);
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at

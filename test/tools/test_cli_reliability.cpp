@@ -377,6 +377,53 @@ TEST_F (CliReliability, NoiseFarBelowTheDataWarnsOnStderr)
   EXPECT_EQ (none.err.find ("noise sigma"), std::string::npos) << none.err;
 }
 
+// A cloud stored in double precision far from its origin loses that precision in PCL's float
+// points: warned once per cloud when the rounding passes a tenth of its sigma (docs/CLI.md,
+// "Coordinates far from the origin"), not when it stays under it or the file stores float32.
+TEST_F (CliReliability, DoubleCoordinatesFarFromTheOriginWarnOnStderr)
+{
+  Cloud scene;
+  ASSERT_EQ (pcl::io::loadPCDFile (kScene.string (), scene), 0);
+  // The scene as float64 ascii, moved by `offset` along x (exact in double).
+  auto saveDouble = [&] (const std::string& name, double offset) {
+    std::ostringstream text;
+    text.precision (17);
+    text << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " << scene.size ()
+         << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << scene.size () << "\nDATA ascii\n";
+    for (const auto& p : scene.points)
+      text << static_cast<double> (p.x) + offset << ' ' << p.y << ' ' << p.z << '\n';
+    writeFile (dir_ / name, text.str ());
+    return (dir_ / name).string ();
+  };
+  // 10 km out a float keeps about 0.5 mm: 0.24 of -sigma 0.002.
+  const std::string far = saveDouble ("far.pcd", 10000.0);
+  const Run warned = run ({far, far, "-sigma", "0.002"});
+  EXPECT_EQ (warned.status, 0) << warned.err;
+  ASSERT_EQ (warned.json.size (), 1u);  // stdout stays pure JSON
+  const std::string message = "pcd_collision: warning: '" + far + "' stores x y z in double precision up to 10000.";
+  const std::size_t first = warned.err.find (message);
+  ASSERT_NE (first, std::string::npos) << warned.err;
+  EXPECT_NE (warned.err.find (message, first + 1), std::string::npos) << "one warning per cloud\n" << warned.err;
+  EXPECT_NE (warned.err.find ("of its sigma 0.002"), std::string::npos) << warned.err;
+  EXPECT_NE (warned.err.find ("Coordinates far from the origin"), std::string::npos) << warned.err;
+  // With a depth sensor's model, judged against the cloud's size instead (0.74 m: 4.9e-4 > 1e-5).
+  const Run kinect = run ({far, far, "-sensor", "kinect"});
+  EXPECT_NE (kinect.err.find ("of its size"), std::string::npos) << kinect.err;
+  // 1 km out: about 0.06 mm, under a tenth of the sigma: no warning, the same answer as the
+  // scene at its own place within the rounding's effect.
+  const Run near = run ({saveDouble ("near.pcd", 1000.0), kScene.string (), "-sigma", "0.002", "-pose", "-1000,0,0,0,0,0"});
+  EXPECT_EQ (near.status, 0) << near.err;
+  EXPECT_EQ (near.err.find ("warning"), std::string::npos) << near.err;
+  // The same far cloud stored as float32 was rounded when written: not judged.
+  Cloud far_float = scene;
+  for (auto& p : far_float.points)
+    p.x = static_cast<float> (static_cast<double> (p.x) + 10000.0);
+  const std::string stored = save ("far_float.pcd", far_float);
+  const Run floats = run ({stored, stored, "-sigma", "0.002"});
+  EXPECT_EQ (floats.status, 0) << floats.err;
+  EXPECT_EQ (floats.err.find ("warning"), std::string::npos) << floats.err;
+}
+
 // A few points have no telling extent: a two-point probe 1 mm long against the 0.74 m scene
 // (740x) is legitimate. From 50 finite points on (docs/CLI.md) the extent is judged.
 TEST_F (CliReliability, UnitsWarningNeedsEnoughPoints)

@@ -226,3 +226,38 @@ TEST_F (CloudInput, PlyNormals)
   EXPECT_NE (error.find ("partial.ply"), std::string::npos) << error;
   EXPECT_NE (error.find ("'normal_y'"), std::string::npos) << error;
 }
+
+// What holding x y z in float costs: reported for a float64 file (the largest change and the
+// largest |coordinate|, NaN points left out), nothing for a float32 one, by both loaders.
+TEST_F (CloudInput, TheRoundingOfDoubleCoordinatesIsReported)
+{
+  // 10 km out a float keeps steps of 2^-10 (about 1 mm): 10000.0003 is kept as 10000.0
+  // (a change of 0.0003), 10000.0007 as 10000.0009765625 (a change of 0.0002765625).
+  writeFile (dir_ / "far.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n" +
+                                   kHeaderTail +
+                                   "10000.0003 0 1\n"
+                                   "10000.0007 0 1\n"
+                                   "-20000.5 0.25 1\n"
+                                   "nan nan nan\n");
+  writeFile (dir_ / "near.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n" +
+                                    kHeaderTail + "10000.0003 0 1\n0 0 1\n1 0 1\n0 1 1\n");
+  std::string error;
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl_probcollision::io::XyzRounding rounding;
+  ASSERT_TRUE (loadCloud (path ("far.pcd"), cloud, error, &rounding)) << error;
+  EXPECT_NEAR (rounding.largest_change, 0.0003, 1e-9);
+  EXPECT_EQ (rounding.largest_magnitude, 20000.5);
+  EXPECT_EQ (cloud[0].x, 10000.0f);
+  pcl::PointCloud<pcl::PointNormal> with_normals;
+  bool has_normals = true;
+  pcl_probcollision::io::XyzRounding same;
+  ASSERT_TRUE (loadCloudWithNormals (path ("far.pcd"), with_normals, has_normals, error, &same)) << error;
+  EXPECT_EQ (same.largest_change, rounding.largest_change);
+  EXPECT_EQ (same.largest_magnitude, rounding.largest_magnitude);
+  // Stored as float32: rounded when written, nothing to report (and a stale value is cleared).
+  ASSERT_TRUE (loadCloud (path ("near.pcd"), cloud, error, &rounding)) << error;
+  EXPECT_EQ (rounding.largest_change, 0.0);
+  EXPECT_EQ (rounding.largest_magnitude, 0.0);
+  ASSERT_TRUE (loadCloudWithNormals (path ("near.pcd"), with_normals, has_normals, error, &same)) << error;
+  EXPECT_EQ (same.largest_change, 0.0);
+}
