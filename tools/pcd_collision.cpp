@@ -95,6 +95,8 @@ struct Input
   std::size_t finite = 0;
   /** \brief What holding a cloud file's x y z in float points cost (loadCloud). */
   pcl_probcollision::io::XyzRounding rounding;
+  /** \brief warnIfPrecisionLost warned: the model's own precision warning would repeat it. */
+  bool precision_warned = false;
   double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
   std::string spacing_source;
   double load_ms = 0.0;
@@ -588,7 +590,7 @@ warnIfNoiseImplausible (const Input& in, double diagonal, const std::string& sen
   * spread, discretisation included; this one knows what the file held. diagonal is
   * inputDiagonal (in). */
 void
-warnIfPrecisionLost (const Input& in, double diagonal, const std::string& sensor, double sigma)
+warnIfPrecisionLost (Input& in, double diagonal, const std::string& sensor, double sigma)
 {
   const double change = in.rounding.largest_change;
   if (in.kind != InputKind::Cloud || !(change > 0.0))
@@ -607,6 +609,7 @@ warnIfPrecisionLost (const Input& in, double diagonal, const std::string& sensor
                 "float points keep them to within %.3g (%s), and the answer is for the rounded cloud; move the "
                 "inputs nearer the origin to keep it (docs/CLI.md, \"Coordinates far from the origin\")\n",
                 in.path.c_str (), in.rounding.largest_magnitude, change, scale);
+  in.precision_warned = true;
 }
 
 /** \brief The stage line of -surface that says where an input's surface normals got their
@@ -961,6 +964,10 @@ run (int argc, char** argv)
       std::fprintf (log, "Building %s [done, %.1f ms : %zu points%s, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
                     model->buildMilliseconds (), model->size (), merged, model->hierarchy ().nodes ().size (),
                     model->params ().surface ? ", surface model" : "", static_cast<double> (model->bytes ()) / 1e6);
+      // The model's own precision warning (float points whose spacing is coarse against their
+      // spread: a float32 file far from its origin), unless the file's rounding was warned of.
+      if (!model->warning ().empty () && !in->precision_warned)
+        std::fprintf (stderr, "pcd_collision: warning: '%s': %s\n", in->path.c_str (), model->warning ().c_str ());
     }
   pc.setRequest (requestFor (o));
 

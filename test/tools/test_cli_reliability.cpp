@@ -379,7 +379,8 @@ TEST_F (CliReliability, NoiseFarBelowTheDataWarnsOnStderr)
 
 // A cloud stored in double precision far from its origin loses that precision in PCL's float
 // points: warned once per cloud when the rounding passes a tenth of its sigma (docs/CLI.md,
-// "Coordinates far from the origin"), not when it stays under it or the file stores float32.
+// "Coordinates far from the origin"), not when it stays under it. A float32 file was rounded
+// when written: the model's own warning (CloudModel::warning) says so instead, never both.
 TEST_F (CliReliability, DoubleCoordinatesFarFromTheOriginWarnOnStderr)
 {
   Cloud scene;
@@ -406,6 +407,7 @@ TEST_F (CliReliability, DoubleCoordinatesFarFromTheOriginWarnOnStderr)
   EXPECT_NE (warned.err.find (message, first + 1), std::string::npos) << "one warning per cloud\n" << warned.err;
   EXPECT_NE (warned.err.find ("of its sigma 0.002"), std::string::npos) << warned.err;
   EXPECT_NE (warned.err.find ("Coordinates far from the origin"), std::string::npos) << warned.err;
+  EXPECT_EQ (warned.err.find ("float spacing"), std::string::npos) << "the model's warning repeats it\n" << warned.err;
   // With a depth sensor's model, judged against the cloud's size instead (0.74 m: 4.9e-4 > 1e-5).
   const Run kinect = run ({far, far, "-sensor", "kinect"});
   EXPECT_NE (kinect.err.find ("of its size"), std::string::npos) << kinect.err;
@@ -414,14 +416,21 @@ TEST_F (CliReliability, DoubleCoordinatesFarFromTheOriginWarnOnStderr)
   const Run near = run ({saveDouble ("near.pcd", 1000.0), kScene.string (), "-sigma", "0.002", "-pose", "-1000,0,0,0,0,0"});
   EXPECT_EQ (near.status, 0) << near.err;
   EXPECT_EQ (near.err.find ("warning"), std::string::npos) << near.err;
-  // The same far cloud stored as float32 was rounded when written: not judged.
+  // The same far cloud stored as float32 was rounded when written: the model's warning, once
+  // per cloud, naming the file.
   Cloud far_float = scene;
   for (auto& p : far_float.points)
     p.x = static_cast<float> (static_cast<double> (p.x) + 10000.0);
   const std::string stored = save ("far_float.pcd", far_float);
   const Run floats = run ({stored, stored, "-sigma", "0.002"});
   EXPECT_EQ (floats.status, 0) << floats.err;
-  EXPECT_EQ (floats.err.find ("warning"), std::string::npos) << floats.err;
+  ASSERT_EQ (floats.json.size (), 1u);
+  EXPECT_EQ (floats.err.find ("double precision"), std::string::npos) << floats.err;
+  const std::string model_warning = "pcd_collision: warning: '" + stored + "': ";
+  const std::size_t at = floats.err.find (model_warning);
+  ASSERT_NE (at, std::string::npos) << floats.err;
+  EXPECT_NE (floats.err.find ("float spacing", at), std::string::npos) << floats.err;
+  EXPECT_NE (floats.err.find (model_warning, at + 1), std::string::npos) << "one warning per cloud\n" << floats.err;
 }
 
 // A few points have no telling extent: a two-point probe 1 mm long against the 0.74 m scene
