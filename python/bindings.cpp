@@ -287,6 +287,17 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
 }
 
+/** The built model, after a RuntimeWarning with its precision warning (CloudModel::warning), if
+  * it has one: the library prints it through PCL's console, which a Python user does not watch.
+  * Under warnings.simplefilter("error") the warning is raised instead. Holds the GIL. */
+std::shared_ptr<CloudModel>
+warnedModel (const CloudModel::ConstPtr& model)
+{
+  if (!model->warning ().empty () && PyErr_WarnEx (PyExc_RuntimeWarning, model->warning ().c_str (), 1) < 0)
+    throw py::error_already_set ();
+  return std::const_pointer_cast<CloudModel> (model);
+}
+
 /** A 4x4 rigid transform from a 4x4 array or (R, t). */
 Eigen::Isometry3d
 toPose (const py::object& obj, const char* arg)
@@ -1100,8 +1111,7 @@ PYBIND11_MODULE (_core, m)
   m.def ("build_model",
          [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
              const py::object& viewpoint, const py::object& normals, bool any_length_normals) {
-           return std::const_pointer_cast<CloudModel> (
-               buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
+           return warnedModel (buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
          py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
@@ -1118,10 +1128,11 @@ PYBIND11_MODULE (_core, m)
          "    none. The points' model is the same with or without them (pcl::PointNormal instead of pcl::PointXYZ).\n"
          "any_length_normals: keyword only; True takes the normals of any length, as a file stores them (read_cloud_with_normals)\n"
          "    and as pcd_collision -surface reads them: the surface model normalizes them. False: not unit length is a ValueError.\n"
+         "A RuntimeWarning carries CloudModel.warning when the points, held in float, lost precision far from the origin.\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
-           return std::const_pointer_cast<CloudModel> (loadModel (path, params, name));
+           return warnedModel (loadModel (path, params, name));
          },
          py::arg ("path"), py::arg ("params") = py::none (), py::arg ("name") = py::none (),
          "Builds the CloudModel of a .pcd file (x y z fields, any numeric type; its VIEWPOINT is the sensor pose).\n\n"
@@ -1133,7 +1144,7 @@ PYBIND11_MODULE (_core, m)
          "    params.surface the normals are not read (they change nothing else in the model).\n"
          "FileNotFoundError for a missing file, IsADirectoryError for a directory, ValueError for a file PCL cannot\n"
          "    read or one with only some of the\n"
-         "    normal fields (with params.surface).");
+         "    normal fields (with params.surface). A RuntimeWarning carries CloudModel.warning, as build_model's.");
   m.attr ("MAX_COORDINATE") = detail::kMaxCoordinate;  // the library's coordinate and translation bound
   m.attr ("MAX_THREADS") = detail::kMaxThreads;         // the library's cap on a thread count
   // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).

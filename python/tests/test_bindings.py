@@ -4,6 +4,7 @@ immutability, and the bad-input table of docs/RELIABILITY.md."""
 import os
 import pathlib
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -824,3 +825,30 @@ def test_wrong_argument_types_and_values_are_typeerror_and_valueerror():
             pc.sample_mesh(V, [[0, 1, 2]], spacing)
         with pytest.raises(ValueError, match="spacing"):
             pc.sample_mesh_with_normals(V, [[0, 1, 2]], spacing)
+
+
+def test_a_model_that_lost_precision_far_from_the_origin_warns():
+    # 100 km out a float keeps 7.8 mm, far above a tenth of the 1 mm noise: CloudModel.warning,
+    # which Python users see as a RuntimeWarning (the library's PCL console message goes unseen).
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    points = sheet().astype(np.float64)
+    far = points + np.array([1e5, 0.0, 0.0])
+    with pytest.warns(RuntimeWarning, match="float spacing") as caught:
+        model = pc.build_model(far, params=params, name="far_sheet")
+    assert model.warning and "far_sheet" in model.warning
+    assert str(caught[0].message) == model.warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(RuntimeWarning, match="float spacing"):
+            pc.build_model(far, params=params)
+        # At the origin: no warning at all.
+        assert pc.build_model(points, params=params).warning == ""
+
+
+def test_load_model_warns_as_build_model_does(tmp_path):
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    path = tmp_path / "far.pcd"
+    write_pcd(path, sheet().astype(np.float64) + np.array([1e5, 0.0, 0.0]))
+    with pytest.warns(RuntimeWarning, match="float spacing"):
+        model = pc.load_model(path, params=params)
+    assert "far.pcd" in model.warning
