@@ -120,7 +120,8 @@ sheetThickness (const Sample& s)
 /** \brief The samples of the surface leaves paired with one query leaf, ordered by their
   * distance from the leaf's centre (the key), so that a search about a point x can stop early:
   * |p - x| >= |key(p) - key(x)|. Sorted lazily, as far as the searches have asked: a prefix in
-  * (key, sample) order holding every entry whose key is at most limit(). Where the noise is wide
+  * (key, sample) order holding every entry whose key is at most the largest limit asked of
+  * sortThrough() so far. Where the noise is wide
   * against the spacing (leaf boxes grown by 3 deviations) a pool holds thousands of samples
   * while a point's search ends within a few spacings: sorting every pool whole took a third of
   * the query of a scan against itself. The prefix is always the whole sort's, so every search
@@ -565,17 +566,11 @@ evaluate (const Eigen::Vector3d& x, SortedPool& pool, double x_key, const std::v
     const double thickness = sheetThickness (s);
     const double reach = kCorroborationGaps * g;
     const double reach2 = reach * reach;
-    // |p - x| >= |key(p) - key(x)|: only keys within reach of x's can hold such a sample.
-    const auto range = pool.window (x_key - reach, x_key + reach);
-    for (std::size_t k = range.first; k < range.second; ++k)
-    {
-      const int j = pool.sample (k);
+    return inPool (pool, x_key) (reach, [&] (int j) {
       const Sample& o = samples[static_cast<std::size_t> (j)];
-      if (j != lone && o.normal.dot (s.normal) >= kSameFaceCosine && std::abs (s.normal.dot (o.position - s.position)) < thickness &&
-          (o.position - x).squaredNorm () < reach2)
-        return true;
-    }
-    return false;
+      return j != lone && o.normal.dot (s.normal) >= kSameFaceCosine && std::abs (s.normal.dot (o.position - s.position)) < thickness &&
+             (o.position - x).squaredNorm () < reach2;
+    });
   };
   const Fit nearest_face = fit (0);
   Fit chosen = nearest_face;

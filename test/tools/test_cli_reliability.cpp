@@ -411,8 +411,7 @@ TEST_F (CliReliability, DoubleCoordinatesFarFromTheOriginWarnOnStderr)
   // With a depth sensor's model, judged against the cloud's size instead (0.74 m: 4.9e-4 > 1e-5).
   const Run kinect = run ({far, far, "-sensor", "kinect"});
   EXPECT_NE (kinect.err.find ("of its size"), std::string::npos) << kinect.err;
-  // 1 km out: about 0.06 mm, under a tenth of the sigma: no warning, the same answer as the
-  // scene at its own place within the rounding's effect.
+  // 1 km out: about 0.06 mm, under a tenth of the sigma: no warning.
   const Run near = run ({saveDouble ("near.pcd", 1000.0), kScene.string (), "-sigma", "0.002", "-pose", "-1000,0,0,0,0,0"});
   EXPECT_EQ (near.status, 0) << near.err;
   EXPECT_EQ (near.err.find ("warning"), std::string::npos) << near.err;
