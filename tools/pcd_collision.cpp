@@ -4,6 +4,7 @@
 
 #include "cli_options.h"
 #include "cloud_input.h"
+#include "input_warnings.h"
 #include "json_writer.h"
 #include "mesh_input.h"
 #include "mesh_sampling.h"
@@ -72,16 +73,6 @@ msSince (std::chrono::steady_clock::time_point start)
 }
 
 // ---------------------------------------------------------------------------------------------
-/** \brief Sizes (bounding-box diagonals) differing by more than this get a units warning. */
-constexpr double kScaleWarningRatio = 100.0;
-/** \brief Fewest finite points of a cloud whose extent the units warnings judge. A handful of
-  * points (a probe, two points 1 mm apart) has no telling size; a scan has thousands. */
-constexpr std::size_t kScaleWarningMinPoints = 50;
-/** \brief An isotropic sigma below this fraction of its cloud's bounding-box diagonal gets a
-  * units warning. No sensor is that precise on what it scans (10 um on a 1 m part is 1e-5);
-  * the default sigma, 5 mm in metres, given to a millimetre scan of a metre-sized object is
-  * 5 um there, 2.8e-6 of a piano's diagonal. */
-constexpr double kNoiseWarningRatio = 1e-5;
 
 struct Input
 {
@@ -95,8 +86,8 @@ struct Input
   std::size_t finite = 0;
   /** \brief What holding a cloud file's x y z in float points cost (loadCloud). */
   pcl_probcollision::io::XyzRounding rounding;
-  /** \brief warnIfPrecisionLost warned: the model's own precision warning would repeat it. */
-  bool precision_warned = false;
+  /** \brief What the input warnings judge of it (io/input_warnings.h), set once it is loaded. */
+  pcl_probcollision::io::InputFacts facts;
   double spacing = std::numeric_limits<double>::quiet_NaN ();  ///< mesh sample spacing
   std::string spacing_source;
   double load_ms = 0.0;
@@ -524,92 +515,27 @@ witnessLine (const pcl_probcollision::CollisionResult& r)
   return line;
 }
 
-/** \brief Bounding-box diagonal of an input as loaded: the finite points of a cloud, the vertices
-  * of a mesh (0 for a single point). */
-double
-inputDiagonal (const Input& in)
+/** \brief What the input warnings judge of an input as loaded under the options of its side;
+  * its bounding-box diagonal is a cloud's finite points' or a mesh's vertices' (0 for a single
+  * point). */
+void
+setFacts (Input& in, const std::string& sensor, double sigma)
 {
-  if (in.kind == InputKind::Mesh)
-    return meshDiagonal (in.mesh);
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
-  Eigen::Vector3d hi = -lo;
-  for (const auto& p : in.cloud->points)
-    if (std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z))
-    {
-      const Eigen::Vector3d q = p.getVector3fMap ().cast<double> ();
-      lo = lo.cwiseMin (q);
-      hi = hi.cwiseMax (q);
-    }
-  return (hi.array () >= lo.array ()).all () ? (hi - lo).norm () : 0.0;
+  in.facts.path = in.path;
+  in.facts.cloud = in.kind == InputKind::Cloud;
+  in.facts.finite = in.finite;
+  in.facts.diagonal = in.kind == InputKind::Mesh ? meshDiagonal (in.mesh) : pcl_probcollision::io::finiteDiagonal (*in.cloud);
+  in.facts.rounding = in.rounding;
+  in.facts.sensor = sensor;
+  in.facts.sigma = sigma;
 }
 
-/** \brief Both inputs must be in the same units (docs/CLI.md). A millimetre scan against a metre
-  * mesh makes sizes differ by 1000x: warn on stderr when they differ by more than 100x. A warning,
-  * not an error: a screw against a room is legitimate. Clouds under kScaleWarningMinPoints are not
-  * judged (a mesh always is: its vertices span the whole object). */
+/** \brief Prints a warning of io/input_warnings.h on stderr, if there is one. */
 void
-warnIfScalesDiffer (const Input& a, double da, const Input& b, double db)
+warn (const std::string& warning)
 {
-  for (const Input* in : {&a, &b})
-    if (in->kind == InputKind::Cloud && in->finite < kScaleWarningMinPoints)
-      return;
-  if (!(da > 0.0 && db > 0.0 && std::isfinite (da) && std::isfinite (db)))
-    return;
-  const double ratio = std::max (da, db) / std::min (da, db);
-  if (ratio > kScaleWarningRatio)
-    std::fprintf (stderr,
-                  "pcd_collision: warning: the inputs' sizes differ by %.0fx (bounding-box diagonal %.6g in '%s', "
-                  "%.6g in '%s'); both must be in the same units (e.g. metres), so convert one of them if they "
-                  "are not\n",
-                  ratio, da, a.path.c_str (), db, b.path.c_str ());
-}
-
-/** \brief -sigma is in the data's units (docs/CLI.md). Warn on stderr when a cloud's isotropic
-  * sigma is below kNoiseWarningRatio of its size: most likely the default, 0.005 (metres), on a
-  * cloud in millimetres. The answer is then for a near noise-free cloud, and its classifier fits
-  * are the hardest there are. diagonal is inputDiagonal (in). */
-void
-warnIfNoiseImplausible (const Input& in, double diagonal, const std::string& sensor, double sigma)
-{
-  if (in.kind != InputKind::Cloud || sensor != "isotropic" || in.finite < kScaleWarningMinPoints)
-    return;
-  if (sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal) && sigma < kNoiseWarningRatio * diagonal)
-    std::fprintf (stderr,
-                  "pcd_collision: warning: the noise sigma %.6g of '%s' is %.2g of its size (bounding-box "
-                  "diagonal %.6g); sigma is in the data's units (the default 0.005 is 5 mm in metres), so give "
-                  "-sigma in the cloud's units (e.g. -sigma 5 for millimetres)\n",
-                  sigma, in.path.c_str (), sigma / diagonal, diagonal);
-}
-
-/** \brief A cloud stored as float64 far from its origin loses its precision in PCL's float
-  * points (24 bits: about 0.5 mm at 10 km). Warn on stderr when the conversion moved a
-  * coordinate by more than CloudModel::kPrecisionWarningRatio (a tenth) of the cloud's isotropic
-  * sigma, or, with a depth sensor's model, by more than kNoiseWarningRatio of its size (no sensor
-  * is that precise): the answer is then for the rounded cloud. The model's own precision warning
-  * (CloudModel::warning) sees only the float points, and judges their spacing against their
-  * spread, discretisation included; this one knows what the file held. diagonal is
-  * inputDiagonal (in). */
-void
-warnIfPrecisionLost (Input& in, double diagonal, const std::string& sensor, double sigma)
-{
-  const double change = in.rounding.largest_change;
-  if (in.kind != InputKind::Cloud || !(change > 0.0))
-    return;
-  const bool isotropic = sensor == "isotropic";
-  const double limit = isotropic ? pcl_probcollision::CloudModel::kPrecisionWarningRatio * sigma : kNoiseWarningRatio * diagonal;
-  if (!(change > limit))
-    return;
-  char scale[120];
-  if (isotropic)
-    std::snprintf (scale, sizeof scale, "%.2g of its sigma %.6g", change / sigma, sigma);
-  else
-    std::snprintf (scale, sizeof scale, "%.2g of its size, bounding-box diagonal %.6g", change / diagonal, diagonal);
-  std::fprintf (stderr,
-                "pcd_collision: warning: '%s' stores x y z in double precision up to %.6g from its origin; PCL's "
-                "float points keep them to within %.3g (%s), and the answer is for the rounded cloud; move the "
-                "inputs nearer the origin to keep it (docs/CLI.md, \"Coordinates far from the origin\")\n",
-                in.path.c_str (), in.rounding.largest_magnitude, change, scale);
-  in.precision_warned = true;
+  if (!warning.empty ())
+    std::fprintf (stderr, "pcd_collision: warning: %s\n", warning.c_str ());
 }
 
 /** \brief The stage line of -surface that says where an input's surface normals got their
@@ -822,13 +748,14 @@ run (int argc, char** argv)
   const bool with_normals = o.surface && !o.ignore_normals;
   loadInput (a, with_normals, log);
   loadInput (b, with_normals, log);
-  // One pass over each input for both units warnings (5,000,000 points are 60 MB to read).
-  const double diagonal_a = inputDiagonal (a), diagonal_b = inputDiagonal (b);
-  warnIfScalesDiffer (a, diagonal_a, b, diagonal_b);
-  warnIfNoiseImplausible (a, diagonal_a, o.sensor_a, o.sigma_a);
-  warnIfNoiseImplausible (b, diagonal_b, o.sensor_b, o.sigma_b);
-  warnIfPrecisionLost (a, diagonal_a, o.sensor_a, o.sigma_a);
-  warnIfPrecisionLost (b, diagonal_b, o.sensor_b, o.sigma_b);
+  // The units and precision warnings (one pass over each input: 5,000,000 points are 60 MB).
+  setFacts (a, o.sensor_a, o.sigma_a);
+  setFacts (b, o.sensor_b, o.sigma_b);
+  warn (pcl_probcollision::io::scaleWarning (a.facts, b.facts));
+  for (const Input* in : {&a, &b})
+    warn (pcl_probcollision::io::noiseWarning (in->facts));
+  for (const Input* in : {&a, &b})
+    warn (pcl_probcollision::io::roundingWarning (in->facts));
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at
@@ -966,8 +893,7 @@ run (int argc, char** argv)
                     model->params ().surface ? ", surface model" : "", static_cast<double> (model->bytes ()) / 1e6);
       // The model's own precision warning (float points whose spacing is coarse against their
       // spread: a float32 file far from its origin), unless the file's rounding was warned of.
-      if (!model->warning ().empty () && !in->precision_warned)
-        std::fprintf (stderr, "pcd_collision: warning: '%s': %s\n", in->path.c_str (), model->warning ().c_str ());
+      warn (pcl_probcollision::io::modelWarning (in->facts, model->warning ()));
     }
   pc.setRequest (requestFor (o));
 
@@ -1049,17 +975,17 @@ run (int argc, char** argv)
       write_ms = msSince (start);
     }
 
-    if (both_meshes && !warned_between_samples && result.verdict == pcl_probcollision::Verdict::Free &&
-        result.leaf_pairs_tested > 0)
+    if (!warned_between_samples)
     {
-      warned_between_samples = true;
-      progress.clear ();
-      std::fprintf (stderr,
-                    "pcd_collision: warning: %s reads free, but both inputs are meshes sampled %g apart and their "
-                    "samples come within reach of each other there: a part thinner than that crossing a thin wall "
-                    "passes between samples and reads free. Check it with a smaller -mesh_density (said once a "
-                    "run)\n",
-                    batch ? ("pose " + std::to_string (i)).c_str () : "the pose", std::max (a.spacing, b.spacing));
+      const std::string warning = pcl_probcollision::io::betweenSamplesWarning (
+          both_meshes, result.verdict == pcl_probcollision::Verdict::Free, result.leaf_pairs_tested,
+          batch ? "pose " + std::to_string (i) : "the pose", std::max (a.spacing, b.spacing));
+      if (!warning.empty ())
+      {
+        warned_between_samples = true;
+        progress.clear ();
+        warn (warning);
+      }
     }
     const long long index = batch ? static_cast<long long> (i) : -1;
     if (o.json)

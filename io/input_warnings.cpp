@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "input_warnings.h"
+
+#include <pcl_probcollision/cloud_model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+
+namespace pcl_probcollision
+{
+namespace io
+{
+namespace
+{
+std::string
+formatted (const char* format, ...) __attribute__ ((format (printf, 1, 2)));
+
+std::string
+formatted (const char* format, ...)
+{
+  va_list args;
+  va_start (args, format);
+  va_list again;
+  va_copy (again, args);
+  const int n = std::vsnprintf (nullptr, 0, format, args);
+  va_end (args);
+  std::string text (n > 0 ? static_cast<std::size_t> (n) : 0, '\0');
+  if (n > 0)
+    std::vsnprintf (text.data (), text.size () + 1, format, again);
+  va_end (again);
+  return text;
+}
+} // namespace
+
+double
+finiteDiagonal (const pcl::PointCloud<pcl::PointXYZ>& cloud)
+{
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& p : cloud.points)
+    if (std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z))
+    {
+      const Eigen::Vector3d q = p.getVector3fMap ().cast<double> ();
+      lo = lo.cwiseMin (q);
+      hi = hi.cwiseMax (q);
+    }
+  return (hi.array () >= lo.array ()).all () ? (hi - lo).norm () : 0.0;
+}
+
+std::string
+scaleWarning (const InputFacts& a, const InputFacts& b)
+{
+  for (const InputFacts* in : {&a, &b})
+    if (in->cloud && in->finite < kScaleWarningMinPoints)
+      return {};
+  const double da = a.diagonal, db = b.diagonal;
+  if (!(da > 0.0 && db > 0.0 && std::isfinite (da) && std::isfinite (db)))
+    return {};
+  const double ratio = std::max (da, db) / std::min (da, db);
+  if (!(ratio > kScaleWarningRatio))
+    return {};
+  return formatted ("the inputs' sizes differ by %.0fx (bounding-box diagonal %.6g in '%s', %.6g in '%s'); both must "
+                    "be in the same units (e.g. metres), so convert one of them if they are not",
+                    ratio, da, a.path.c_str (), db, b.path.c_str ());
+}
+
+std::string
+noiseWarning (const InputFacts& in)
+{
+  if (!in.cloud || in.sensor != "isotropic" || in.finite < kScaleWarningMinPoints)
+    return {};
+  const double sigma = in.sigma, diagonal = in.diagonal;
+  if (!(sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal) && sigma < kNoiseWarningRatio * diagonal))
+    return {};
+  return formatted ("the noise sigma %.6g of '%s' is %.2g of its size (bounding-box diagonal %.6g); sigma is in the "
+                    "data's units (the default 0.005 is 5 mm in metres), so give -sigma in the cloud's units (e.g. "
+                    "-sigma 5 for millimetres)",
+                    sigma, in.path.c_str (), sigma / diagonal, diagonal);
+}
+
+std::string
+roundingWarning (const InputFacts& in)
+{
+  const double change = in.rounding.largest_change;
+  if (!in.cloud || !(change > 0.0))
+    return {};
+  const bool isotropic = in.sensor == "isotropic";
+  const double limit = isotropic ? CloudModel::kPrecisionWarningRatio * in.sigma : kNoiseWarningRatio * in.diagonal;
+  if (!(change > limit))
+    return {};
+  const std::string scale = isotropic ? formatted ("%.2g of its sigma %.6g", change / in.sigma, in.sigma)
+                                      : formatted ("%.2g of its size, bounding-box diagonal %.6g",
+                                                   change / in.diagonal, in.diagonal);
+  return formatted ("'%s' stores x y z in double precision up to %.6g from its origin; PCL's float points keep them "
+                    "to within %.3g (%s), and the answer is for the rounded cloud; move the inputs nearer the origin "
+                    "to keep it (docs/CLI.md, \"Coordinates far from the origin\")",
+                    in.path.c_str (), in.rounding.largest_magnitude, change, scale.c_str ());
+}
+
+std::string
+modelWarning (const InputFacts& in, const std::string& model_warning)
+{
+  if (model_warning.empty () || !roundingWarning (in).empty ())
+    return {};
+  return "'" + in.path + "': " + model_warning;
+}
+
+std::string
+betweenSamplesWarning (bool both_meshes, bool free, std::size_t leaf_pairs_tested, const std::string& where,
+                       double spacing)
+{
+  if (!both_meshes || !free || leaf_pairs_tested == 0)
+    return {};
+  return formatted ("%s reads free, but both inputs are meshes sampled %g apart and their samples come within reach "
+                    "of each other there: a part thinner than that crossing a thin wall passes between samples and "
+                    "reads free. Check it with a smaller -mesh_density (said once a run)",
+                    where.c_str (), spacing);
+}
+} // namespace io
+} // namespace pcl_probcollision
