@@ -3,6 +3,8 @@
 // own defaults. numpy points become a pcl::PointCloud<pcl::PointXYZ> once and go through
 // buildCloudModel<pcl::PointXYZ>, so a Python model is exactly the C++ model of the same floats.
 #include "cloud_input.h"
+#include "input_warnings.h"
+#include "quiet_pcl_console.h"
 #include "mesh_input.h"
 #include "mesh_sampling.h"
 
@@ -250,8 +252,31 @@ requireRegularFile (const std::filesystem::path& path)
   throw py::error_already_set ();
 }
 
+/** What the input warnings (io/input_warnings.h) judge of a cloud file read under a noise
+  * model: its finite points' extent, the rounding of its x y z to float, the isotropic sigma. */
+pcl_probcollision::io::InputFacts
+fileFacts (const std::filesystem::path& path, const pcl::PointCloud<pcl::PointXYZ>& cloud,
+           const pcl_probcollision::io::XyzRounding& rounding, const SensorNoiseModel& noise)
+{
+  pcl_probcollision::io::InputFacts facts;
+  facts.path = path.string ();
+  for (const auto& p : cloud.points)
+    facts.finite += std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
+  facts.diagonal = pcl_probcollision::io::finiteDiagonal (cloud);
+  facts.rounding = rounding;
+  facts.sensor = noise.name ();
+  if (noise.type () == SensorNoiseModel::Type::Isotropic)
+  {
+    double axial = 0.0, lateral = 0.0;
+    noise.sigmas (Eigen::Vector3d::Zero (), Eigen::Vector3d::Zero (), SensorPose (), axial, lateral);
+    facts.sigma = axial;
+  }
+  return facts;
+}
+
 std::shared_ptr<const CloudModel>
-loadModel (const std::filesystem::path& path, const py::object& params_obj, const py::object& name_obj)
+loadModel (const std::filesystem::path& path, const py::object& params_obj, const py::object& name_obj,
+           std::string& file_warning)
 {
   requireRegularFile (path);
   std::string ext = path.extension ().string ();
@@ -270,20 +295,22 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   pcl::PointCloud<pcl::PointXYZ> cloud;
   pcl::PointCloud<pcl::PointNormal> oriented;
   bool has_normals = false;
+  pcl_probcollision::io::XyzRounding rounding;
   std::string error;
   bool loaded = false;
   {
     py::gil_scoped_release release;
-    loaded = params.surface ? pcl_probcollision::io::loadCloudWithNormals (path.string (), oriented, has_normals, error)
-                            : pcl_probcollision::io::loadCloud (path.string (), cloud, error);
+    loaded = params.surface ? pcl_probcollision::io::loadCloudWithNormals (path.string (), oriented, has_normals, error, &rounding)
+                            : pcl_probcollision::io::loadCloud (path.string (), cloud, error, &rounding);
   }
   if (!loaded)
     throw py::value_error ("path: " + error);
   py::gil_scoped_release release;
-  if (has_normals)
-    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, nullptr, name);
   if (params.surface)
     pcl::copyPointCloud (oriented, cloud);
+  file_warning = pcl_probcollision::io::roundingWarning (fileFacts (path, cloud, rounding, params.noise));
+  if (has_normals)
+    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, nullptr, name);
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
 }
 
@@ -500,37 +527,47 @@ viewpointOf (const pcl::PointCloud<PointT>& cloud)
   return viewpoint;
 }
 
+/** io::XyzRounding as read_cloud(rounding=True) returns it: (largest change, largest |coordinate|). */
+py::tuple
+roundingOf (const pcl_probcollision::io::XyzRounding& r)
+{
+  return py::make_tuple (r.largest_change, r.largest_magnitude);
+}
+
 /** The file as pcd_collision reads it: io::loadCloud (PCD, face-less PLY), NaN rows kept. */
 py::tuple
-readCloud (const std::filesystem::path& path)
+readCloud (const std::filesystem::path& path, bool with_rounding)
 {
   requireRegularFile (path);
   pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl_probcollision::io::XyzRounding rounding;
   std::string error;
   bool loaded = false;
   {
     py::gil_scoped_release release;
-    loaded = pcl_probcollision::io::loadCloud (path.string (), cloud, error);
+    loaded = pcl_probcollision::io::loadCloud (path.string (), cloud, error, &rounding);
   }
   if (!loaded)
     throw py::value_error ("path: " + error);
-  return py::make_tuple (pointsOf (cloud), viewpointOf (cloud), cloud.width, cloud.height);
+  py::tuple read = py::make_tuple (pointsOf (cloud), viewpointOf (cloud), cloud.width, cloud.height);
+  return with_rounding ? py::tuple (read + py::make_tuple (roundingOf (rounding))) : read;
 }
 
 /** read_cloud with the file's normal_x normal_y normal_z (io::loadCloudWithNormals, as pcd_collision
   * -surface reads them): (points, normals (N, 3) float32 as stored, NaN for none; None when the file
   * has no normals), viewpoint, width, height). */
 py::tuple
-readCloudWithNormals (const std::filesystem::path& path)
+readCloudWithNormals (const std::filesystem::path& path, bool with_rounding)
 {
   requireRegularFile (path);
   pcl::PointCloud<pcl::PointNormal> cloud;
   bool has_normals = false;
+  pcl_probcollision::io::XyzRounding rounding;
   std::string error;
   bool loaded = false;
   {
     py::gil_scoped_release release;
-    loaded = pcl_probcollision::io::loadCloudWithNormals (path.string (), cloud, has_normals, error);
+    loaded = pcl_probcollision::io::loadCloudWithNormals (path.string (), cloud, has_normals, error, &rounding);
   }
   if (!loaded)
     throw py::value_error ("path: " + error);
@@ -545,7 +582,8 @@ readCloudWithNormals (const std::filesystem::path& path)
         q (i, d) = cloud[static_cast<std::size_t> (i)].normal[d];
     normals = nrm;
   }
-  return py::make_tuple (pointsOf (cloud), normals, viewpointOf (cloud), cloud.width, cloud.height);
+  py::tuple read = py::make_tuple (pointsOf (cloud), normals, viewpointOf (cloud), cloud.width, cloud.height);
+  return with_rounding ? py::tuple (read + py::make_tuple (roundingOf (rounding))) : read;
 }
 
 pcl_probcollision::io::TriangleMesh
@@ -1110,12 +1148,17 @@ PYBIND11_MODULE (_core, m)
   // --- functions ----------------------------------------------------------------------------------
   m.def ("build_model",
          [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
-             const py::object& viewpoint, const py::object& normals, bool any_length_normals) {
-           return warnedModel (buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
+             const py::object& viewpoint, const py::object& normals, bool any_length_normals, bool warn) {
+           if (warn)
+             return warnedModel (buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
+           // Nor on PCL's console, where the library prints it too (as pcd_collision keeps it quiet).
+           const pcl_probcollision::io::QuietPclConsole quiet;
+           return std::const_pointer_cast<CloudModel> (
+               buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
          py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
-         py::kw_only (), py::arg ("any_length_normals") = false,
+         py::kw_only (), py::arg ("any_length_normals") = false, py::arg ("warn") = true,
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
          "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
          "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
@@ -1128,11 +1171,21 @@ PYBIND11_MODULE (_core, m)
          "    none. The points' model is the same with or without them (pcl::PointNormal instead of pcl::PointXYZ).\n"
          "any_length_normals: keyword only; True takes the normals of any length, as a file stores them (read_cloud_with_normals)\n"
          "    and as pcd_collision -surface reads them: the surface model normalizes them. False: not unit length is a ValueError.\n"
-         "A RuntimeWarning carries CloudModel.warning when the points, held in float, lost precision far from the origin.\n"
+         "A RuntimeWarning carries CloudModel.warning when the points, held in float, lost precision far from the origin;\n"
+         "    warn=False (keyword only) leaves it in CloudModel.warning alone, PCL's console quiet during the build (for a\n"
+         "    caller that reports it itself, as pcl_probcollision.dask does).\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
-           return warnedModel (loadModel (path, params, name));
+           // The file's rounding to float, when it matters, says more than the model's own
+           // precision warning (which then is not repeated), as pcd_collision's warnings do.
+           std::string file_warning;
+           const CloudModel::ConstPtr model = loadModel (path, params, name, file_warning);
+           if (file_warning.empty ())
+             return warnedModel (model);
+           if (PyErr_WarnEx (PyExc_RuntimeWarning, file_warning.c_str (), 1) < 0)
+             throw py::error_already_set ();
+           return std::const_pointer_cast<CloudModel> (model);
          },
          py::arg ("path"), py::arg ("params") = py::none (), py::arg ("name") = py::none (),
          "Builds the CloudModel of a .pcd file (x y z fields, any numeric type; its VIEWPOINT is the sensor pose).\n\n"
@@ -1144,7 +1197,10 @@ PYBIND11_MODULE (_core, m)
          "    params.surface the normals are not read (they change nothing else in the model).\n"
          "FileNotFoundError for a missing file, IsADirectoryError for a directory, ValueError for a file PCL cannot\n"
          "    read or one with only some of the\n"
-         "    normal fields (with params.surface). A RuntimeWarning carries CloudModel.warning, as build_model's.");
+         "    normal fields (with params.surface). A RuntimeWarning says when the file stores x y z in double precision\n"
+         "    so far from the origin that their rounding to float passes a tenth of an isotropic sigma (under another\n"
+         "    noise model, 1e-5 of the cloud's size), as pcd_collision warns; otherwise it carries CloudModel.warning,\n"
+         "    as build_model's.");
   m.attr ("MAX_COORDINATE") = detail::kMaxCoordinate;  // the library's coordinate and translation bound
   m.attr ("MAX_THREADS") = detail::kMaxThreads;         // the library's cap on a thread count
   // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).
@@ -1164,15 +1220,59 @@ PYBIND11_MODULE (_core, m)
          "free_below or collision_above when out of range.");
 
   // --- file input and poses as pcd_collision reads them (io/, used by pcl_probcollision.dask) ------
-  m.def ("read_cloud", &readCloud, py::arg ("path"),
+  m.def ("read_cloud", &readCloud, py::arg ("path"), py::kw_only (), py::arg ("rounding") = false,
          "Reads a .pcd (or face-less .ply) file as pcd_collision does.\n\n"
          "Returns (points (N, 3) float32 with NaN rows kept, viewpoint (7,) tx ty tz qw qx qy qz, width, height).\n"
+         "rounding=True appends what holding x y z in float cost: (largest change of a coordinate, largest |coordinate|),\n"
+         "    (0, 0) for a file that stores them as float32 (InputFacts.rounding, rounding_warning()).\n"
          "ValueError with pcd_collision's message for a file it cannot read.");
-  m.def ("read_cloud_with_normals", &readCloudWithNormals, py::arg ("path"),
+  m.def ("read_cloud_with_normals", &readCloudWithNormals, py::arg ("path"), py::kw_only (), py::arg ("rounding") = false,
          "read_cloud with the file's normal_x normal_y normal_z, as pcd_collision -surface reads them.\n\n"
          "Returns (points (N, 3) float32, normals (N, 3) float32 as stored (any length; NaN rows: none) or None when the\n"
-         "file has no normal fields, viewpoint (7,), width, height). ValueError with pcd_collision's message for a file\n"
-         "it cannot read, or with only some of the three normal fields.");
+         "file has no normal fields, viewpoint (7,), width, height); rounding=True appends the rounding as read_cloud's.\n"
+         "ValueError with pcd_collision's message for a file it cannot read, or with only some of the three normal fields.");
+  // The command lines' warnings about their inputs (io/input_warnings.h), which the Dask command
+  // line prints as pcd_collision does.
+  py::class_<pcl_probcollision::io::InputFacts> (m, "InputFacts",
+                                                 "What the command lines' input warnings judge of one input, as read.")
+      .def (py::init ([] (const std::string& path, bool cloud, std::size_t finite, double diagonal,
+                          std::pair<double, double> rounding, const std::string& sensor, double sigma) {
+              pcl_probcollision::io::InputFacts f;
+              f.path = path;
+              f.cloud = cloud;
+              f.finite = finite;
+              f.diagonal = diagonal;
+              f.rounding.largest_change = rounding.first;
+              f.rounding.largest_magnitude = rounding.second;
+              f.sensor = sensor;
+              f.sigma = sigma;
+              return f;
+            }),
+            py::kw_only (), py::arg ("path"), py::arg ("cloud") = true, py::arg ("finite") = 0, py::arg ("diagonal") = 0.0,
+            py::arg ("rounding") = std::pair<double, double> (0.0, 0.0), py::arg ("sensor") = "isotropic",
+            py::arg ("sigma") = 0.0,
+            "path as given; cloud False for a mesh; finite points; diagonal of the finite points' (a mesh's vertices')\n"
+            "bounding box; rounding as read_cloud(rounding=True) returns it; sensor a noise model's name; sigma the\n"
+            "isotropic sigma (data units).")
+      .def_readonly ("path", &pcl_probcollision::io::InputFacts::path)
+      .def_readonly ("cloud", &pcl_probcollision::io::InputFacts::cloud)
+      .def_readonly ("finite", &pcl_probcollision::io::InputFacts::finite)
+      .def_readonly ("diagonal", &pcl_probcollision::io::InputFacts::diagonal)
+      .def_readonly ("sensor", &pcl_probcollision::io::InputFacts::sensor)
+      .def_readonly ("sigma", &pcl_probcollision::io::InputFacts::sigma);
+  m.def ("scale_warning", &pcl_probcollision::io::scaleWarning, py::arg ("a"), py::arg ("b"),
+         "pcd_collision's warning when the inputs' sizes differ by more than 100x (units); '' when none.");
+  m.def ("noise_warning", &pcl_probcollision::io::noiseWarning, py::arg ("input"),
+         "pcd_collision's warning when a cloud's isotropic sigma is under 1e-5 of its size (units); '' when none.");
+  m.def ("rounding_warning", &pcl_probcollision::io::roundingWarning, py::arg ("input"),
+         "pcd_collision's warning when holding a file's x y z in float moved one by more than a tenth of its isotropic\n"
+         "sigma (under another model, 1e-5 of its size); '' when none.");
+  m.def ("model_warning", &pcl_probcollision::io::modelWarning, py::arg ("input"), py::arg ("model_warning"),
+         "A model's precision warning (CloudModel.warning) naming its file, '' when it has none or when\n"
+         "rounding_warning(input) already said it.");
+  m.def ("between_samples_warning", &pcl_probcollision::io::betweenSamplesWarning, py::arg ("both_meshes"),
+         py::arg ("free"), py::arg ("leaf_pairs_tested"), py::arg ("where"), py::arg ("spacing"),
+         "pcd_collision's warning for a free answer between two meshes' samples (where: 'pose 3'); '' when none.");
   m.def ("is_faceless_ply", [] (const std::filesystem::path& p) { return pcl_probcollision::io::isFacelessPly (p.string ()); },
          py::arg ("path"), "True for a .ply whose header declares no face (pcd_collision reads it as a cloud).");
   m.def ("read_mesh",

@@ -63,6 +63,15 @@ def write_pcd(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
     pathlib.Path(path).write_bytes(header.encode("ascii") + points.tobytes())
 
 
+def write_pcd_double(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
+    """A binary PCD with x y z float64 fields (a survey's or a map's coordinates, kept whole)."""
+    points = np.ascontiguousarray(points, dtype="<f8")
+    header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n"
+              f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT {' '.join(repr(float(v)) for v in viewpoint)}\n"
+              f"POINTS {len(points)}\nDATA binary\n")
+    pathlib.Path(path).write_bytes(header.encode("ascii") + points.tobytes())
+
+
 def sheet(n=30, size=0.06, noise=5e-4, seed=1):
     """A noisy flat n x n sheet in z = 0 (a scanned plane: the noise is along z), float32."""
     pts = patch(n, size, seed=seed).astype(np.float64)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import pcl_probcollision as pc
-from conftest import DATA, patch, sheet, translation, write_pcd
+from conftest import DATA, patch, sheet, translation, write_pcd, write_pcd_double
 
 NOISE = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005))
 Z = [0.0, 0.004, 0.006, 0.01, 0.03]  # patch heights over the table: collision .. contact .. free
@@ -852,3 +852,51 @@ def test_load_model_warns_as_build_model_does(tmp_path):
     with pytest.warns(RuntimeWarning, match="float spacing"):
         model = pc.load_model(path, params=params)
     assert "far.pcd" in model.warning
+
+
+def test_load_model_warns_of_a_double_file_rounded_far_from_the_origin(tmp_path):
+    # 10 km out a float keeps x to about 0.5 mm: over a tenth of the 1 mm sigma. load_model says
+    # so of the file, as pcd_collision does, instead of the model's float-spacing warning.
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    points = sheet().astype(np.float64)
+    far = tmp_path / "far.pcd"
+    write_pcd_double(far, points + np.array([1e4, 0.0, 0.0]))
+    *_, (change, magnitude) = pc.read_cloud(far, rounding=True)
+    assert 1e-4 < change <= 4.9e-4 and magnitude == pytest.approx(1e4, abs=0.1)
+    assert pc._core.read_cloud_with_normals(far, rounding=True)[-1] == (change, magnitude)
+    assert len(pc.read_cloud(far)) == 4  # the tuple without rounding=True is unchanged
+    with pytest.warns(RuntimeWarning) as caught:
+        pc.load_model(far, params=params)
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and "'" + str(far) + "' stores x y z in double precision up to 10000" in messages[0]
+    assert "of its sigma 0.001" in messages[0] and "float spacing" not in messages[0]
+    # 1 km out (about 0.03 mm) and a float32 file: nothing to say of either.
+    near = tmp_path / "near.pcd"
+    write_pcd_double(near, points + np.array([1e3, 0.0, 0.0]))
+    flat = tmp_path / "flat.pcd"
+    write_pcd(flat, points)
+    assert pc.read_cloud(flat, rounding=True)[-1] == (0.0, 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for path in (near, flat):
+            assert pc.load_model(path, params=params).warning == ""
+    # build_model(warn=False) leaves the model's warning to the caller.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quiet = pc.build_model(points + np.array([1e5, 0.0, 0.0]), params=params, warn=False)
+    assert "float spacing" in quiet.warning
+
+
+def test_input_warnings_are_pcd_collisions():
+    # The rules and words pcd_collision prints (io/input_warnings.h), as the Dask command line uses them.
+    core = pc._core
+    mm = core.InputFacts(path="mm.pcd", finite=1000, diagonal=700.0, sensor="isotropic", sigma=0.005)
+    m = core.InputFacts(path="m.pcd", finite=1000, diagonal=0.7, sensor="isotropic", sigma=0.005)
+    assert core.scale_warning(mm, m).startswith("the inputs' sizes differ by 1000x")
+    assert core.scale_warning(m, m) == ""
+    assert "the noise sigma 0.005 of 'mm.pcd'" in core.noise_warning(mm) and core.noise_warning(m) == ""
+    far = core.InputFacts(path="far.pcd", finite=1000, diagonal=0.7, rounding=(0.0005, 1e4), sensor="isotropic", sigma=0.002)
+    assert "0.25 of its sigma 0.002" in core.rounding_warning(far)
+    assert core.model_warning(far, "float spacing") == "" and core.model_warning(m, "float spacing") == "'m.pcd': float spacing"
+    assert core.between_samples_warning(True, True, 2, "pose 1", 0.08).startswith("pose 1 reads free")
+    assert core.between_samples_warning(True, True, 0, "pose 1", 0.08) == ""

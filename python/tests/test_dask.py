@@ -14,7 +14,7 @@ import pytest
 import pcl_probcollision as pc
 from pcl_probcollision import dask as pcd
 
-from conftest import DATA, patch, sheet, write_pcd
+from conftest import DATA, patch, sheet, write_pcd, write_pcd_double
 
 PYTHON = sys.executable
 FIELDS = ("probability", "verdict", "status", "lower_bound", "budget_exhausted", "no_leaf_tested", "points_a", "points_b",
@@ -88,7 +88,7 @@ def test_each_worker_builds_each_model_once(cluster):
     for _ in range(2):
         pcd.collide_poses(a, b, P, client=cluster, chunk_size=10, sigma=0.002)
     after = cluster.run(lambda: dict(__import__("pcl_probcollision.dask", fromlist=["_builds"])._builds))
-    tokens = {pcd._scattered(pcd.prepare_input(x))["token"] for x in (a, b)}
+    tokens = {pcd._scattered(pcd.prepare_input(x, name))["token"] for x, name in ((a, "a"), (b, "b"))}
     for worker, counts in after.items():
         for t in tokens:
             built = counts.get(t, 0) - before[worker].get(t, 0)
@@ -442,6 +442,51 @@ def test_cli_errors_match_pcd_collision(tmp_path):
         assert (py.returncode, py.stdout) == (cpp.returncode, "") == (1, ""), (py.stderr, cpp.stderr)
         if poses is not ok:  # refused with its line, before any query, in the same words
             assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1]
+
+
+def _warnings(stderr):
+    """The warnings of a command line's stderr, without the program's name."""
+    return [line.split(": warning: ", 1)[1] for line in stderr.splitlines() if ": warning: " in line]
+
+
+def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
+    """pcd_collision's warnings on stderr, in the same words and order: the units (a millimetre
+    cloud against a metre one, the default sigma on the millimetres), a float64 file rounded far
+    from its origin, a float32 one whose model says so, and a free answer between two meshes'
+    samples. The answers stay equal."""
+    write_pcd(tmp_path / "mm.pcd", table_points * 1000.0)
+    write_pcd_double(tmp_path / "far.pcd", table_points.astype(np.float64) + np.array([1e4, 0.0, 0.0]))
+    write_pcd(tmp_path / "far32.pcd", table_points.astype(np.float64) + np.array([1e5, 0.0, 0.0]))
+    (tmp_path / "plate.obj").write_text("v -0.5 -0.5 0\nv 0.5 -0.5 0\nv 0.5 0.5 0\nv -0.5 0.5 0\nf 1 2 3\nf 1 3 4\n")
+    corners = [(x, y, z) for x in (-0.05, 0.05) for y in (-0.05, 0.05) for z in (-0.05, 0.05)]
+    faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2), (3, 4, 8), (3, 8, 7), (1, 3, 7),
+             (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+    (tmp_path / "cube.obj").write_text("".join("v %g %g %g\n" % c for c in corners) + "".join("f %d %d %d\n" % f for f in faces))
+    poses = tmp_path / "poses.txt"
+    poses.write_text("0 0 0 0 0 0\n0 0 0.5 0 0 0\n")
+    runs = {
+        "units and rounding": ([str(tmp_path / "mm.pcd"), str(tmp_path / "far.pcd")], ["-sigma_b", "0.002"], 3),
+        "the models' precision": ([str(tmp_path / "far32.pcd")] * 2, ["-sigma", "0.002"], 2),
+        # the cube through the plate, sampled 8 cm apart: free at pose 0, which collides
+        "between samples": ([str(tmp_path / "cube.obj"), str(tmp_path / "plate.obj")], ["-mesh_density", "0.08"], 1),
+    }
+    for name, (inputs, flags, count) in runs.items():
+        cpp = subprocess.run([_pcd_collision(), *inputs, "-poses", str(poses), "-json", *flags], capture_output=True,
+                             text=True)
+        py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *inputs, str(poses), "--scheduler", "local:1",
+                             *flags], capture_output=True, text=True, timeout=120)
+        assert (cpp.returncode, py.returncode) == (0, 0), (name, cpp.stderr, py.stderr)
+        said = _warnings(cpp.stderr)
+        assert len(said) == count, (name, cpp.stderr)
+        assert _warnings(py.stderr) == said, (name, py.stderr, cpp.stderr)
+        assert all(line.startswith("pcl_probcollision.dask: ") for line in py.stderr.splitlines() if ": warning: " in line)
+        _compare_json_lines(cpp.stdout, py.stdout)
+    # Through the library: RuntimeWarnings (InputWarning), the same words.
+    with pytest.warns(pcd.InputWarning) as caught:
+        pcd.collide_poses(str(tmp_path / "mm.pcd"), str(tmp_path / "far.pcd"), np.zeros((1, 6)), sigma_b=0.002)
+    assert [str(w.message) for w in caught if w.category is pcd.InputWarning] == _warnings(
+        subprocess.run([_pcd_collision(), str(tmp_path / "mm.pcd"), str(tmp_path / "far.pcd"), "-json", "-sigma_b", "0.002"],
+                       capture_output=True, text=True).stderr)
 
 
 def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):

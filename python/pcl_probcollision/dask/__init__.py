@@ -25,13 +25,14 @@ import os
 import threading
 import time
 import uuid
+import warnings
 from typing import Any, Dict, Optional
 
 import numpy as np
 
 from .. import _core as core
 
-__all__ = ["collide_poses", "connect", "prepare_input", "BatchResults", "DEFAULT_OPTIONS", "OPTION_NAMES"]
+__all__ = ["collide_poses", "connect", "prepare_input", "BatchResults", "InputWarning", "DEFAULT_OPTIONS", "OPTION_NAMES"]
 
 #: pcd_collision's flags without the dash and their defaults (docs/CLI.md). The model and request
 #: defaults come from the C++ structs; sensor and sigma are the tool's own (isotropic 5 mm).
@@ -233,15 +234,15 @@ def prepare_input(x, name: Optional[str] = None, normals: bool = False) -> Dict[
         if low.endswith(".pcd") or (low.endswith(".ply") and core.is_faceless_ply(path)):
             t0 = time.perf_counter()
             if normals:
-                points, stored, viewpoint, width, height = core.read_cloud_with_normals(path)
+                points, stored, viewpoint, width, height, rounding = core.read_cloud_with_normals(path, rounding=True)
             else:
-                (points, viewpoint, width, height), stored = core.read_cloud(path), None
+                (points, viewpoint, width, height, rounding), stored = core.read_cloud(path, rounding=True), None
             finite = int(np.isfinite(points).all(axis=1).sum())
             if finite == 0:
                 raise ValueError(f"'{path}' has no finite point ({len(points)} points, all NaN or Inf)")
             return {"kind": "cloud", "path": path, "name": name or os.path.basename(path), "points": points,
                     "viewpoint": viewpoint, "width": int(width), "height": int(height), "finite": finite,
-                    "normals": stored, "load_ms": (time.perf_counter() - t0) * 1e3}
+                    "normals": stored, "rounding": rounding, "load_ms": (time.perf_counter() - t0) * 1e3}
         if low.endswith(_MESH_EXTENSIONS):
             t0 = time.perf_counter()
             vertices, triangles = core.read_mesh(path)
@@ -270,6 +271,37 @@ def check_mesh_noise(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, An
             if spec["kind"] == "mesh" and options.get(flag) is not None:
                 raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
                                  f"with no sensor noise; the option applies to a cloud")
+
+
+def input_facts(spec: Dict[str, Any], o: Dict[str, Any], side: str):
+    """What pcd_collision's input warnings judge of an input (core.InputFacts): a cloud's finite
+    points and their bounding-box diagonal (computed as pcd_collision does: float coordinates
+    widened to double, the norm summed x, y, z), a file's rounding to float, the side's noise; a
+    mesh's size is its vertices'."""
+    path = spec["path"] or spec["name"]
+    if spec["kind"] == "mesh":
+        return core.InputFacts(path=path, cloud=False, diagonal=core.mesh_diagonal(spec["vertices"], spec["triangles"]))
+    points = spec["points"]
+    finite = points[np.isfinite(points).all(axis=1)]
+    diagonal = 0.0
+    if len(finite):
+        d = finite.max(axis=0).astype(np.float64) - finite.min(axis=0).astype(np.float64)
+        diagonal = math.sqrt(float(d[0]) * float(d[0]) + float(d[1]) * float(d[1]) + float(d[2]) * float(d[2]))
+    return core.InputFacts(path=path, cloud=True, finite=len(finite), diagonal=diagonal,
+                           rounding=spec.get("rounding", (0.0, 0.0)), sensor=o["sensor_" + side],
+                           sigma=float(o["sigma_" + side]))
+
+
+class InputWarning(RuntimeWarning):
+    """A warning pcd_collision prints on stderr about its inputs or an answer (units, rounding to
+    float, a model's precision, a free answer between two meshes' samples)."""
+
+
+def _warn(message: str) -> None:
+    """Issues pcd_collision's warning as an InputWarning (the command line prints it as
+    pcd_collision does); nothing for ''."""
+    if message:
+        warnings.warn(message, InputWarning, stacklevel=3)
 
 
 def _sample_meshes(a: Dict[str, Any], b: Dict[str, Any], o: Dict[str, Any]) -> None:
@@ -305,6 +337,7 @@ def _scattered(spec: Dict[str, Any], surface: bool = False) -> Dict[str, Any]:
     normals = spec.get("normals") if surface else None
     h = hashlib.blake2b(digest_size=16)
     h.update(spec["kind"].encode())
+    h.update(spec["name"].encode() + b"\0")  # a model's messages name it: one cloud as a and b is two models
     h.update(np.ascontiguousarray(spec["points"]).tobytes())
     h.update(str(spec["points"].dtype).encode())
     if spec.get("viewpoint") is not None:
@@ -358,7 +391,7 @@ def _model(spec: Dict[str, Any], o: Dict[str, Any], side: str):
             # A cloud file's stored normals are of any length, as pcd_collision reads them.
             model = core.build_model(points, covariances=covariances, params=model_params(o, side, exact),
                                      name=spec["name"], viewpoint=spec["viewpoint"], normals=spec.get("normals"),
-                                     any_length_normals=not exact)
+                                     any_length_normals=not exact, warn=False)
             with _cache_lock:
                 _cache[key] = model
                 _builds[spec["token"]] += 1
@@ -432,6 +465,8 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
     out["surfaces"] = {"a": surface_summary(A), "b": surface_summary(B)}
     out["merged_samples"] = {"a": A.merged_samples, "b": B.merged_samples}
+    # The models' precision warnings (CloudModel.warning), reported by the client.
+    out["model_warnings"] = {"a": A.warning, "b": B.warning}
     out["pid"] = np.array([os.getpid()])
     return out
 
@@ -450,11 +485,14 @@ class BatchResults:
     witness_side/_index/_point/_normal (b's frame), query_ms; inputs describes a and b; surfaces
     how each model's surface was oriented ({"a": ..., "b": ...}, surface_summary(); None without
     surface); merged_samples the samples of each model merged by noise_resolution ({"a": n, "b": n},
-    CloudModel.merged_samples); chunk_size and chunks how it was split."""
+    CloudModel.merged_samples); model_warnings each model's precision warning ({"a": text, "b": text},
+    CloudModel.warning, '' for none); chunk_size and chunks how it was split."""
 
     def __init__(self, fields: Dict[str, np.ndarray], inputs, chunk_size: int, chunks: int, build_ms: float,
-                 surfaces: Dict[str, Optional[Dict[str, Any]]], merged_samples: Dict[str, int]):
+                 surfaces: Dict[str, Optional[Dict[str, Any]]], merged_samples: Dict[str, int],
+                 model_warnings: Dict[str, str]):
         self.fields = fields
+        self.model_warnings = model_warnings
         self.surfaces = surfaces
         self.merged_samples = merged_samples
         for k, v in fields.items():
@@ -542,12 +580,22 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
         be True (the answer rests on surface the samples do not show; always False otherwise).
         distance=True is pcd_collision's -distance: beyond the query's reach signed_distance is
         the distance between the two clouds' nearest samples (sample_distance True).
-    Returns BatchResults in pose order, identical to the single-process answers."""
+    Returns BatchResults in pose order, identical to the single-process answers.
+    pcd_collision's warnings (inputs' sizes or sigma in other units, coordinates rounded far from
+    the origin, a model's precision, a free answer between two meshes' samples) come as
+    InputWarnings (RuntimeWarnings); the command line prints them as pcd_collision does."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)
     stored = o["surface"] and not o["ignore_normals"]
     A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
     check_mesh_noise(A, B, options)
+    # pcd_collision's warnings about the inputs (units, noise, rounding to float), in its order.
+    facts = (input_facts(A, o, "a"), input_facts(B, o, "b"))
+    _warn(core.scale_warning(*facts))
+    for f in facts:
+        _warn(core.noise_warning(f))
+    for f in facts:
+        _warn(core.rounding_warning(f))
     _sample_meshes(A, B, o)
     sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)
@@ -580,7 +628,16 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
         finally:
             for f in futures:
                 f.release()
-    return _assemble(parts, m, (A, B), chunk_size)
+    r = _assemble(parts, m, (A, B), chunk_size)
+    # The models' precision warnings (built on the workers, which leave them to the client).
+    for f, side in zip(facts, "ab"):
+        _warn(core.model_warning(f, r.model_warnings[side]))
+    if A["kind"] == B["kind"] == "mesh":
+        free = np.flatnonzero((r.verdict == int(core.Verdict.Free)) & (r.leaf_pairs_tested > 0))
+        if free.size:
+            _warn(core.between_samples_warning(True, True, int(r.leaf_pairs_tested[free[0]]), f"pose {free[0]}",
+                                               max(A["spacing"], B["spacing"])))
+    return r
 
 
 _SCATTERED = 8  # clouds kept scattered per client, the most recent
@@ -607,11 +664,11 @@ def _assemble(parts, m: int, inputs, chunk_size: int) -> BatchResults:
     if not parts:
         raise ValueError("poses: no pose given")
     fields = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]
-              if k not in ("build_ms", "pid", "surfaces", "merged_samples")}
+              if k not in ("build_ms", "pid", "surfaces", "merged_samples", "model_warnings")}
     index = fields.pop("index")
     # Every pose answered exactly once, in pose order.
     if len(index) != m or not np.array_equal(index, np.arange(m)):
         raise RuntimeError(f"internal error: {len(index)} answers for {m} poses")
     build_ms = float(parts[0]["build_ms"][0])
     return BatchResults(fields, inputs, chunk_size, len(parts), build_ms, parts[0]["surfaces"],
-                        parts[0]["merged_samples"])
+                        parts[0]["merged_samples"], parts[0]["model_warnings"])

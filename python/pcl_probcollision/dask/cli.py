@@ -1,18 +1,20 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The command line of `python3 -m pcl_probcollision.dask`: pcd_collision's batch mode with the poses
 answered on Dask. Same flags (-sigma, -sensor, ...; docs/CLI.md), same JSON lines on stdout as
-`pcd_collision a b -poses FILE -json`, same exit status (1 runtime failure, 2 usage error)."""
+`pcd_collision a b -poses FILE -json`, same warnings on stderr, same exit status (1 runtime failure,
+2 usage error)."""
 import json
 import math
 import os
 import re
 import sys
 import time
+import warnings
 
 import numpy as np
 
 from .. import _core as core
-from . import _MESH_EXTENSIONS, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
+from . import _MESH_EXTENSIONS, InputWarning, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
@@ -344,8 +346,9 @@ def main(argv):
         try:
             # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
             stored = bool(options.get("surface") or options.get("surface_pooled") or options.get("surface_ladder")) and not options.get("ignore_normals")
-            a = prepare_input(path_a, "a", stored)
-            b = prepare_input(path_b, "b", stored)
+            # Named as pcd_collision names its models (a model's messages say which).
+            a = prepare_input(path_a, "input", stored)
+            b = prepare_input(path_b, "target", stored)
             try:  # a noise model given to a mesh: a usage error, still before the scheduler
                 check_mesh_noise(a, b, options)
             except ValueError as e:
@@ -361,7 +364,16 @@ def main(argv):
         print(f"Scheduler {own['scheduler']} [done, {(time.perf_counter() - t0) * 1e3:.1f} ms : "
               f"{len(client.nthreads())} workers, {sum(client.nthreads().values())} threads]", file=sys.stderr)
         try:
-            r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], **options)
+            # pcd_collision's warnings (units, rounding, a model's precision, meshes' samples) come
+            # as InputWarnings: printed on stderr as pcd_collision prints them, once each.
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always", InputWarning)
+                r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], **options)
+            for w in said:
+                if issubclass(w.category, InputWarning):
+                    print(f"{prog}: warning: {w.message}", file=sys.stderr)
+                else:
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
         except (TypeError, ValueError) as e:
             # the options passed above: what fails here is the data (a cloud without a spacing, a
             # pose out of range), a runtime failure as in pcd_collision (exit 1)
