@@ -134,7 +134,7 @@ splitValue (const std::vector<double>& p, double pmin, double pmax, std::vector<
 }
 
 // The node layout its documentation promises (ProbabilisticBVH::Node).
-static_assert (sizeof (ProbabilisticBVH::Node) == 128, "a hierarchy node is 128 bytes");
+static_assert (sizeof (ProbabilisticBVH::Node) == 120, "a hierarchy node is 120 bytes");
 
 // Per-node geometry: everything computed from the node's own points.
 struct NodeGeometry
@@ -159,39 +159,58 @@ struct BuildPoints
   const std::vector<double>& area_weights;
 };
 
+/** \brief The mean of points' means and the eigen-decomposition of their scatter (ascending
+  * eigenvalues; zero eigenvalues and identity axes when the solver fails). */
 void
-computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, double k_sigma, NodeGeometry& g)
+meanAndScatter (const std::vector<Eigen::Vector3d>& means, const std::vector<int>& points, Eigen::Vector3d& mean,
+                Eigen::Vector3d& lambda, Eigen::Matrix3d& V)
 {
   const std::size_t m = points.size ();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero ();
+  mean.setZero ();
   for (int j : points)
-    mean += cloud.means[j];
+    mean += means[j];
   mean /= static_cast<double> (m);
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero ();
   for (int j : points)
   {
-    const Eigen::Vector3d d = cloud.means[j] - mean;
+    const Eigen::Vector3d d = means[j] - mean;
     C.noalias () += d * d.transpose ();
   }
   C /= static_cast<double> (m);
 
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es (C);
-  Eigen::Vector3d lambda = es.eigenvalues ();
-  Eigen::Matrix3d V = es.eigenvectors ();
+  lambda = es.eigenvalues ();
+  V = es.eigenvectors ();
   if (es.info () != Eigen::Success || !V.allFinite ())
   {
     lambda.setZero ();
     V.setIdentity ();
   }
-  g.mean = mean;
+}
+
+/** \brief sigma_n = lambda_1 / (lambda_1 + lambda_2 + lambda_3) of ascending eigenvalues (0 when
+  * they sum to 0). */
+double
+variationOf (const Eigen::Vector3d& lambda)
+{
+  const double l1 = std::max (0.0, lambda (0));
+  const double sum = l1 + std::max (0.0, lambda (1)) + std::max (0.0, lambda (2));
+  return sum > 0.0 ? l1 / sum : 0.0;
+}
+
+void
+computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, double k_sigma, NodeGeometry& g)
+{
+  const std::size_t m = points.size ();
+  Eigen::Vector3d lambda;
+  Eigen::Matrix3d V;
+  meanAndScatter (cloud.means, points, g.mean, lambda, V);
   g.axes.col (0) = V.col (2);
   g.axes.col (1) = V.col (1);
   // e1 is implied by e3 x e2, as the node's box stores it (OrientedBox), so the extents and the
   // leakage below are those of the stored box exactly.
   g.axes.col (2) = g.axes.col (0).cross (g.axes.col (1));
-  const double l1 = std::max (0.0, lambda (0));
-  const double sum = l1 + std::max (0.0, lambda (1)) + std::max (0.0, lambda (2));
-  g.variation = sum > 0.0 ? l1 / sum : 0.0;
+  g.variation = variationOf (lambda);
 
   for (int k = 0; k < 3; ++k)
   {
@@ -430,8 +449,6 @@ makeNode (const BuildPoints& points, const BVHParams& params, const BuildTask& t
   for (int k = 0; k < 3; ++k)
     node.max_sigma (k) = static_cast<float> (g.s_max (k));
   node.leakage = static_cast<float> (nodeLeakage (points, pts, g, params.leakage_bound));
-  node.variation = static_cast<float> (g.variation);
-  node.num_points = static_cast<std::int32_t> (m);
   node.depth = static_cast<std::uint16_t> (task.depth);
   node.first_child = -1;
   node.num_children = 0;
@@ -784,6 +801,38 @@ ProbabilisticBVH::indices (const Node& node) const
   span.data = indices_.data () + node.begin;
   span.size = static_cast<std::size_t> (node.end - node.begin);
   return span;
+}
+
+namespace
+{
+/** \brief A node's distinct point indices, ascending: the points its build task held (the root's
+  * are ascending and every split keeps their order). */
+std::vector<int>
+distinctIndices (const ProbabilisticBVH::IndexSpan& span)
+{
+  std::vector<int> points (span.begin (), span.end ());
+  std::sort (points.begin (), points.end ());
+  points.erase (std::unique (points.begin (), points.end ()), points.end ());
+  return points;
+}
+} // namespace
+
+std::size_t
+ProbabilisticBVH::distinctPoints (const Node& node) const
+{
+  return node.isLeaf () ? indices (node).size : distinctIndices (indices (node)).size ();
+}
+
+double
+ProbabilisticBVH::variation (const Node& node) const
+{
+  const std::vector<int> points = distinctIndices (indices (node));
+  if (points.empty ())
+    return 0.0;
+  Eigen::Vector3d mean, lambda;
+  Eigen::Matrix3d V;
+  meanAndScatter (means_, points, mean, lambda, V);
+  return variationOf (lambda);
 }
 
 std::size_t

@@ -61,8 +61,8 @@ differingNodes (const ProbabilisticBVH& a, const ProbabilisticBVH& b)
     const Node& x = a.nodes ()[i];
     const Node& y = b.nodes ()[i];
     const bool same = x.first_child == y.first_child && x.num_children == y.num_children && x.begin == y.begin &&
-                      x.end == y.end && x.num_points == y.num_points && x.depth == y.depth &&
-                      x.leaf_reason == y.leaf_reason && x.leakage == y.leakage && x.variation == y.variation &&
+                      x.end == y.end && x.depth == y.depth &&
+                      x.leaf_reason == y.leaf_reason && x.leakage == y.leakage &&
                       x.max_sigma == y.max_sigma && x.box.first_axes == y.box.first_axes && x.box.center == y.box.center &&
                       x.box.half_extents == y.box.half_extents;
     differing += same ? 0 : 1;
@@ -239,7 +239,7 @@ TEST_P (BVHInvariants, Hold)
 
   // Root holds every point; the stored cloud is the input.
   EXPECT_EQ (bvh.size (), n);
-  EXPECT_EQ (nodes[0].num_points, static_cast<std::int32_t> (n));
+  EXPECT_EQ (bvh.distinctPoints (nodes[0]), static_cast<std::size_t> (n));
   EXPECT_EQ (bvh.means (), cloud.means);
   ASSERT_EQ (bvh.covariances ().size (), n);
   for (std::size_t i = 0; i < n; ++i)
@@ -259,7 +259,7 @@ TEST_P (BVHInvariants, Hold)
     SCOPED_TRACE ("node " + std::to_string (id));
     max_depth = std::max (max_depth, static_cast<int> (nd.depth));
     const std::vector<int> pts = distinctPoints (bvh, nd);
-    ASSERT_EQ (pts.size (), static_cast<std::size_t> (nd.num_points));
+    ASSERT_EQ (pts.size (), bvh.distinctPoints (nd));
 
     // The box: a rotation, non-negative extents, and equal to a refit on the node's points.
     EXPECT_NEAR ((nd.box.axes ().transpose () * nd.box.axes () - Eigen::Matrix3d::Identity ()).norm (), 0.0, 1e-12);
@@ -293,14 +293,14 @@ TEST_P (BVHInvariants, Hold)
     EXPECT_GE (nd.leakage, 0.0);
     EXPECT_LE (nd.leakage, 1.0);
     EXPECT_NEAR (nd.coverage (), 1.0 - nd.leakage, 0.0);
-    EXPECT_GE (nd.variation, 0.0f);
-    EXPECT_LE (nd.variation, 1.0f / 3.0f + 1e-6f);
+    EXPECT_GE (bvh.variation (nd), 0.0f);
+    EXPECT_LE (bvh.variation (nd), 1.0f / 3.0f + 1e-6f);
 
     if (nd.isLeaf ())
     {
       ++leaves;
       stored += static_cast<std::size_t> (nd.end - nd.begin);
-      EXPECT_EQ (nd.end - nd.begin, nd.num_points) << "a leaf holds each point once";
+      EXPECT_EQ (nd.end - nd.begin, static_cast<std::int32_t> (bvh.distinctPoints (nd))) << "a leaf holds each point once";
       for (int j : pts)
         covered[j] = 1;
       const std::size_t m = pts.size ();
@@ -308,7 +308,7 @@ TEST_P (BVHInvariants, Hold)
       {
         case ProbabilisticBVH::LeafReason::StopRule:
           EXPECT_LE (m, static_cast<std::size_t> (params.n_max));
-          EXPECT_LE (nd.variation, params.sigma_max);
+          EXPECT_LE (bvh.variation (nd), params.sigma_max);
           break;
         case ProbabilisticBVH::LeafReason::MinSize:
           EXPECT_LE (m, static_cast<std::size_t> (params.n_min));
@@ -324,8 +324,8 @@ TEST_P (BVHInvariants, Hold)
 
     // Internal node: children partition the node's points with overlap, each strictly smaller.
     EXPECT_EQ (nd.leaf_reason, ProbabilisticBVH::LeafReason::NotLeaf);
-    EXPECT_TRUE (nd.num_points > params.n_max || nd.variation > params.sigma_max);
-    EXPECT_GT (nd.num_points, params.n_min);
+    EXPECT_TRUE (static_cast<std::int32_t> (bvh.distinctPoints (nd)) > params.n_max || bvh.variation (nd) > params.sigma_max);
+    EXPECT_GT (static_cast<std::int32_t> (bvh.distinctPoints (nd)), params.n_min);
     if (params.split_style == BVHParams::SplitStyle::Pca)
       EXPECT_EQ (nd.num_children, 2);
     else
@@ -490,7 +490,7 @@ TEST (ProbabilisticBVH, VariationOracles)
   }
   ProbabilisticBVH bvh_plane (plane);
   for (const Node& nd : bvh_plane.nodes ())
-    EXPECT_LT (nd.variation, 1e-12f);
+    EXPECT_LT (bvh_plane.variation (nd), 1e-12f);
   // The normal of the patch is box axis 2 (e1).
   EXPECT_NEAR (std::abs (bvh_plane.node (0).box.axes ().col (2).dot (R.col (2))), 1.0, 1e-9);
 
@@ -498,8 +498,8 @@ TEST (ProbabilisticBVH, VariationOracles)
   // standard deviation sqrt(0.8 / 10^4) = 0.009, so sigma_n is within 0.015 of 1/3.
   const UncertainCloud cube = shapeCloud (Shape::Box, 10000, 6);
   ProbabilisticBVH bvh_cube (cube);
-  EXPECT_NEAR (bvh_cube.node (0).variation, 1.0 / 3.0, 0.015);
-  EXPECT_LE (bvh_cube.node (0).variation, 1.0 / 3.0 + 1e-7);
+  EXPECT_NEAR (bvh_cube.variation (bvh_cube.node (0)), 1.0 / 3.0, 0.015);
+  EXPECT_LE (bvh_cube.variation (bvh_cube.node (0)), 1.0 / 3.0 + 1e-7);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -520,7 +520,7 @@ TEST (ProbabilisticBVH, GatherAppliesTheTransform)
     if (!nd.isLeaf ())
       continue;
     const PointSetView v = bvh.gatherPoints (nd, T, m, cv);
-    ASSERT_EQ (v.size, static_cast<std::size_t> (nd.num_points));
+    ASSERT_EQ (v.size, bvh.distinctPoints (nd));
     const auto idx = bvh.indices (nd);
     for (std::size_t i = 0; i < v.size; ++i)
     {
@@ -641,8 +641,8 @@ TEST (ProbabilisticBVH, SinglePointIsOneLeaf)
   const Node& r = bvh.node (0);
   EXPECT_TRUE (r.isLeaf ());
   EXPECT_EQ (r.leaf_reason, ProbabilisticBVH::LeafReason::StopRule);
-  EXPECT_EQ (r.num_points, 1);
-  EXPECT_EQ (r.variation, 0.0f);
+  EXPECT_EQ (static_cast<std::int32_t> (bvh.distinctPoints (r)), 1);
+  EXPECT_EQ (bvh.variation (r), 0.0f);
   EXPECT_EQ (r.leakage, 0.0) << "an exact point inside its box";
   EXPECT_EQ (r.box.half_extents, Eigen::Vector3f::Zero ());
   EXPECT_LE ((r.box.center - c.means[0]).norm (), 1e-15);
@@ -664,9 +664,9 @@ TEST (ProbabilisticBVH, IdenticalPointsMakeOneNoProgressLeaf)
     ProbabilisticBVH bvh (c, p);
     ASSERT_EQ (bvh.nodes ().size (), 1u);
     EXPECT_EQ (bvh.node (0).leaf_reason, ProbabilisticBVH::LeafReason::NoProgress);
-    EXPECT_EQ (bvh.node (0).num_points, 100);
+    EXPECT_EQ (bvh.distinctPoints (bvh.node (0)), 100u);
     EXPECT_EQ (bvh.storedPoints (), 100u);
-    EXPECT_EQ (bvh.node (0).variation, 0.0f);
+    EXPECT_EQ (bvh.variation (bvh.node (0)), 0.0f);
     EXPECT_FLOAT_EQ (bvh.node (0).leakage, static_cast<float> (2.0 * Phi (-1.0)));
   }
 }
@@ -688,13 +688,13 @@ TEST (ProbabilisticBVH, CollinearPointsSplitAlongTheLine)
     EXPECT_GT (bvh.leafCount (), 4u);
     for (const Node& nd : bvh.nodes ())
     {
-      EXPECT_LT (nd.variation, 1e-9f);
+      EXPECT_LT (bvh.variation (nd), 1e-9f);
       EXPECT_NEAR (std::abs (nd.box.axes ().col (0).dot (dir)), 1.0, 1e-9);
       EXPECT_LT (nd.box.half_extents.tail<2> ().maxCoeff (), 1e-12);
       if (nd.isLeaf ())
       {
         EXPECT_EQ (nd.leaf_reason, ProbabilisticBVH::LeafReason::StopRule);
-        EXPECT_LE (nd.num_points, 20);
+        EXPECT_LE (static_cast<std::int32_t> (bvh.distinctPoints (nd)), 20);
       }
       else
         EXPECT_EQ (nd.num_children, 2) << "only the line's axis is split";
@@ -715,7 +715,7 @@ TEST (ProbabilisticBVH, TwoClustersOfDuplicatesSplitOnce)
   ASSERT_EQ (bvh.nodes ().size (), 3u);
   EXPECT_EQ (bvh.node (1).leaf_reason, ProbabilisticBVH::LeafReason::NoProgress);
   EXPECT_EQ (bvh.node (2).leaf_reason, ProbabilisticBVH::LeafReason::NoProgress);
-  EXPECT_EQ (bvh.node (1).num_points + bvh.node (2).num_points, 60);
+  EXPECT_EQ (bvh.distinctPoints (bvh.node (1)) + bvh.distinctPoints (bvh.node (2)), 60u);
   EXPECT_EQ (bvh.storedPoints (), 60u);
 }
 
@@ -824,17 +824,17 @@ TEST (ProbabilisticBVH, NoiseStopKeepsNodesWithinTheNoiseWhole)
     {
       if (nd.isLeaf ())
       {
-        EXPECT_LE (nd.num_points, params.n_noise_max);
+        EXPECT_LE (static_cast<std::int32_t> (on.distinctPoints (nd)), params.n_noise_max);
         for (int j : on.indices (nd))
           covered[static_cast<std::size_t> (j)] = 1;
       }
       if (nd.leaf_reason == ProbabilisticBVH::LeafReason::NoiseStop)
       {
-        EXPECT_GT (nd.num_points, params.n_min);
+        EXPECT_GT (static_cast<std::int32_t> (on.distinctPoints (nd)), params.n_min);
         EXPECT_LE (extentOverMedianSigma (on, nd), params.noise_stop * (1.0 + 1e-9));
       }
       // An internal node the rule could have kept whole was beyond the noise.
-      if (!nd.isLeaf () && nd.num_points <= params.n_noise_max)
+      if (!nd.isLeaf () && static_cast<std::int32_t> (on.distinctPoints (nd)) <= params.n_noise_max)
       {
         EXPECT_GT (extentOverMedianSigma (on, nd), params.noise_stop * (1.0 - 1e-9));
       }
@@ -850,7 +850,7 @@ TEST (ProbabilisticBVH, NoiseStopKeepsNodesWithinTheNoiseWhole)
     {
       if (nd.isLeaf ())
       {
-        EXPECT_LE (nd.num_points, 40);
+        EXPECT_LE (static_cast<std::int32_t> (capped.distinctPoints (nd)), 40);
       }
     }
   }
@@ -874,7 +874,7 @@ TEST (ProbabilisticBVH, NoiseStopBuildsTheSameHierarchyOnAnyThreadCount)
     std::int32_t largest = 0;
     for (const Node& nd : one.nodes ())
       if (nd.leaf_reason == ProbabilisticBVH::LeafReason::NoiseStop)
-        largest = std::max (largest, nd.num_points);
+        largest = std::max (largest, static_cast<std::int32_t> (one.distinctPoints (nd)));
     if (params.n_noise_max == 40000)
     {
       EXPECT_GT (largest, 5000);

@@ -109,10 +109,11 @@ public:
     NoiseStop   ///< a split was wanted but the node is within the noise (BVHParams::noise_stop)
   };
 
-  /** \brief One node. Children of a node are stored contiguously. A node is 128 bytes (the
+  /** \brief One node. Children of a node are stored contiguously. A node is 120 bytes (the
     * nodes are most of a large cloud's model, 0.6 a point at 1,000,000 points), so the box keeps
     * two of its axes and its half extents in single precision (rounded up), the leakage is
-    * single precision and the depth 16 bits. */
+    * single precision and the depth 16 bits, and what only the build reads (the node's distinct
+    * point count and variation) is not kept: distinctPoints() and variation() recompute it. */
   struct Node
   {
     /** \brief Inflated oriented box in the cloud's frame (metres). */
@@ -124,9 +125,6 @@ public:
     /** \brief Per box axis, the largest point standard deviation sqrt(a^T Sigma a) (metres);
       * lets a traversal inflate the box further (ExpandedBV). */
     Eigen::Vector3f max_sigma = Eigen::Vector3f::Zero ();
-    /** \brief Variation sigma_n = lambda_1 / (lambda_1 + lambda_2 + lambda_3) of the node's
-      * means, in [0, 1/3]; 0 when all means coincide. */
-    float variation = 0.0f;
     /** \brief Id of the first child, -1 for a leaf. */
     std::int32_t first_child = -1;
     /** \brief Start of the range [begin, end) into pointIndices(): for a leaf its points, for
@@ -134,8 +132,6 @@ public:
     std::int32_t begin = 0;
     /** \brief End of the range [begin, end) into pointIndices(). */
     std::int32_t end = 0;
-    /** \brief Number of distinct points of the node (m). */
-    std::int32_t num_points = 0;
     /** \brief Depth below the root (root = 0), at most maxDepth(). */
     std::uint16_t depth = 0;
     /** \brief Number of children: 0 (leaf), 2 (Pca) or 1..8 (Octree). */
@@ -223,6 +219,16 @@ public:
 
   /** \brief The point indices of a node (duplicates included for internal nodes). */
   IndexSpan indices (const Node& node) const;
+
+  /** \brief Number of distinct points of a node (m; a leaf holds each of its points once, an
+    * internal node's range repeats those its children share). */
+  std::size_t distinctPoints (const Node& node) const;
+
+  /** \brief Variation sigma_n = lambda_1 / (lambda_1 + lambda_2 + lambda_3) of a node's
+    * distinct means (the stop rule's, METHOD.md 8.2), in [0, 1/3]; 0 when all coincide.
+    * Recomputed as the build computed it, from the node's points in the same (ascending) order:
+    * the same number. */
+  double variation (const Node& node) const;
 
   /** \brief Points stored in the leaves, counted with duplication (>= size()). */
   std::size_t storedPoints () const { return indices_.size (); }
