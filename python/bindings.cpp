@@ -282,8 +282,13 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   std::string ext = path.extension ().string ();
   for (char& ch : ext)
     ch = static_cast<char> (std::tolower (static_cast<unsigned char> (ch)));
-  if (ext != ".pcd")
-    throw py::value_error ("path: only .pcd files are read, got '" + path.string () + "'");
+  // What pcd_collision reads as a cloud: a .pcd, or a .ply declaring no face (one with faces is
+  // a mesh, whose samples read_mesh and sample_mesh give).
+  if (ext == ".ply" && !pcl_probcollision::io::isFacelessPly (path.string ()))
+    throw py::value_error ("path: '" + path.string () + "' is a mesh (its header declares faces) or not a readable "
+                           ".ply; read_mesh and sample_mesh (or sample_mesh_with_normals) give a mesh's samples");
+  if (ext != ".pcd" && ext != ".ply")
+    throw py::value_error ("path: only .pcd and face-less .ply files are read, got '" + path.string () + "'");
   const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : castArgument<CloudModelParams> (params_obj, "params", "CloudModelParams");
   const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
 
@@ -1188,7 +1193,8 @@ PYBIND11_MODULE (_core, m)
            return std::const_pointer_cast<CloudModel> (model);
          },
          py::arg ("path"), py::arg ("params") = py::none (), py::arg ("name") = py::none (),
-         "Builds the CloudModel of a .pcd file (x y z fields, any numeric type; its VIEWPOINT is the sensor pose).\n\n"
+         "Builds the CloudModel of a .pcd file (x y z fields, any numeric type; its VIEWPOINT is the sensor pose) or of a\n"
+         "    .ply declaring no face (its camera element, if any, is the sensor pose), as pcd_collision reads them.\n\n"
          "params: CloudModelParams (None = defaults); name: defaults to the file name.\n"
          "With params.surface, a file with normal_x normal_y normal_z fields (any numeric type) gives its points\n"
          "    those normals, as build_model(normals=) does: taken as outward by the Auto and PointNormals\n"

@@ -900,3 +900,23 @@ def test_input_warnings_are_pcd_collisions():
     assert core.model_warning(far, "float spacing") == "" and core.model_warning(m, "float spacing") == "'m.pcd': float spacing"
     assert core.between_samples_warning(True, True, 2, "pose 1", 0.08).startswith("pose 1 reads free")
     assert core.between_samples_warning(True, True, 0, "pose 1", 0.08) == ""
+
+
+def test_load_model_reads_a_faceless_ply_as_pcd_collision_does(tmp_path):
+    # pcd_collision and read_cloud take a .ply without faces as a cloud; load_model refused it.
+    points = sheet()
+    ply = tmp_path / "sheet.ply"
+    ply.write_text("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                   "end_header\n" % len(points) + "".join("%r %r %r\n" % tuple(map(float, p)) for p in points))
+    pcd = tmp_path / "sheet.pcd"
+    write_pcd(pcd, points)
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    a, b = pc.load_model(ply, params=params), pc.load_model(pcd, params=params)
+    assert len(a) == len(b) == len(points)
+    r = pc.collide(a, b, translation(z=0.0005))
+    assert r.probability == pc.collide(b, b, translation(z=0.0005)).probability
+    mesh = tmp_path / "triangle.ply"
+    mesh.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    with pytest.raises(ValueError, match="triangle.ply' is a mesh"):
+        pc.load_model(mesh)
