@@ -489,6 +489,43 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
                        capture_output=True, text=True).stderr)
 
 
+def test_cli_shows_progress_on_a_terminal_only(tmp_path, table_points):
+    """As pcd_collision: "\\r[k/n poses]" on stderr while a batch runs, when stderr is a terminal,
+    erased at the end; through a pipe nothing of it."""
+    import pty
+
+    write_pcd(tmp_path / "table.pcd", table_points)
+    poses = tmp_path / "poses.txt"
+    rows = near_table_poses(3000, seed=5)  # about 2 s of answers on one worker
+    poses.write_text("".join("{:.5f} {:.5f} {:.5f} {:.4f} {:.4f} {:.4f}\n".format(*r) for r in rows))
+    args = [PYTHON, "-m", "pcl_probcollision.dask", str(DATA / "gripper.obj"), str(tmp_path / "table.pcd"), str(poses),
+            "--scheduler", "local:1", "--chunk-size", "25", "-sigma", "0.0015"]
+    master, slave = pty.openpty()
+    with open(tmp_path / "out.jsonl", "w") as out_file:  # a file: a full pipe would stall the run
+        p = subprocess.Popen(args, stdout=out_file, stderr=slave)
+    os.close(slave)
+    shown = b""
+    while True:
+        try:
+            got = os.read(master, 4096)
+        except OSError:  # the terminal closed with the process
+            break
+        if not got:
+            break
+        shown += got
+    p.wait(timeout=300)
+    os.close(master)
+    assert p.returncode == 0, shown
+    assert len((tmp_path / "out.jsonl").read_text().splitlines()) == 3000
+    text = shown.decode()
+    lines = re.findall(r"\r\[(\d+)/3000 poses\]", text)
+    assert lines and all(0 < int(k) < 3000 for k in lines), text
+    assert [int(k) for k in lines] == sorted(int(k) for k in lines)
+    assert text.rfind("\r\x1b[K") > text.rfind("poses]"), "erased at the end"
+    piped = subprocess.run(args, capture_output=True, text=True, timeout=300)
+    assert piped.returncode == 0 and "\r" not in piped.stderr and "poses]" not in piped.stderr
+
+
 def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
     """One dash for pcd_collision's options and two for this command's own (found in review: any
     number of dashes was taken, `--sigma` too), decimal numbers only in both (pcd_collision took

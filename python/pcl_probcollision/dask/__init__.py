@@ -26,7 +26,7 @@ import threading
 import time
 import uuid
 import warnings
-from typing import Any, Dict, Optional
+from typing import Any, Callable, Dict, Optional
 
 import numpy as np
 
@@ -562,13 +562,16 @@ def _default_client():
         return None
 
 
-def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **options) -> BatchResults:
+def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
+                  progress: Optional[Callable[[int, int], None]] = None, **options) -> BatchResults:
     """Answers every pose of an (M, 4, 4) or (M, 6) array, pcd_collision-style, on Dask workers.
 
     a, b: file paths (.pcd, face-less .ply; meshes .ply .obj .stl .vtk, sampled as pcd_collision
         does), (N, 3) numpy arrays, or Open3D PointClouds. A pose moves a into b's frame.
     client: a distributed.Client; None = the default client if there is one, else this process.
     chunk_size: poses per task (default: about 8 tasks per worker thread, 32 to 2000 poses).
+    progress: called as progress(answered, total) with the poses answered so far, each time a
+        chunk's answers arrive (in whatever order the chunks finish).
     options: pcd_collision's flags without the dash (sensor, sensor_a, sensor_b, sigma, sigma_a,
         sigma_b, k, thresholds=(low, high), measured, stochastic, seed, exhaustive, defer_kernel_fits, surface, nmax,
         sigma_max, epsilon, split, mesh_density, ignore_normals, closed, closed_a, closed_b, orientation,
@@ -610,7 +613,11 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
         raise ValueError(f"chunk_size: must be >= 1, got {chunk_size}")
     starts = list(range(0, m, chunk_size))
     if client is None:
-        parts = [answer_chunk(sa, sb, T[s:s + chunk_size], s, o) for s in starts]
+        parts = []
+        for s in starts:
+            parts.append(answer_chunk(sa, sb, T[s:s + chunk_size], s, o))
+            if progress is not None:
+                progress(min(s + chunk_size, m), m)
     else:
         fa, fb = (_scatter(client, x) for x in (sa, sb))
         run = uuid.uuid4().hex[:12]
@@ -622,9 +629,13 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None, **
 
         parts = [None] * len(futures)
         where = {f.key: i for i, f in enumerate(futures)}
+        answered = 0
         try:
             for future in as_completed(futures):
-                parts[where[future.key]] = future.result()
+                part = parts[where[future.key]] = future.result()
+                if progress is not None:
+                    answered += len(part["index"])
+                    progress(answered, m)
         finally:
             for f in futures:
                 f.release()

@@ -35,6 +35,9 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   the next argument or follows '='. -surface (experimental) adds the signed distance between the
   surfaces.
 
+On a terminal, stderr shows pcd_collision's progress line ([answered/total poses]) while the batch
+runs; its warnings (units, rounding far from the origin, ...) are printed in its words.
+
 Exit status, as pcd_collision's: 0 every pose answered, 1 a runtime failure (an unreadable input,
 a malformed poses file, a failed query), 2 a usage error (a bad option or value, an unsupported
 input type), found before the scheduler is reached.
@@ -332,6 +335,34 @@ def json_lines(r, pose_rows, o, a, b):
                f'"inputs":{inputs},"parameters":{parameters}}}')
 
 
+class Progress:
+    """pcd_collision's progress line: "\\r[k/n poses]" on stderr when it is a terminal, drawn at
+    most every 0.2 s (a short batch shows nothing) and erased before anything else is printed."""
+
+    DELAY = 0.2
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.enabled = stream.isatty()
+        self.last = time.monotonic()
+        self.shown = False
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.monotonic()
+        if not self.enabled or done >= total or now - self.last < self.DELAY:
+            return
+        self.last = now
+        self.stream.write(f"\r[{done}/{total} poses]")
+        self.stream.flush()
+        self.shown = True
+
+    def clear(self) -> None:
+        if self.shown:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+            self.shown = False
+
+
 def main(argv):
     prog = "pcl_probcollision.dask"
     client = None
@@ -366,9 +397,14 @@ def main(argv):
         try:
             # pcd_collision's warnings (units, rounding, a model's precision, meshes' samples) come
             # as InputWarnings: printed on stderr as pcd_collision prints them, once each.
+            progress = Progress(sys.stderr)
             with warnings.catch_warnings(record=True) as said:
                 warnings.simplefilter("always", InputWarning)
-                r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], **options)
+                try:
+                    r = collide_poses(a, b, pose_rows, client=client, chunk_size=own["chunk-size"], progress=progress,
+                                      **options)
+                finally:
+                    progress.clear()
             for w in said:
                 if issubclass(w.category, InputWarning):
                     print(f"{prog}: warning: {w.message}", file=sys.stderr)
