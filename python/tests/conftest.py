@@ -54,10 +54,10 @@ def translation(x=0.0, y=0.0, z=0.0):
     return T
 
 
-def write_pcd(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
-    """A binary PCD with x y z float32 fields."""
-    points = np.ascontiguousarray(points, dtype="<f4")
-    header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+def write_pcd(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0), size=4):
+    """A binary PCD with x y z fields: float32 (size 4) or float64 (size 8)."""
+    points = np.ascontiguousarray(points, dtype="<f%d" % size)
+    header = (f"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE {size} {size} {size}\nTYPE F F F\nCOUNT 1 1 1\n"
               f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT {' '.join(repr(float(v)) for v in viewpoint)}\n"
               f"POINTS {len(points)}\nDATA binary\n")
     pathlib.Path(path).write_bytes(header.encode("ascii") + points.tobytes())
@@ -65,11 +65,7 @@ def write_pcd(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
 
 def write_pcd_double(path, points, viewpoint=(0, 0, 0, 1, 0, 0, 0)):
     """A binary PCD with x y z float64 fields (a survey's or a map's coordinates, kept whole)."""
-    points = np.ascontiguousarray(points, dtype="<f8")
-    header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n"
-              f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT {' '.join(repr(float(v)) for v in viewpoint)}\n"
-              f"POINTS {len(points)}\nDATA binary\n")
-    pathlib.Path(path).write_bytes(header.encode("ascii") + points.tobytes())
+    write_pcd(path, points, viewpoint, size=8)
 
 
 def sheet(n=30, size=0.06, noise=5e-4, seed=1):
