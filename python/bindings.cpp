@@ -1266,6 +1266,19 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("diagonal", &pcl_probcollision::io::InputFacts::diagonal)
       .def_readonly ("sensor", &pcl_probcollision::io::InputFacts::sensor)
       .def_readonly ("sigma", &pcl_probcollision::io::InputFacts::sigma);
+  m.def ("finite_diagonal",
+         [] (const py::object& points) {
+           const py::array pts = floatArray (points, "points", 2, "(N, 3)");
+           pcl::PointCloud<pcl::PointXYZ> cloud;
+           if (py::isinstance<py::array_t<float>> (pts))
+             fillPoints<float> (pts, cloud);
+           else
+             fillPoints<double> (pts, cloud);
+           return pcl_probcollision::io::finiteDiagonal (cloud);
+         },
+         py::arg ("points"),
+         "Bounding-box diagonal of the finite rows of (N, 3) points held as float32, as pcd_collision measures a cloud\n"
+         "for its warnings (InputFacts.diagonal); 0 for none or one.");
   m.def ("scale_warning", &pcl_probcollision::io::scaleWarning, py::arg ("a"), py::arg ("b"),
          "pcd_collision's warning when the inputs' sizes differ by more than 100x (units); '' when none.");
   m.def ("noise_warning", &pcl_probcollision::io::noiseWarning, py::arg ("input"),

@@ -900,6 +900,9 @@ def test_input_warnings_are_pcd_collisions():
     assert core.model_warning(far, "float spacing") == "" and core.model_warning(m, "float spacing") == "'m.pcd': float spacing"
     assert core.between_samples_warning(True, True, 2, "pose 1", 0.08).startswith("pose 1 reads free")
     assert core.between_samples_warning(True, True, 0, "pose 1", 0.08) == ""
+    # The size pcd_collision judges a cloud by: its finite points' bounding box.
+    points = np.array([[0, 0, 0], [3, 4, 12], [np.nan, 0, 0], [1, 1, 1]], dtype=np.float32)
+    assert core.finite_diagonal(points) == 13.0 and core.finite_diagonal(points[:1]) == 0.0
 
 
 def test_load_model_reads_a_faceless_ply_as_pcd_collision_does(tmp_path):

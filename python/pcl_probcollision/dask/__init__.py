@@ -275,19 +275,12 @@ def check_mesh_noise(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, An
 
 def input_facts(spec: Dict[str, Any], o: Dict[str, Any], side: str):
     """What pcd_collision's input warnings judge of an input (core.InputFacts): a cloud's finite
-    points and their bounding-box diagonal (computed as pcd_collision does: float coordinates
-    widened to double, the norm summed x, y, z), a file's rounding to float, the side's noise; a
+    points and their bounding-box diagonal, a file's rounding to float, the side's noise; a
     mesh's size is its vertices'."""
     path = spec["path"] or spec["name"]
     if spec["kind"] == "mesh":
         return core.InputFacts(path=path, cloud=False, diagonal=core.mesh_diagonal(spec["vertices"], spec["triangles"]))
-    points = spec["points"]
-    finite = points[np.isfinite(points).all(axis=1)]
-    diagonal = 0.0
-    if len(finite):
-        d = finite.max(axis=0).astype(np.float64) - finite.min(axis=0).astype(np.float64)
-        diagonal = math.sqrt(float(d[0]) * float(d[0]) + float(d[1]) * float(d[1]) + float(d[2]) * float(d[2]))
-    return core.InputFacts(path=path, cloud=True, finite=len(finite), diagonal=diagonal,
+    return core.InputFacts(path=path, cloud=True, finite=spec["finite"], diagonal=core.finite_diagonal(spec["points"]),
                            rounding=spec.get("rounding", (0.0, 0.0)), sensor=o["sensor_" + side],
                            sigma=float(o["sigma_" + side]))
 
