@@ -52,7 +52,9 @@ def test_in_process_equals_collide_batch_bit_for_bit():
     rng = np.random.default_rng(9)  # b within a few sigma of a's plane: some P strictly in (0, 1)
     P = np.column_stack([rng.uniform(-0.01, 0.01, (40, 2)), rng.uniform(-0.004, 0.004, 40),
                          rng.uniform(-0.05, 0.05, (40, 2)), rng.uniform(-3, 3, 40)])
-    r = pcd.collide_poses(a, b, P, sigma=0.002, k=8)
+    calls = []
+    r = pcd.collide_poses(a, b, P, sigma=0.002, k=8, chunk_size=16, progress=lambda done, total: calls.append(done))
+    assert calls == [16, 32, 40], "in process: after each chunk, in pose order"
     o = pcd.resolve_options({"sigma": 0.002, "k": 8})
     A = pc.build_model(a, params=pcd.model_params(o, "a", exact=False))
     B = pc.build_model(b, params=pcd.model_params(o, "b", exact=False))
@@ -68,11 +70,22 @@ def test_in_process_equals_collide_batch_bit_for_bit():
 def test_cluster_equals_in_process_on_numpy_and_files(cluster, table_path, table_points):
     P = near_table_poses(300)
     gripper = DATA / "gripper.obj"
-    local = pcd.collide_poses(gripper, table_path, P, client=None, sigma=0.0015)
+    calls = []  # progress: the poses answered so far after each chunk (chunks finish in any order)
+
+    def check_progress(chunks):
+        assert len(calls) == chunks and calls[-1] == (300, 300) and all(t == 300 for _, t in calls)
+        assert [d for d, _ in calls] == sorted(d for d, _ in calls) and calls[0][0] > 0
+        calls.clear()
+
+    local = pcd.collide_poses(gripper, table_path, P, client=None, sigma=0.0015,
+                              progress=lambda done, total: calls.append((done, total)))
+    check_progress(local.chunks)
     for chunk in (7, 64):  # many small chunks, a few large ones, in pose order
-        r = pcd.collide_poses(gripper, table_path, P, client=cluster, chunk_size=chunk, sigma=0.0015)
+        r = pcd.collide_poses(gripper, table_path, P, client=cluster, chunk_size=chunk, sigma=0.0015,
+                              progress=lambda done, total: calls.append((done, total)))
         assert r.chunks == -(-300 // chunk)
         assert_same(r, local)
+        check_progress(r.chunks)
     assert set(np.unique(local.verdict)) >= {int(pc.Verdict.Free), int(pc.Verdict.InCollision)}
     # numpy input, float64 and float32: the same model as the file's points (viewpoint at the origin).
     pts = table_points.astype(np.float64)
