@@ -163,6 +163,19 @@ fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud, boo
   }
 }
 
+/** An (N, 3) float32 / float64 array as pcl::PointXYZ (fillPoints), arg naming it in errors. */
+pcl::PointCloud<pcl::PointXYZ>
+cloudOf (const py::object& points, const char* arg)
+{
+  const py::array pts = floatArray (points, arg, 2, "(N, 3)");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  if (py::isinstance<py::array_t<float>> (pts))
+    fillPoints<float> (pts, cloud);
+  else
+    fillPoints<double> (pts, cloud);
+  return cloud;
+}
+
 std::shared_ptr<const CloudModel>
 buildModel (const py::object& points, const py::object& covariances, const py::object& params_obj,
             const std::string& name, const py::object& viewpoint = py::none (),
@@ -1267,15 +1280,7 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("sensor", &pcl_probcollision::io::InputFacts::sensor)
       .def_readonly ("sigma", &pcl_probcollision::io::InputFacts::sigma);
   m.def ("finite_diagonal",
-         [] (const py::object& points) {
-           const py::array pts = floatArray (points, "points", 2, "(N, 3)");
-           pcl::PointCloud<pcl::PointXYZ> cloud;
-           if (py::isinstance<py::array_t<float>> (pts))
-             fillPoints<float> (pts, cloud);
-           else
-             fillPoints<double> (pts, cloud);
-           return pcl_probcollision::io::finiteDiagonal (cloud);
-         },
+         [] (const py::object& points) { return pcl_probcollision::io::finiteDiagonal (cloudOf (points, "points")); },
          py::arg ("points"),
          "Bounding-box diagonal of the finite rows of (N, 3) points held as float32, as pcd_collision measures a cloud\n"
          "for its warnings (InputFacts.diagonal); 0 for none or one.");
@@ -1374,12 +1379,7 @@ PYBIND11_MODULE (_core, m)
          py::arg ("vertices"), py::arg ("triangles"), "Bounding-box diagonal of a mesh, as pcd_collision measures it.");
   m.def ("median_spacing",
          [] (const py::object& points) {
-           const py::array pts = floatArray (points, "points", 2, "(N, 3)");
-           pcl::PointCloud<pcl::PointXYZ> cloud;
-           if (py::isinstance<py::array_t<float>> (pts))
-             fillPoints<float> (pts, cloud);
-           else
-             fillPoints<double> (pts, cloud);
+           const pcl::PointCloud<pcl::PointXYZ> cloud = cloudOf (points, "points");
            py::gil_scoped_release release;
            return pcl_probcollision::io::medianSpacing (cloud);
          },
