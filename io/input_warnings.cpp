@@ -35,20 +35,60 @@ formatted (const char* format, ...)
 }
 } // namespace
 
+template <typename PointT>
+std::size_t
+finiteCount (const pcl::PointCloud<PointT>& cloud)
+{
+  std::size_t n = 0;
+  for (const auto& p : cloud.points)
+    n += std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
+  return n;
+}
+
+template <typename PointT>
 double
-finiteDiagonal (const pcl::PointCloud<pcl::PointXYZ>& cloud)
+finiteDiagonal (const pcl::PointCloud<PointT>& cloud)
 {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ());
   Eigen::Vector3d hi = -lo;
   for (const auto& p : cloud.points)
     if (std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z))
     {
-      const Eigen::Vector3d q = p.getVector3fMap ().cast<double> ();
+      const Eigen::Vector3d q = p.getVector3fMap ().template cast<double> ();
       lo = lo.cwiseMin (q);
       hi = hi.cwiseMax (q);
     }
   return (hi.array () >= lo.array ()).all () ? (hi - lo).norm () : 0.0;
 }
+
+template <typename PointT>
+InputFacts
+cloudFacts (const std::string& path, const pcl::PointCloud<PointT>& cloud, const XyzRounding& rounding,
+            const SensorNoiseModel& noise)
+{
+  InputFacts facts;
+  facts.path = path;
+  facts.finite = finiteCount (cloud);
+  facts.diagonal = finiteDiagonal (cloud);
+  facts.rounding = rounding;
+  facts.sensor = noise.name ();
+  if (noise.type () == SensorNoiseModel::Type::Isotropic)
+  {
+    double axial = 0.0, lateral = 0.0;
+    noise.sigmas (Eigen::Vector3d::Zero (), Eigen::Vector3d::Zero (), SensorPose (), axial, lateral);
+    facts.sigma = axial;
+  }
+  return facts;
+}
+
+#define PCL_PROBCOLLISION_INPUT_FACTS(PointT)                                                                          \
+  template std::size_t finiteCount (const pcl::PointCloud<PointT>&);                                                 \
+  template double finiteDiagonal (const pcl::PointCloud<PointT>&);                                                   \
+  template InputFacts cloudFacts (const std::string&, const pcl::PointCloud<PointT>&, const XyzRounding&,           \
+                                  const SensorNoiseModel&);
+PCL_PROBCOLLISION_INPUT_FACTS (pcl::PointXYZ)
+PCL_PROBCOLLISION_INPUT_FACTS (pcl::PointNormal)
+#undef PCL_PROBCOLLISION_INPUT_FACTS
 
 std::string
 scaleWarning (const InputFacts& a, const InputFacts& b)

@@ -8,6 +8,8 @@
 
 #include "cloud_input.h"
 
+#include <pcl_probcollision/sensor_noise.h>
+
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -42,8 +44,20 @@ struct InputFacts
   double sigma = 0.0;         ///< the isotropic sigma (data units)
 };
 
+/** \brief Number of a cloud's points with finite x y z (NaN points of organized clouds are skipped). */
+template <typename PointT>
+std::size_t finiteCount (const pcl::PointCloud<PointT>& cloud);
+
 /** \brief Bounding-box diagonal of a cloud's finite points (0 for none or one point). */
-double finiteDiagonal (const pcl::PointCloud<pcl::PointXYZ>& cloud);
+template <typename PointT>
+double finiteDiagonal (const pcl::PointCloud<PointT>& cloud);
+
+/** \brief The facts of a cloud read from path (loadCloud or loadCloudWithNormals gave rounding)
+  * under noise: its finite points and their extent, the noise model's name and, for an isotropic
+  * model, its sigma. PointT: pcl::PointXYZ or pcl::PointNormal. */
+template <typename PointT>
+InputFacts cloudFacts (const std::string& path, const pcl::PointCloud<PointT>& cloud, const XyzRounding& rounding,
+                       const SensorNoiseModel& noise);
 
 /** \brief Both inputs must be in the same units: a millimetre scan against a metre mesh makes
   * their sizes differ by 1000x. The warning when they differ by more than kScaleWarningRatio

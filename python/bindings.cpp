@@ -265,28 +265,6 @@ requireRegularFile (const std::filesystem::path& path)
   throw py::error_already_set ();
 }
 
-/** What the input warnings (io/input_warnings.h) judge of a cloud file read under a noise
-  * model: its finite points' extent, the rounding of its x y z to float, the isotropic sigma. */
-pcl_probcollision::io::InputFacts
-fileFacts (const std::filesystem::path& path, const pcl::PointCloud<pcl::PointXYZ>& cloud,
-           const pcl_probcollision::io::XyzRounding& rounding, const SensorNoiseModel& noise)
-{
-  pcl_probcollision::io::InputFacts facts;
-  facts.path = path.string ();
-  for (const auto& p : cloud.points)
-    facts.finite += std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
-  facts.diagonal = pcl_probcollision::io::finiteDiagonal (cloud);
-  facts.rounding = rounding;
-  facts.sensor = noise.name ();
-  if (noise.type () == SensorNoiseModel::Type::Isotropic)
-  {
-    double axial = 0.0, lateral = 0.0;
-    noise.sigmas (Eigen::Vector3d::Zero (), Eigen::Vector3d::Zero (), SensorPose (), axial, lateral);
-    facts.sigma = axial;
-  }
-  return facts;
-}
-
 std::shared_ptr<const CloudModel>
 loadModel (const std::filesystem::path& path, const py::object& params_obj, const py::object& name_obj,
            std::string& file_warning)
@@ -324,11 +302,15 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   if (!loaded)
     throw py::value_error ("path: " + error);
   py::gil_scoped_release release;
+  namespace io = pcl_probcollision::io;
+  if (has_normals)
+  {
+    file_warning = io::roundingWarning (io::cloudFacts (path.string (), oriented, rounding, params.noise));
+    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, nullptr, name);
+  }
   if (params.surface)
     pcl::copyPointCloud (oriented, cloud);
-  file_warning = pcl_probcollision::io::roundingWarning (fileFacts (path, cloud, rounding, params.noise));
-  if (has_normals)
-    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, nullptr, name);
+  file_warning = io::roundingWarning (io::cloudFacts (path.string (), cloud, rounding, params.noise));
   return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, nullptr, name);
 }
 

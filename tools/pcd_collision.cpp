@@ -109,15 +109,6 @@ requireReadable (const std::string& path)
   std::fclose (f);
 }
 
-std::size_t
-countFinite (const Cloud& cloud)
-{
-  std::size_t n = 0;
-  for (const auto& p : cloud.points)
-    n += std::isfinite (p.x) && std::isfinite (p.y) && std::isfinite (p.z);
-  return n;
-}
-
 /** \brief Loads an input; with_normals (-surface without -ignore_normals): a cloud file's
   * normal_x normal_y normal_z too, kept in in.oriented when the file has them. */
 void
@@ -142,7 +133,7 @@ loadInput (Input& in, bool with_normals, FILE* log)
     }
     else if (!loadCloud (in.path, *in.cloud, error, &in.rounding))
       throw Failure{kRuntimeFailure, error};
-    in.finite = countFinite (*in.cloud);
+    in.finite = pcl_probcollision::io::finiteCount (*in.cloud);
     if (in.finite == 0)
       throw Failure{kRuntimeFailure, "'" + in.path + "' has no finite point (" + std::to_string (in.cloud->size ()) +
                                          " points, all NaN or Inf)"};

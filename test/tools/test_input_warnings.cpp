@@ -6,7 +6,11 @@
 
 #include <pcl_probcollision/cloud_model.h>
 
+#include <pcl/common/io.h>
+
 #include <gtest/gtest.h>
+
+#include <array>
 
 #include <cmath>
 #include <limits>
@@ -105,4 +109,35 @@ TEST (InputWarnings, AFreeAnswerBetweenTwoMeshesSamplesIsWarnedOf)
   EXPECT_EQ (betweenSamplesWarning (false, true, 3, "pose 4", 90.0), "") << "a cloud's samples are what it is";
   EXPECT_EQ (betweenSamplesWarning (true, false, 3, "pose 4", 90.0), "");
   EXPECT_EQ (betweenSamplesWarning (true, true, 0, "pose 4", 90.0), "") << "nothing came within reach";
+}
+
+TEST (InputWarnings, ACloudsFactsCountAndSpanItsFinitePointsOnly)
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN ();
+  pcl::PointCloud<pcl::PointNormal> cloud;
+  for (const auto& xyz : {std::array<float, 3>{0, 0, 0}, {3, 4, 0}, {nan, 1, 1}, {1e9f, nan, 0}})
+  {
+    pcl::PointNormal p;
+    p.x = xyz[0], p.y = xyz[1], p.z = xyz[2];
+    cloud.push_back (p);
+  }
+  XyzRounding rounding;
+  rounding.largest_change = 0.25;
+  const InputFacts facts =
+      cloudFacts ("scan.pcd", cloud, rounding, pcl_probcollision::SensorNoiseModel::isotropic (0.002));
+  EXPECT_EQ (facts.path, "scan.pcd");
+  EXPECT_TRUE (facts.cloud);
+  EXPECT_EQ (facts.finite, 2u);
+  EXPECT_DOUBLE_EQ (facts.diagonal, 5.0) << "NaN points stretch nothing";
+  EXPECT_EQ (facts.rounding.largest_change, 0.25);
+  EXPECT_EQ (facts.sensor, "isotropic");
+  EXPECT_DOUBLE_EQ (facts.sigma, 0.002);
+
+  const InputFacts kinect = cloudFacts ("scan.pcd", cloud, rounding, pcl_probcollision::SensorNoiseModel::kinect ());
+  EXPECT_EQ (kinect.sensor, "kinect");
+  EXPECT_EQ (kinect.sigma, 0.0) << "a depth sensor's sigma varies; the rounding is judged against the size";
+  pcl::PointCloud<pcl::PointXYZ> xyz;
+  pcl::copyPointCloud (cloud, xyz);
+  EXPECT_EQ (finiteCount (xyz), 2u);
+  EXPECT_DOUBLE_EQ (finiteDiagonal (xyz), 5.0);
 }
