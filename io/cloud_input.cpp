@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -257,6 +259,27 @@ checkField (const CloudFile& file, int index, const std::string& path, const cha
   return true;
 }
 
+} // namespace
+
+std::string
+unreadableFile (const std::string& path)
+{
+  std::error_code ec;
+  const auto status = std::filesystem::status (path, ec);
+  if (ec || !std::filesystem::exists (status))
+    return "cannot read '" + path + "': No such file or directory";
+  if (!std::filesystem::is_regular_file (status))
+    return "cannot read '" + path + "': " +
+           (std::filesystem::is_directory (status) ? std::string ("is a directory") : std::string ("not a regular file"));
+  std::FILE* f = std::fopen (path.c_str (), "rb");
+  if (!f)
+    return "cannot read '" + path + "': " + std::strerror (errno);
+  std::fclose (f);
+  return {};
+}
+
+namespace
+{
 /** \brief Reads the file (PCD, or PLY by its extension) with every check; with want_normals,
   * also locates normal_x normal_y normal_z, all three or none (a partial set is an error naming
   * the missing field). */
@@ -265,21 +288,9 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
 {
   const QuietPclConsole quiet;  // the error returned is the one report (pcd_collision -v shows PCL's)
   pcl::PCLPointCloud2& blob = file.blob;
-  // PCL's readers are given regular files only: on a directory PCDReader::readHeader never
-  // returns (found in review, through Python's read_cloud).
-  std::error_code ec;
-  const auto status = std::filesystem::status (path, ec);
-  if (ec || !std::filesystem::exists (status))
-  {
-    error = "cannot read '" + path + "': No such file or directory";
+  error = unreadableFile (path);
+  if (!error.empty ())
     return false;
-  }
-  if (!std::filesystem::is_regular_file (status))
-  {
-    error = "cannot read '" + path + "': " +
-            (std::filesystem::is_directory (status) ? std::string ("is a directory") : std::string ("not a regular file"));
-    return false;
-  }
   const bool ply = isPly (path);
   const char* format = ply ? "PLY" : "PCD";
   if (ply)

@@ -26,6 +26,12 @@ struct XyzRounding
   double largest_magnitude = 0.0;
 };
 
+/** \brief Why the command lines cannot read path ("cannot read 'PATH': No such file or
+  * directory", "is a directory", "not a regular file" or the system's reason), or empty when it
+  * is a regular file they can open. PCL's readers are given regular files only: on a directory
+  * PCDReader::readHeader never returns, and opening a FIFO blocks. */
+std::string unreadableFile (const std::string& path);
+
 /** \brief Loads any PCD with x y z fields into PointXYZ, keeping width/height (organization),
   * NaN points and the VIEWPOINT (sensor_origin_, sensor_orientation_); a .ply (extension
   * case-insensitive) goes through PCL's PLY reader, its camera element giving the viewpoint. x y z

@@ -2,6 +2,7 @@
 // Python bindings (issue #18): the per-cloud model, the query and its batch, with the C++ structs'
 // own defaults. numpy points become a pcl::PointCloud<pcl::PointXYZ> once and go through
 // buildCloudModel<pcl::PointXYZ>, so a Python model is exactly the C++ model of the same floats.
+#include "cli_options.h"
 #include "cloud_input.h"
 #include "input_warnings.h"
 #include "quiet_pcl_console.h"
@@ -31,6 +32,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -630,7 +632,26 @@ cloudArray (const pcl::PointCloud<pcl::PointXYZ>& cloud)
   return points;
 }
 
-/** (M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), exactly as pcd_collision turns -pose into T. */
+/** pcd_collision's -poses file (pcd_collision::parsePoses, the one reader of the format) as (M, 6)
+  * tx ty tz roll pitch yaw. */
+py::array_t<double>
+readPoses (const std::filesystem::path& path)
+{
+  requireRegularFile (path);
+  std::vector<pcd_collision::Pose> poses;
+  std::string error = pcl_probcollision::io::unreadableFile (path.string ());
+  std::ifstream f (path);
+  if (!error.empty () || !pcd_collision::parsePoses (f, path.string (), poses, error))
+    throw py::value_error ("path: " + error);
+  py::array_t<double> out ({static_cast<py::ssize_t> (poses.size ()), static_cast<py::ssize_t> (6)});
+  auto o = out.mutable_unchecked<2> ();
+  for (std::size_t k = 0; k < poses.size (); ++k)
+    for (int d = 0; d < 6; ++d)
+      o (static_cast<py::ssize_t> (k), d) = poses[k][static_cast<std::size_t> (d)];
+  return out;
+}
+
+/** (M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), by pcd_collision's rule (poseTransform). */
 py::array_t<double>
 posesFromXyzRpy (const py::object& obj)
 {
@@ -647,11 +668,7 @@ posesFromXyzRpy (const py::object& obj)
   auto o = out.mutable_unchecked<3> ();
   for (py::ssize_t k = 0; k < p.shape (0); ++k)
   {
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
-    T.linear () = (Eigen::AngleAxisd (p (k, 5), Eigen::Vector3d::UnitZ ()) * Eigen::AngleAxisd (p (k, 4), Eigen::Vector3d::UnitY ()) *
-                   Eigen::AngleAxisd (p (k, 3), Eigen::Vector3d::UnitX ()))
-                      .toRotationMatrix ();
-    T.translation () = Eigen::Vector3d (p (k, 0), p (k, 1), p (k, 2));
+    const Eigen::Isometry3d T = pcd_collision::poseTransform ({p (k, 0), p (k, 1), p (k, 2), p (k, 3), p (k, 4), p (k, 5)});
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         o (k, i, j) = T.matrix () (i, j);
@@ -1366,6 +1383,11 @@ PYBIND11_MODULE (_core, m)
            return pcl_probcollision::io::medianSpacing (cloud);
          },
          py::arg ("points"), "Median nearest-neighbour spacing of a cloud (pcd_collision's mesh sample spacing).");
+  m.def ("read_poses", &readPoses, py::arg ("path"),
+         "Reads pcd_collision's -poses file: six numbers a line (tx ty tz roll pitch yaw) separated by blanks\n"
+         "and/or one comma, '#' comments and blank lines allowed.\n\n"
+         "Returns (M, 6) float64. FileNotFoundError or IsADirectoryError for a path that is no file; ValueError with\n"
+         "pcd_collision's message (\"path: FILE:LINE: reason\") for a malformed line or a file without a pose.");
   m.def ("poses_from_xyzrpy", &posesFromXyzRpy, py::arg ("poses"),
          "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.");
   m.def ("invert_poses", &invertPoses, py::arg ("poses"), "(M, 4, 4) rigid transforms -> their inverses (Eigen's).");

@@ -144,6 +144,21 @@ inputKindOf (const std::string& path)
 
 namespace
 {
+/** \brief A word for a number that is not finite (nan, inf, infinity, any case, signed or not) or
+  * a decimal beyond a double's range (1e999): "not a finite number" rather than "not a number". */
+bool
+nonFiniteNumber (const std::string& text)
+{
+  const std::string word = lower (text.empty () || (text[0] != '+' && text[0] != '-') ? text : text.substr (1));
+  if (word == "nan" || word == "inf" || word == "infinity")
+    return true;
+  if (text.empty () || text.find_first_not_of ("0123456789+-.eE") != std::string::npos)
+    return false;
+  char* end = nullptr;
+  const double v = std::strtod (text.c_str (), &end);
+  return end == text.c_str () + text.size () && !std::isfinite (v);
+}
+
 /** \brief Why a pose's translation is out of the library's range (detail::kMaxCoordinate, the
   * bound collide() enforces), so that the command line refuses it where it is read; empty if
   * none. Finite angles always give a rotation. */
@@ -156,6 +171,17 @@ translationRangeError (const Pose& pose)
   return std::string ();
 }
 } // namespace
+
+Eigen::Isometry3d
+poseTransform (const Pose& p)
+{
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
+  T.linear () = (Eigen::AngleAxisd (p[5], Eigen::Vector3d::UnitZ ()) * Eigen::AngleAxisd (p[4], Eigen::Vector3d::UnitY ()) *
+                 Eigen::AngleAxisd (p[3], Eigen::Vector3d::UnitX ()))
+                    .toRotationMatrix ();
+  T.translation () = Eigen::Vector3d (p[0], p[1], p[2]);
+  return T;
+}
 
 int
 parsePoseLine (const std::string& line, Pose& pose, std::string& error)
@@ -203,7 +229,7 @@ parsePoseLine (const std::string& line, Pose& pose, std::string& error)
   {
     if (!parseDouble (tokens[i], pose[i]))
     {
-      error = "'" + tokens[i] + "' is not a finite number";
+      error = "'" + tokens[i] + "' is not " + (nonFiniteNumber (tokens[i]) ? "a finite number" : "a number");
       return -1;
     }
   }

@@ -8,6 +8,8 @@
 #include <pcl_probcollision/cloud_model_params.h>
 #include <pcl_probcollision/collision_request.h>
 
+#include <Eigen/Geometry>
+
 #include <array>
 #include <cstdint>
 #include <istream>
@@ -20,6 +22,10 @@ namespace pcd_collision
 /** \brief tx, ty, tz, roll, pitch, yaw (data units, radians):
   * p' = Rz(yaw) Ry(pitch) Rx(roll) p + t. */
 using Pose = std::array<double, 6>;
+
+/** \brief The rigid transform of a pose, p' = Rz(yaw) Ry(pitch) Rx(roll) p + t: pcd_collision's
+  * -pose and -poses, and Python's poses_from_xyzrpy. */
+Eigen::Isometry3d poseTransform (const Pose& pose);
 
 /** \brief The defaults of the options, shown by helpText(). The library's settings are read
   * from the structs that own them (CloudModelParams, BVHParams, CollisionRequest); only what
@@ -183,7 +189,8 @@ bool parseDoubleList (const std::string& text, std::size_t count, std::vector<do
 int parsePoseLine (const std::string& line, Pose& pose, std::string& error);
 
 /** \brief A whole -poses file; false with "NAME:LINE: reason" in error on the first malformed
-  * line, or when it holds no pose at all. */
+  * line, or when it holds no pose at all. Lines end at '\n' alone. The one reader of the
+  * format: pcd_collision's and, through Python's read_poses, the Dask command line's. */
 bool parsePoses (std::istream& in, const std::string& name, std::vector<Pose>& poses,
                  std::string& error);
 } // namespace pcd_collision

@@ -97,16 +97,8 @@ struct Input
 void
 requireReadable (const std::string& path)
 {
-  std::error_code ec;
-  const auto st = fs::status (path, ec);
-  if (ec || !fs::exists (st))
-    throw Failure{kRuntimeFailure, "cannot read '" + path + "': No such file or directory"};
-  if (fs::is_directory (st))
-    throw Failure{kRuntimeFailure, "cannot read '" + path + "': is a directory"};
-  std::FILE* f = std::fopen (path.c_str (), "rb");
-  if (!f)
-    throw Failure{kRuntimeFailure, "cannot read '" + path + "': " + std::strerror (errno)};
-  std::fclose (f);
+  if (std::string why = pcl_probcollision::io::unreadableFile (path); !why.empty ())
+    throw Failure{kRuntimeFailure, why};
 }
 
 /** \brief Loads an input; with_normals (-surface without -ignore_normals): a cloud file's
@@ -176,17 +168,6 @@ sampleInput (Input& in, double spacing, const std::string& source, FILE* log)
   in.sample_ms = msSince (start);
   std::fprintf (log, "Sampling %s [done, %.1f ms : %zu points at spacing %g, %s]\n", in.path.c_str (), in.sample_ms,
                 in.cloud->size (), spacing, source.c_str ());
-}
-
-Eigen::Isometry3d
-toIsometry (const Pose& p)
-{
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
-  T.linear () = (Eigen::AngleAxisd (p[5], Eigen::Vector3d::UnitZ ()) * Eigen::AngleAxisd (p[4], Eigen::Vector3d::UnitY ()) *
-                 Eigen::AngleAxisd (p[3], Eigen::Vector3d::UnitX ()))
-                    .toRotationMatrix ();
-  T.translation () = Eigen::Vector3d (p[0], p[1], p[2]);
-  return T;
 }
 
 /** \brief Refuses an -o that is one of the inputs (same file, through any link), and an -o in a
@@ -720,12 +701,9 @@ run (int argc, char** argv)
   const bool batch = o.poses_file.has_value ();
   if (batch)
   {
-    requireReadable (*o.poses_file);
+    std::string error = pcl_probcollision::io::unreadableFile (*o.poses_file);
     std::ifstream f (*o.poses_file);
-    if (!f)
-      throw Failure{kRuntimeFailure, "cannot read '" + *o.poses_file + "'"};
-    std::string error;
-    if (!parsePoses (f, *o.poses_file, poses, error))
+    if (!error.empty () || !parsePoses (f, *o.poses_file, poses, error))
       throw Failure{kRuntimeFailure, error};
   }
   else
@@ -906,7 +884,7 @@ run (int argc, char** argv)
     Chunk c;
     c.start = start;
     for (std::size_t j = start; j < std::min (poses.size (), start + chunk); ++j)
-      c.T.push_back (toIsometry (poses[j]));
+      c.T.push_back (poseTransform (poses[j]));
     pc.computeBatch (c.T, c.results, static_cast<int> (workers));
     return c;
   };

@@ -712,6 +712,31 @@ def test_bad_poses_in_a_batch():
         pc.collide_batch(a, a, "all")
 
 
+def test_read_poses_reads_pcd_collisions_poses_files(tmp_path):
+    """The demo's poses file as pcd_collision reads it (its -poses format: blanks or one comma,
+    comments, blank lines), and its messages for malformed lines."""
+    P = pc.read_poses(DATA / "demo_poses.txt")
+    assert P.shape == (3, 6) and P.dtype == np.float64
+    np.testing.assert_array_equal(P[2], [-0.15, 0.05, -0.02, 0, 0, 0])
+    mixed = tmp_path / "mixed.txt"
+    mixed.write_text("# tx ty tz roll pitch yaw\n\n1, 2, 3, 0.1, 0.2, 0.3  # a comment\n4 5 6\f0 0 0\n")
+    np.testing.assert_array_equal(pc.read_poses(mixed), [[1, 2, 3, 0.1, 0.2, 0.3], [4, 5, 6, 0, 0, 0]])
+    for text, words in (("0 0 0 0 0 0\n1 2 3 4 5\n", "p.txt:2: expected 6 numbers (tx ty tz roll pitch yaw), got 5"),
+                        ("1 2 3 4 5 six\n", "p.txt:1: 'six' is not a number"),
+                        ("1 2 3 4 5 nan\n", "p.txt:1: 'nan' is not a finite number"),
+                        ("1,,2,3,4,5,6\n", "p.txt:1: empty field between commas"),
+                        ("# nothing\n", "p.txt: no pose in the file")):
+        bad = tmp_path / "p.txt"
+        bad.write_text(text)
+        with pytest.raises(ValueError) as e:
+            pc.read_poses(bad)
+        assert str(e.value) == f"path: {bad}{words[5:]}", (str(e.value), words)
+    with pytest.raises(FileNotFoundError):
+        pc.read_poses(tmp_path / "missing.txt")
+    with pytest.raises(IsADirectoryError):
+        pc.read_poses(tmp_path)
+
+
 def test_bad_files(tmp_path):
     with pytest.raises(FileNotFoundError):
         pc.load_model(tmp_path / "missing.pcd")

@@ -448,7 +448,14 @@ def test_cli_errors_match_pcd_collision(tmp_path):
                    "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n0 0 0\n")
     ok = tmp_path / "ok.txt"
     ok.write_text("0 0 0 0 0 0\n")
-    for inputs, poses in ((args, huge), (args, far), ([str(DATA / "gripper.obj"), str(one)], ok)):
+    # Both read the poses file with the same reader (pcd_collision::parsePoses): a word where a
+    # number belongs, and a form feed, a blank inside a line there (Python's splitlines() ended
+    # the line at it and read line 1 as malformed).
+    word = tmp_path / "word.txt"
+    word.write_text("0 0 0 0 0 0\n1 2 3 4 5 six\n")
+    feed = tmp_path / "feed.txt"
+    feed.write_text("0 0 0\f0 0 0\n1 2 3 4 5\n")
+    for inputs, poses in ((args, huge), (args, far), (args, word), (args, feed), ([str(DATA / "gripper.obj"), str(one)], ok)):
         cpp = subprocess.run([_pcd_collision(), *inputs, "-poses", str(poses), "-json"], capture_output=True, text=True)
         py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *inputs, str(poses), "--scheduler", "local:1"],
                             capture_output=True, text=True, timeout=120)

@@ -393,9 +393,31 @@ TEST (CliOptions, PoseLines)
   EXPECT_EQ (parsePoseLine (",1,2,3,4,5,6", p, e), -1);
   EXPECT_EQ (parsePoseLine ("1,2,3,4,5,6,", p, e), -1);
   EXPECT_EQ (parsePoseLine ("1 2 3 4 5 six", p, e), -1);
-  EXPECT_NE (e.find ("six"), std::string::npos) << e;
+  EXPECT_EQ (e, "'six' is not a number");
   EXPECT_EQ (parsePoseLine ("1 2 3 4 5 nan", p, e), -1);
+  EXPECT_EQ (e, "'nan' is not a finite number");
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 -Infinity", p, e), -1);
+  EXPECT_EQ (e, "'-Infinity' is not a finite number");
+  EXPECT_EQ (parsePoseLine ("1 2 3 4 5 1e999", p, e), -1);
+  EXPECT_EQ (e, "'1e999' is not a finite number") << "a decimal beyond a double's range";
   EXPECT_EQ (parsePoseLine ("0x1p3 0 0 0 0 0", p, e), -1);
+  EXPECT_EQ (e, "'0x1p3' is not a number") << "decimal numbers only";
+  EXPECT_EQ (parsePoseLine ("1 2 3\f4 5 6", p, e), 1) << "a form feed is a blank inside a line, not a line's end";
+}
+
+TEST (CliOptions, APoseIsYawPitchRollAboutFixedAxesThenATranslation)
+{
+  const double h = std::acos (0.0);  // a quarter turn
+  // Roll then pitch (both about fixed axes): x -> x (roll about x), then x -> -z (pitch about y).
+  const Eigen::Isometry3d T = poseTransform ({1.0, 2.0, 3.0, h, h, 0.0});
+  const Eigen::Vector3d x = T * Eigen::Vector3d::UnitX ();
+  EXPECT_NEAR ((x - Eigen::Vector3d (1.0, 2.0, 2.0)).norm (), 0.0, 1e-12) << x.transpose ();
+  // y: roll takes it to z, pitch takes z to x.
+  const Eigen::Vector3d y = T.linear () * Eigen::Vector3d::UnitY ();
+  EXPECT_NEAR ((y - Eigen::Vector3d::UnitX ()).norm (), 0.0, 1e-12) << y.transpose ();
+  // Yaw alone turns x to y.
+  const Eigen::Vector3d z = poseTransform ({0, 0, 0, 0, 0, h}).linear () * Eigen::Vector3d::UnitX ();
+  EXPECT_NEAR ((z - Eigen::Vector3d::UnitY ()).norm (), 0.0, 1e-12) << z.transpose ();
 }
 
 TEST (CliOptions, PoseFiles)

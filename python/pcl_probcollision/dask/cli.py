@@ -56,14 +56,6 @@ _FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")  # A
 _INT = re.compile(r"[+-]?[0-9]+\Z")
 
 
-def _non_finite_word(text):
-    """nan, inf, infinity with a sign or not: numbers to float(), but not finite ones."""
-    try:
-        return not math.isfinite(float(text))
-    except ValueError:
-        return False
-
-
 def _as_flag_message(message):
     """The library's and collide_poses' messages in this command line's words: no C++ scope
     ("[pcl_probcollision::BVHParams::validate] "), and an option named with its dash."""
@@ -190,56 +182,6 @@ def parse(argv):
     if "nmax" in options and options["nmax"] < 1:
         raise Usage(f"option -nmax: must be >= 1, got {options['nmax']}")
     return positional, options, own
-
-
-def read_poses(path):
-    """pcd_collision's -poses file: six numbers a line separated by blanks and/or one comma, '#'
-    comments, blank lines."""
-    try:
-        with open(path, encoding="utf-8", errors="replace") as f:
-            lines = f.read().splitlines()
-    except OSError as e:
-        raise Failure(f"cannot read '{path}': {e.strerror}") from None
-    poses = []
-    for number, line in enumerate(lines, 1):
-        body = line.split("#", 1)[0]
-        tokens, current, commas, why = [], "", 0, None
-        for c in body:
-            if c == "," or c.isspace():
-                if current:
-                    tokens.append(current)
-                    current, commas = "", 0
-                if c == ",":
-                    commas += 1
-                    if commas > 1 or not tokens:
-                        why = "empty field between commas"
-                        break
-            else:
-                current += c
-        if why is None:
-            if current:
-                tokens.append(current)
-            elif commas:
-                why = "trailing comma"
-        if why is None and tokens and len(tokens) != 6:
-            why = f"expected 6 numbers (tx ty tz roll pitch yaw), got {len(tokens)}"
-        if why is None and tokens:
-            bad = [t for t in tokens if not _FLOAT.match(t)]
-            if bad:
-                why = f"'{bad[0]}' is not {'a finite number' if _non_finite_word(bad[0]) else 'a number'}"
-            else:
-                huge = [t for t in tokens if not math.isfinite(float(t))]  # 1e999 matches _FLOAT
-                if huge:
-                    why = f"'{huge[0]}' is not a finite number"
-                elif any(abs(float(t)) > core.MAX_COORDINATE for t in tokens[:3]):
-                    why = "translation beyond the supported range of +-1e15"
-        if why is not None:
-            raise Failure(f"{path}:{number}: {why}")
-        if tokens:
-            poses.append([float(t) for t in tokens])
-    if not poses:
-        raise Failure(f"{path}: no pose in the file")
-    return np.array(poses, dtype=np.float64)
 
 
 def _num(v):
@@ -373,8 +315,8 @@ def main(argv):
             resolve_options(options)
         except (TypeError, ValueError) as e:
             raise Usage(_as_flag_message(str(e))) from None
-        pose_rows = read_poses(poses_path)  # a malformed file fails before the (slow) loading
         try:
+            pose_rows = core.read_poses(poses_path)  # a malformed file fails before the (slow) loading
             # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
             stored = bool(options.get("surface") or options.get("surface_pooled") or options.get("surface_ladder")) and not options.get("ignore_normals")
             # Named as pcd_collision names its models (a model's messages say which).
