@@ -1383,6 +1383,14 @@ PYBIND11_MODULE (_core, m)
            return pcl_probcollision::io::medianSpacing (cloud);
          },
          py::arg ("points"), "Median nearest-neighbour spacing of a cloud (pcd_collision's mesh sample spacing).");
+  m.def ("pcd_collision_usage_error",
+         [] (const std::vector<std::string>& args) {
+           const pcd_collision::ParseResult r = pcd_collision::parseCommandLine (args);
+           return r.kind == pcd_collision::ParseResult::Kind::Error ? r.error : std::string ();
+         },
+         py::arg ("args"),
+         "pcd_collision's usage error for these arguments (its argv without the program's name), in its words;\n"
+         "empty when its parser accepts them. The Dask command line judges pcd_collision's flags with it.");
   m.def ("read_poses", &readPoses, py::arg ("path"),
          "Reads pcd_collision's -poses file: six numbers a line (tx ty tz roll pitch yaw) separated by blanks\n"
          "and/or one comma, '#' comments and blank lines allowed.\n\n"

@@ -587,10 +587,26 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
         cli.parse(["-sigm", "-h"])
     with pytest.raises(ValueError, match="threads"):
         pcd.resolve_options({"threads": pc._core.MAX_THREADS + 1})
-    # Both command lines refuse the same malformed values as usage errors (exit 2), before any work.
+    # Both command lines refuse the same arguments as usage errors (exit 2), before any work, in
+    # the same words: pcd_collision's parser judges its flags for both (before, the Dask command
+    # line had its own copy of the rules, which had drifted into other words for 20 of these).
+    refused = [["-sigma", "0x1p-3"], ["-threads", str(pc._core.MAX_THREADS + 1)], ["-threads", "-1"], ["-k", "0"],
+               ["-k", "1.5"], ["-sigma", "-1"], ["-sigma", "1e16"], ["-sigma_a", "1e400"], ["-nmax", "0"],
+               ["-epsilon", "0.5"], ["-thresholds", "0.6,0.9"], ["-thresholds", "0.1"], ["-seed", "-1"],
+               ["-max_leaf_fits", "-1"], ["-noise_stop", "1e999"], ["-noise_resolution", "-1"], ["-mesh_density", "0"],
+               ["-sensor", "bogus"], ["-sensor", "kinect", "-sigma", "0.01"], ["-closed"], ["-orientation", "propagate"],
+               ["-surface_pooled", "-surface_ladder"], ["-sigma_max", "-1"], ["-split", "kd"],
+               ["-noise_resolution_gate", "x"], ["-stochastic", "-deterministic"], ["-surface_calibrated"],
+               ["-sigma=0.01", "-sigma", "0.02"], ["-json=1"], ["-bogus", "1"], ["-sigma"]]
+    for bad in refused:
+        cpp = subprocess.run([_pcd_collision(), *args[:2], "-poses", str(poses), *bad], capture_output=True, text=True)
+        assert cpp.returncode == 2, (bad, cpp.stderr)
+        with pytest.raises(cli.Usage) as e:
+            cli.parse(args + ["--scheduler", "local:1", *bad])
+        assert "pcd_collision: error: " + str(e.value) == cpp.stderr.strip().splitlines()[0], (bad, cpp.stderr)
     for flag, value in (("-sigma", "0x1p-3"), ("-threads", str(pc._core.MAX_THREADS + 1))):
         cpp = subprocess.run([_pcd_collision(), *args[:2], "-poses", str(poses), flag, value], capture_output=True, text=True)
         py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, "--scheduler", "local:1", flag, value],
                             capture_output=True, text=True, timeout=60)
         assert (cpp.returncode, py.returncode) == (2, 2), (flag, cpp.stderr, py.stderr)
-        assert flag in cpp.stderr and flag.lstrip("-") in py.stderr, (cpp.stderr, py.stderr)
+        assert cpp.stderr.split("error: ", 1)[1] == py.stderr.split("error: ", 1)[1], (cpp.stderr, py.stderr)

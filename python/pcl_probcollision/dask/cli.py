@@ -2,7 +2,8 @@
 """The command line of `python3 -m pcl_probcollision.dask`: pcd_collision's batch mode with the poses
 answered on Dask. Same flags (-sigma, -sensor, ...; docs/CLI.md), same JSON lines on stdout as
 `pcd_collision a b -poses FILE -json`, same warnings on stderr, same exit status (1 runtime failure,
-2 usage error)."""
+2 usage error). pcd_collision's own parser judges its flags and the poses file here too, so both
+refuse the same arguments in the same words."""
 import json
 import math
 import os
@@ -82,35 +83,33 @@ def _flag(name):
     return ("--" if name in _OWN else "-") + name
 
 
-def _number(flag, text, kind):
-    if kind is float:
-        if not _FLOAT.match(text):
-            raise Usage(f"option {_flag(flag)}: '{text}' is not a number")
-        return float(text)
-    if kind is int or kind == "u64":
-        if not _INT.match(text):
-            raise Usage(f"option {_flag(flag)}: '{text}' is not an integer")
-        v = int(text)
-        if kind == "u64" and not 0 <= v < 2 ** 64:
-            raise Usage(f"option {_flag(flag)}: '{text}' is out of range")
-        return v
+def _own_value(flag, text, kind):
+    """A value of this command's own options (pcd_collision's are judged by its parser)."""
+    if kind is float and not _FLOAT.match(text):
+        raise Usage(f"option {_flag(flag)}: '{text}' is not a number")
+    if kind is int and not _INT.match(text):
+        raise Usage(f"option {_flag(flag)}: '{text}' is not an integer")
+    return kind(text)
+
+
+def _typed(name, text):
+    """A value pcd_collision's parser has accepted, as collide_poses takes it."""
+    kind = _VALUE[name]
     if kind == "pair":
-        parts = text.split(",")
-        if len(parts) != 2:
-            raise Usage(f"option -{flag}: expected LOW,HIGH, got '{text}'")
-        low, high = (_number(flag, p, float) for p in parts)
-        if not (0.0 <= low <= 0.5 and 0.5 <= high <= 1.0):
-            raise Usage(f"option -{flag}: LOW must be in [0, 0.5] and HIGH in [0.5, 1], got '{text}'")
-        return (low, high)
-    return text
+        return tuple(float(t) for t in text.split(","))
+    return int(text) if kind in (int, "u64") else float(text) if kind is float else text
 
 
 def parse(argv):
-    """(positional, options for collide_poses, own options) or Usage."""
+    """(positional, options for collide_poses, own options) or Usage. pcd_collision's flags and
+    values are judged by pcd_collision's own parser (core.pcd_collision_usage_error: the same
+    rules, the same words); this command adds its own options, which take two dashes, and its
+    third argument, the poses file."""
     positional, options, own, seen = [], {}, {"scheduler": None, "timeout": 10.0, "chunk-size": None}, set()
     # -h wins over every other argument, as in pcd_collision (an unknown option beside it too).
     if any(a in ("-h", "-help", "--help") for a in argv[:argv.index("--") if "--" in argv else len(argv)]):
         raise SystemExit(print(USAGE, end="") or 0)
+    flags, values = [], {}  # pcd_collision's flags as given; their values, by name
     i, only_positional = 0, False
     while i < len(argv):
         arg = argv[i]
@@ -131,34 +130,35 @@ def parse(argv):
         # pcd_collision's options take one dash, as there; this command's own take two.
         if dashes != (2 if name in _OWN else 1):
             raise Usage(f"unknown option '{arg.partition('=')[0]}'")
-        if name in seen:
-            raise Usage(f"option {_flag(name)} given twice")
-        seen.add(name)
-        if name in _SWITCH:
-            if eq:
-                raise Usage(f"option {_flag(name)} takes no value")
-            if name not in ("json", "v"):
-                options[name] = True
-            continue
-        kind = _VALUE.get(name) or _OWN.get(name)
-        if kind is None:
-            raise Usage(f"unknown option '{arg}'")
-        if not eq:
-            if i >= len(argv):
-                raise Usage(f"option {_flag(name)} needs a value")
-            value = argv[i]
-            i += 1
-        v = _number(name, value, kind)
         if name in _OWN:
-            own[name] = v
-        else:
-            options[name] = v
+            if name in seen:
+                raise Usage(f"option {_flag(name)} given twice")
+            seen.add(name)
+            if not eq:
+                if i >= len(argv):
+                    raise Usage(f"option {_flag(name)} needs a value")
+                value = argv[i]
+                i += 1
+            own[name] = _own_value(name, value, _OWN[name])
+            continue
+        if name not in _VALUE and name not in _SWITCH:  # in pcd_collision's words
+            raise Usage(core.pcd_collision_usage_error([arg]))
+        flags.append(arg)
+        if name in _VALUE and not eq and i < len(argv):
+            value = argv[i]
+            flags.append(value)
+            i += 1
+        values[name] = value if name in _VALUE else None
     if len(positional) != 3:
         raise Usage(f"expected <a> <b> <poses.txt>, got {len(positional)} argument(s)")
-    # pcd_collision's rule on the inputs' types, read from their names as there.
-    for path in positional[:2]:
-        if not path.lower().endswith((".pcd",) + _MESH_EXTENSIONS):
-            raise Usage(f"input '{path}': unsupported file type (expected .pcd, .ply, .obj, .stl or .vtk)")
+    error = core.pcd_collision_usage_error(positional[:2] + ["-poses", positional[2]] + flags)
+    if error:
+        raise Usage(error)
+    for name, value in values.items():
+        if name in _VALUE:
+            options[name] = _typed(name, value)
+        elif name not in ("json", "v"):
+            options[name] = True
     if own["scheduler"] is None:
         raise Usage("--scheduler ADDRESS|local[:N] is required")
     scheduler = own["scheduler"]  # an address (tcp://host:8786, localhost:8786) is checked by connecting
@@ -170,17 +170,6 @@ def parse(argv):
         raise Usage(f"option --chunk-size: must be >= 1, got {own['chunk-size']}")
     if not own["timeout"] > 0:
         raise Usage(f"option --timeout: must be > 0, got {own['timeout']}")
-    if "k" in options and options["k"] < 1:
-        raise Usage(f"option -k: must be >= 1, got {options['k']}")
-    for flag in ("sigma", "sigma_a", "sigma_b", "sigma_max"):
-        if flag in options and options[flag] < 0:
-            raise Usage(f"option -{flag}: must be >= 0, got {options[flag]}")
-    if "noise_resolution" in options and not 0 <= options["noise_resolution"] < math.inf:
-        raise Usage(f"option -noise_resolution: must be a finite number >= 0, got {options['noise_resolution']}")
-    if "noise_stop" in options and not 0 <= options["noise_stop"] < math.inf:
-        raise Usage(f"option -noise_stop: must be a finite number >= 0, got {options['noise_stop']}")
-    if "nmax" in options and options["nmax"] < 1:
-        raise Usage(f"option -nmax: must be >= 1, got {options['nmax']}")
     return positional, options, own
 
 
