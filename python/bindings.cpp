@@ -1221,6 +1221,10 @@ PYBIND11_MODULE (_core, m)
          "    as build_model's.");
   m.attr ("MAX_COORDINATE") = detail::kMaxCoordinate;  // the library's coordinate and translation bound
   m.attr ("MAX_THREADS") = detail::kMaxThreads;         // the library's cap on a thread count
+  // pcd_collision's own defaults (pcd_collision::Defaults), which the Dask command line shares.
+  m.attr ("PCD_COLLISION_SENSOR") = std::string (pcd_collision::Defaults::sensor);
+  m.attr ("PCD_COLLISION_SIGMA") = pcd_collision::Defaults::sigma;
+  m.attr ("PCD_COLLISION_MESH_SEED") = pcd_collision::Defaults::mesh_sampling_seed;
   // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).
   m.def ("collide", &collideOne, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("pose"),
          py::arg ("request") = py::none (),

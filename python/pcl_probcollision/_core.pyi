@@ -213,6 +213,9 @@ class CloudModel:
 
 MAX_COORDINATE: float  # the library's coordinate and pose-translation bound (1e15)
 MAX_THREADS: int  # the library's cap on a thread count (1024; pcd_collision -threads refuses more)
+PCD_COLLISION_SENSOR: str  # pcd_collision's default -sensor ("isotropic")
+PCD_COLLISION_SIGMA: float  # pcd_collision's default -sigma (0.005)
+PCD_COLLISION_MESH_SEED: int  # the seed pcd_collision samples meshes with
 
 def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDArray[np.floating]] = None,
                 params: Optional[CloudModelParams] = None, name: str = "cloud",

@@ -39,7 +39,7 @@ __all__ = ["collide_poses", "connect", "prepare_input", "BatchResults", "InputWa
 _MODEL = core.CloudModelParams()
 _REQUEST = core.CollisionRequest()
 DEFAULT_OPTIONS: Dict[str, Any] = {
-    "sensor": "isotropic",
+    "sensor": core.PCD_COLLISION_SENSOR,
     "sensor_a": None,
     "sensor_b": None,
     "sigma": None,        # None: 0.005 (pcd_collision's default) for every isotropic input
@@ -103,8 +103,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "threads": 1,
 }
 OPTION_NAMES = tuple(DEFAULT_OPTIONS)
-_DEFAULT_SIGMA = 0.005
-_MESH_SEED = 20111                 # pcd_collision's Defaults::mesh_sampling_seed
+_DEFAULT_SIGMA = core.PCD_COLLISION_SIGMA
+_MESH_SEED = core.PCD_COLLISION_MESH_SEED
 _N_MIN = _MODEL.n_min              # pcd_collision: n_min = min(8, nmax)
 _MESH_EXTENSIONS = (".ply", ".obj", ".stl", ".vtk")
 
