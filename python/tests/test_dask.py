@@ -114,10 +114,20 @@ def test_options_are_pcd_collision_flags():
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sigm=0.01)
     with pytest.raises(ValueError, match="isotropic"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor="kinect", sigma=0.01)
-    with pytest.raises(ValueError, match=r"^option sensor_b: unknown sensor model 'sonar'"):
+    with pytest.raises(ValueError, match=r"^option sensor_b: 'sonar' must be one of isotropic, kinect"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor_b="sonar")
-    with pytest.raises(ValueError, match=r"^option sensor: unknown sensor model 'sonar'"):
+    with pytest.raises(ValueError, match=r"^option sensor: 'sonar' must be one of"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sensor="sonar")
+    # pcd_collision's parser judges the options (its words, the dash dropped); a value of the
+    # wrong type is a TypeError (k = 1.5 was taken as 1 before).
+    with pytest.raises(ValueError, match=r"^option k: '0' must be >= 1$"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), k=0)
+    with pytest.raises(TypeError, match=r"^option k: expected an integer, got 1.5$"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), k=1.5)
+    with pytest.raises(ValueError, match=r"^option sigma_b: '-0.5' must be >= 0$"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sigma_b=-0.5)
+    with pytest.raises(ValueError, match=r"^options surface_pooled and surface_ladder cannot be combined$"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), surface_pooled=True, surface_ladder=True)
     with pytest.raises(ValueError, match=r"\(M, 4, 4\) or \(M, 6\)"):
         pcd.collide_poses(patch(), patch(), np.zeros((3, 5)))
     with pytest.raises(ValueError, match="last row"):

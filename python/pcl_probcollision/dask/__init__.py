@@ -21,7 +21,9 @@ from __future__ import annotations
 import collections
 import hashlib
 import math
+import operator
 import os
+import re
 import threading
 import time
 import uuid
@@ -109,70 +111,61 @@ _N_MIN = _MODEL.n_min              # pcd_collision: n_min = min(8, nmax)
 _MESH_EXTENSIONS = (".ply", ".obj", ".stl", ".vtk")
 
 
+_SWITCHES = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kernel_fits", "surface", "surface_pooled",
+             "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b")
+_INTEGERS = ("k", "seed", "max_leaf_fits", "nmax", "threads")
+
+
+def _as_flags(options: Dict[str, Any]) -> list:
+    """The options given, as pcd_collision's flags (a switch when true, a value unless None)."""
+    flags = []
+    for name, v in options.items():
+        if name in _SWITCHES:
+            if v:
+                flags.append("-" + name)
+            continue
+        if v is None:
+            continue
+        try:
+            if name == "thresholds":
+                low, high = v
+                text = f"{float(low)!r},{float(high)!r}"
+            elif name in _INTEGERS:
+                text = str(operator.index(v)) if not isinstance(v, bool) else repr(v)
+            elif isinstance(v, str):
+                text = v
+            else:
+                text = repr(float(v))
+        except (TypeError, ValueError):
+            raise TypeError(f"option {name}: expected {'two numbers (LOW, HIGH)' if name == 'thresholds' else 'an integer' if name in _INTEGERS else 'a number'}, got {v!r}") from None
+        flags.append(f"-{name}={text}")
+    return flags
+
+
 def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
-    """pcd_collision's flags as a complete, checked dict (TypeError for an unknown name,
-    ValueError for a value pcd_collision would refuse)."""
+    """pcd_collision's flags as a complete, checked dict (TypeError for an unknown name or a value
+    of the wrong type, ValueError for a value pcd_collision would refuse: its own parser judges
+    them, with its message, the options named without the dash)."""
     unknown = sorted(set(options) - set(DEFAULT_OPTIONS))
     if unknown:
         raise TypeError(f"unknown option(s) {', '.join(unknown)}; expected some of {', '.join(OPTION_NAMES)}")
+    error = core.pcd_collision_usage_error(["a.pcd", "b.pcd", *_as_flags(options)])
+    if error:
+        # "option -sigma_b: ..." -> "option sigma_b: ...", as the keyword is spelt here.
+        raise ValueError(re.sub(r"(?<![\w'])-(?=[a-z])", "", error.removesuffix(" (see -h)")))
     o = dict(DEFAULT_OPTIONS)
     o.update({k: v for k, v in options.items()})
     o["surface"] = bool(o["surface"] or o["surface_pooled"] or o["surface_ladder"])
-    if o["surface_pooled"] and o["surface_ladder"]:
-        raise ValueError("options surface_pooled and surface_ladder cannot be combined")
     o["closed_a"] = bool(o["closed_a"] or o["closed"])
     o["closed_b"] = bool(o["closed_b"] or o["closed"])
-    if (o["closed_a"] or o["closed_b"]) and not o["surface"]:
-        raise ValueError("options closed, closed_a and closed_b need surface (or surface_pooled, surface_ladder): they "
-                         "say where the surface layer's inside is")
-    if o["surface_calibrated"] and not o["surface"]:
-        raise ValueError("option surface_calibrated needs surface (or surface_pooled, surface_ladder): it maps the "
-                         "surface layer's probability")
-    if any(o[k] is not None for k in ("orientation", "orientation_a", "orientation_b")) and not o["surface"]:
-        raise ValueError("options orientation, orientation_a and orientation_b need surface (or surface_pooled, "
-                         "surface_ladder): they orient the surface layer's surfaces")
     for side in ("a", "b"):
-        name = o["orientation_" + side] or o["orientation"] or _ORIENTATION_NAMES[_MODEL.orientation]
-        if name not in _ORIENTATION_NAMES.values():
-            raise ValueError(f"option orientation{'_' + side if o['orientation_' + side] else ''}: expected one of "
-                             f"{', '.join(_ORIENTATION_NAMES.values())}, got {name!r}")
-        o["orientation_" + side] = name
-    try:  # the names CloudModelParams knows, checked before any work is sent out
-        core.CloudModelParams().noise_resolution_gate = o["noise_resolution_gate"]
-    except (ValueError, TypeError):
-        raise ValueError(f"option noise_resolution_gate: expected one of everywhere, spacing, cloud, got "
-                         f"{o['noise_resolution_gate']!r}") from None
-    if o["stochastic"] and options.get("deterministic"):
-        raise ValueError("options deterministic and stochastic cannot be combined")
+        o["orientation_" + side] = o["orientation_" + side] or o["orientation"] or _ORIENTATION_NAMES[_MODEL.orientation]
     o["sensor_a"] = o["sensor_a"] or o["sensor"]
     o["sensor_b"] = o["sensor_b"] or o["sensor"]
     for side in "ab":
-        try:
-            core.SensorNoiseModel.from_name(o["sensor_" + side])
-        except ValueError as e:  # named by the option that gave it, without the C++ scope
-            flag = "sensor_" + side if options.get("sensor_" + side) is not None else "sensor"
-            raise ValueError(f"option {flag}: {str(e).split('] ', 1)[-1]}") from None
-    iso = "isotropic"
-    if o["sigma"] is not None and (o["sensor_a"] != iso or o["sensor_b"] != iso):
-        raise ValueError(f"option sigma needs the isotropic model for both inputs (got {o['sensor_a']} for <a>, "
-                         f"{o['sensor_b']} for <b>); use sigma_a or sigma_b for one input")
-    for side in "ab":
-        if o["sigma_" + side] is not None and o["sensor_" + side] != iso:
-            raise ValueError(f"option sigma_{side} needs the isotropic model for <{side}> (got {o['sensor_' + side]})")
         if o["sigma_" + side] is None:
             o["sigma_" + side] = _DEFAULT_SIGMA if o["sigma"] is None else o["sigma"]
-        if not (float(o["sigma_" + side]) >= 0.0):
-            raise ValueError(f"option sigma_{side}: must be >= 0, got {o['sigma_' + side]}")
-    low, high = (float(t) for t in o["thresholds"])
-    o["thresholds"] = (low, high)
-    if o["split"] not in ("pca", "octree"):
-        raise ValueError(f"option split: expected pca or octree, got {o['split']!r}")
-    if o["mesh_density"] is not None and not (float(o["mesh_density"]) > 0.0):
-        raise ValueError(f"option mesh_density: must be > 0, got {o['mesh_density']}")
-    if not 0 <= int(o["threads"]) <= core.MAX_THREADS:  # pcd_collision -threads' range
-        raise ValueError(f"option threads: must be in [0, {core.MAX_THREADS}], got {o['threads']}")
-    if int(o["max_leaf_fits"]) < 0:
-        raise ValueError(f"option max_leaf_fits: must be >= 0, got {o['max_leaf_fits']}")
+    o["thresholds"] = tuple(float(t) for t in o["thresholds"])
     model_params(o, "a", exact=False).validate()
     request_of(o).validate()
     return o
