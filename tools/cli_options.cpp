@@ -159,6 +159,13 @@ nonFiniteNumber (const std::string& text)
   return end == text.c_str () + text.size () && !std::isfinite (v);
 }
 
+/** \brief "is not a number", or "is not a finite number" for a non-finite one. */
+std::string
+notANumber (const std::string& text)
+{
+  return nonFiniteNumber (text) ? "is not a finite number" : "is not a number";
+}
+
 /** \brief Why a pose's translation is out of the library's range (detail::kMaxCoordinate, the
   * bound collide() enforces), so that the command line refuses it where it is read; empty if
   * none. Finite angles always give a rotation. */
@@ -229,7 +236,7 @@ parsePoseLine (const std::string& line, Pose& pose, std::string& error)
   {
     if (!parseDouble (tokens[i], pose[i]))
     {
-      error = "'" + tokens[i] + "' is not " + (nonFiniteNumber (tokens[i]) ? "a finite number" : "a number");
+      error = "'" + tokens[i] + "' " + notANumber (tokens[i]);
       return -1;
     }
   }
@@ -372,7 +379,7 @@ parseCommandLine (const std::vector<std::string>& args)
     auto nonNegative = [&] (std::optional<double>& out) -> std::optional<ParseResult> {
       double d = 0.0;
       if (!parseDouble (v, d))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (d < 0.0)
         return usage (bad + "must be >= 0");
       if (!(d <= pcl_probcollision::detail::kMaxCoordinate))
@@ -461,21 +468,21 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-sigma_max")
     {
       if (!parseDouble (v, o.sigma_max))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (o.sigma_max < 0.0)
         return usage (bad + "must be >= 0");
     }
     else if (a == "-epsilon")
     {
       if (!parseDouble (v, o.epsilon))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (!(o.epsilon >= 0.0 && o.epsilon < 0.5))
         return usage (bad + "must be in [0, 0.5)");
     }
     else if (a == "-noise_resolution")
     {
       if (!parseDouble (v, o.noise_resolution))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (!(o.noise_resolution >= 0.0) || !std::isfinite (o.noise_resolution))
         return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging)");
     }
@@ -487,7 +494,7 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-noise_stop")
     {
       if (!parseDouble (v, o.noise_stop))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (!(o.noise_stop >= 0.0) || !std::isfinite (o.noise_stop))
         return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: off)");
     }
@@ -521,7 +528,7 @@ parseCommandLine (const std::vector<std::string>& args)
     {
       double d = 0.0;
       if (!parseDouble (v, d))
-        return usage (bad + "is not a number");
+        return usage (bad + notANumber (v));
       if (!(d > 0.0))
         return usage (bad + "must be > 0 (a sample spacing in data units)");
       o.mesh_spacing = d;

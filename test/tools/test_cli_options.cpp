@@ -206,13 +206,13 @@ TEST (CliOptions, Help)
 TEST (CliOptions, MalformedNumbersNameTheFlag)
 {
   expectUsageError ({"-sigma", "-1"}, "-sigma");
-  expectUsageError ({"-sigma", "1O"}, "-sigma");
+  expectUsageError ({"-sigma", "1O"}, "option -sigma: '1O' is not a number");
   expectUsageError ({"-sigma", "0.01x"}, "-sigma");
   expectUsageError ({"-sigma", ""}, "-sigma");
   expectUsageError ({"-sigma", " 1"}, "-sigma");
   expectUsageError ({"-sigma", "nan"}, "-sigma");
-  expectUsageError ({"-sigma", "inf"}, "-sigma");
-  expectUsageError ({"-sigma", "1e999"}, "-sigma");
+  expectUsageError ({"-sigma", "inf"}, "option -sigma: 'inf' is not a finite number");
+  expectUsageError ({"-sigma", "1e999"}, "option -sigma: '1e999' is not a finite number");
   expectUsageError ({"-sigma", "0x1p-3"}, "-sigma");  // decimal only, as the Dask command line
   expectUsageError ({"-sigma_a", "-0.1"}, "-sigma_a");
   expectUsageError ({"-k", "1O"}, "-k");
