@@ -1395,6 +1395,20 @@ PYBIND11_MODULE (_core, m)
          py::arg ("args"),
          "pcd_collision's usage error for these arguments (its argv without the program's name), in its words;\n"
          "empty when its parser accepts them. The Dask command line judges pcd_collision's flags with it.");
+  m.def ("pcd_collision_params",
+         [] (const std::vector<std::string>& flags) {
+           std::vector<std::string> args{"a.pcd", "b.pcd"};
+           args.insert (args.end (), flags.begin (), flags.end ());
+           const pcd_collision::ParseResult r = pcd_collision::parseCommandLine (args);
+           if (r.kind != pcd_collision::ParseResult::Kind::Run)
+             throw py::value_error (r.error);
+           return py::make_tuple (pcd_collision::modelParamsFor (r.options, true),
+                                  pcd_collision::modelParamsFor (r.options, false), pcd_collision::requestFor (r.options));
+         },
+         py::arg ("flags"),
+         "What pcd_collision makes of its flags (without the inputs): (CloudModelParams of <a>, of <b>, CollisionRequest),\n"
+         "by its own modelParamsFor and requestFor; the noise is left unset (the caller's, per input). ValueError with\n"
+         "its usage error.");
   m.def ("read_poses", &readPoses, py::arg ("path"),
          "Reads pcd_collision's -poses file: six numbers a line (tx ty tz roll pitch yaw) separated by blanks\n"
          "and/or one comma, '#' comments and blank lines allowed.\n\n"

@@ -164,6 +164,16 @@ struct ParseResult
 ParseResult parseCommandLine (const std::vector<std::string>& args);
 ParseResult parseCommandLine (int argc, const char* const* argv);
 
+/** \brief The query the options ask for (-thresholds, -exhaustive, the surface layer's flags,
+  * ...; -o adds per-point values and visits every pair): pcd_collision's, and through Python's
+  * pcd_collision_params the Dask layer's. */
+pcl_probcollision::CollisionRequest requestFor (const Options& o);
+
+/** \brief How an input (<a> when `input`, else <b>) is modelled (-k, the hierarchy's flags, the
+  * surface's, -threads, ...); its noise is left to the caller (none for a mesh's exact samples,
+  * SensorNoiseModel::fromName for a cloud). Shared as requestFor is. */
+pcl_probcollision::CloudModelParams modelParamsFor (const Options& o, bool input);
+
 /** \brief The -h text; its syntax lines show every default. */
 std::string helpText ();
 

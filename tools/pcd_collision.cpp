@@ -201,51 +201,6 @@ checkOutput (const Options& o)
     throw Failure{kRuntimeFailure, "cannot write '" + *o.output + "': is a directory"};
 }
 
-pcl_probcollision::CollisionRequest
-requestFor (const Options& o)
-{
-  pcl_probcollision::CollisionRequest r;
-  r.free_below = o.free_below;
-  r.collision_above = o.collision_above;
-  r.exhaustive = o.exhaustive || o.output.has_value ();
-  r.max_leaf_fits = o.max_leaf_fits;
-  r.defer_kernel_fits = o.defer_kernel_fits;
-  r.surface = o.surface;
-  r.surface_pooled = o.surface_pooled;
-  r.surface_ladder = o.surface_ladder;
-  r.surface_calibrated = o.surface_calibrated;
-  r.distance = o.distance;
-  r.per_point = o.output.has_value ();
-  r.enable_timings = true;
-  r.traversal = o.stochastic ? pcl_probcollision::TraversalMode::Stochastic
-                             : pcl_probcollision::TraversalMode::ExpectedWeight;
-  r.seed = o.seed;
-  return r;
-}
-
-/** \brief How an input (<a> when `input`, else <b>) is modelled; the noise is set per input. */
-pcl_probcollision::CloudModelParams
-modelParamsFor (const Options& o, bool input)
-{
-  pcl_probcollision::CloudModelParams m;
-  m.closed_objects = input ? o.closed_a : o.closed_b;
-  m.orientation = input ? o.orientation_a : o.orientation_b;
-  m.k = o.k;
-  m.noise_resolution = o.noise_resolution;
-  m.noise_resolution_gate = o.noise_resolution_gate;
-  m.surface_projection = !o.measured;
-  m.surface = o.surface;
-  m.hierarchy.split_style = o.split == "octree" ? pcl_probcollision::BVHParams::SplitStyle::Octree
-                                                : pcl_probcollision::BVHParams::SplitStyle::Pca;
-  m.hierarchy.n_max = o.n_max;
-  m.hierarchy.noise_stop = o.noise_stop;
-  m.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
-  m.hierarchy.sigma_max = o.sigma_max;
-  m.hierarchy.epsilon = o.epsilon;
-  m.threads = o.threads;
-  return m;
-}
-
 /** \brief How the model's surface was oriented (SurfaceModel), the JSON member "surface" of an
   * input: null without -surface. */
 void

@@ -109,6 +109,25 @@ def test_each_worker_builds_each_model_once(cluster):
     assert sum(after[w].get(t, 0) for w in after for t in tokens) >= 2
 
 
+def test_options_map_to_params_as_pcd_collision_maps_its_flags():
+    """model_params and request_of are pcd_collision's modelParamsFor and requestFor (bound as
+    pcd_collision_params), with the noise of each input set here."""
+    a, b, request = pc._core.pcd_collision_params(["-nmax=5", "-surface_ladder", "-closed_a", "-k", "12",
+                                                   "-thresholds=0.2,0.8", "-stochastic", "-seed=7", "-measured"])
+    assert (a.k, a.n_max, a.n_min, a.surface, a.closed_objects, a.surface_projection) == (12, 5, 5, True, True, False)
+    assert not b.closed_objects
+    assert (request.free_below, request.collision_above, request.seed) == (0.2, 0.8, 7)
+    assert request.surface_ladder and request.surface and not request.per_point and request.enable_timings
+    assert request.traversal == pc.TraversalMode.Stochastic
+    with pytest.raises(ValueError, match="option -nmax: '0' must be >= 1"):
+        pc._core.pcd_collision_params(["-nmax=0"])
+    o = pcd.resolve_options({"nmax": 5, "surface_ladder": True, "closed_a": True, "k": 12, "thresholds": (0.2, 0.8),
+                             "stochastic": True, "seed": 7, "measured": True, "sensor_b": "kinect"})
+    assert repr(pcd.model_params(o, "a", exact=True)) == repr(a)
+    assert repr(pcd.request_of(o)) == repr(request)
+    assert pcd.model_params(o, "b", exact=False).noise.name == "kinect"
+
+
 def test_options_are_pcd_collision_flags():
     with pytest.raises(TypeError, match="unknown option"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), sigm=0.01)

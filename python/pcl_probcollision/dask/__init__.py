@@ -107,7 +107,6 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
 OPTION_NAMES = tuple(DEFAULT_OPTIONS)
 _DEFAULT_SIGMA = core.PCD_COLLISION_SIGMA
 _MESH_SEED = core.PCD_COLLISION_MESH_SEED
-_N_MIN = _MODEL.n_min              # pcd_collision: n_min = min(8, nmax)
 _MESH_EXTENSIONS = (".ply", ".obj", ".stl", ".vtk")
 
 
@@ -171,34 +170,31 @@ def resolve_options(options: Dict[str, Any]) -> Dict[str, Any]:
     return o
 
 
+# Resolved options pcd_collision_params is not given: the noise (set per input below), the forms
+# resolved into per-input ones, the traversal's default, and what is not a model's or a query's
+# (threads: collide_batch's; a worker's build uses its cores).
+_NOT_PARAMS = {"sensor", "sensor_a", "sensor_b", "sigma", "sigma_a", "sigma_b", "closed", "orientation", "deterministic",
+               "threads", "mesh_density", "ignore_normals"}
+
+
+def _params(o: Dict[str, Any]):
+    """pcd_collision's modelParamsFor (<a>, <b>) and requestFor of resolved options."""
+    given = {k: v for k, v in o.items() if k not in _NOT_PARAMS and (o["surface"] or not k.startswith("orientation"))}
+    return core.pcd_collision_params(_as_flags(given))
+
+
 def model_params(o: Dict[str, Any], side: str, exact: bool) -> core.CloudModelParams:
-    """pcd_collision's modelParamsFor(): the same CloudModelParams, the noise of one input (none
-    for a mesh's exact samples, whose covariances are given)."""
-    p = core.CloudModelParams(k=int(o["k"]), surface_projection=not o["measured"], n_max=int(o["nmax"]),
-                              n_min=min(_N_MIN, int(o["nmax"])), sigma_max=float(o["sigma_max"]),
-                              epsilon=float(o["epsilon"]), surface=bool(o["surface"]))
-    p.split = o["split"]
-    p.noise_resolution = float(o["noise_resolution"])
-    p.noise_resolution_gate = o["noise_resolution_gate"]
-    p.noise_stop = float(o["noise_stop"])
-    p.closed_objects = bool(o["closed_" + side])
-    p.orientation = next(m for m, name in _ORIENTATION_NAMES.items() if name == o["orientation_" + side])
+    """pcd_collision's modelParamsFor() (the same function), with the noise of one input (none for
+    a mesh's exact samples, whose covariances are given)."""
+    p = _params(o)[0 if side == "a" else 1]
     if not exact:
         p.noise = core.SensorNoiseModel.from_name(o["sensor_" + side], float(o["sigma_" + side]))
     return p
 
 
 def request_of(o: Dict[str, Any]) -> core.CollisionRequest:
-    """pcd_collision's requestFor() without -o."""
-    return core.CollisionRequest(
-        free_below=o["thresholds"][0], collision_above=o["thresholds"][1], exhaustive=bool(o["exhaustive"]),
-        per_point=False, enable_timings=True,
-        traversal=core.TraversalMode.Stochastic if o["stochastic"] else core.TraversalMode.ExpectedWeight,
-        seed=int(o["seed"]), max_leaf_fits=int(o["max_leaf_fits"]), defer_kernel_fits=bool(o["defer_kernel_fits"]),
-        surface=bool(o["surface"]),
-        surface_pooled=bool(o["surface_pooled"]), surface_ladder=bool(o["surface_ladder"]),
-        surface_calibrated=bool(o["surface_calibrated"]),
-        distance=bool(o["distance"]))
+    """pcd_collision's requestFor() (the same function) without -o."""
+    return _params(o)[2]
 
 
 # ------------------------------------------------------------------------------------------------

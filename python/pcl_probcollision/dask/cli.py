@@ -215,9 +215,10 @@ _ANSWERED_BY = {0: "unknown", 1: "separators", 2: "surface", 3: "pooled"}  # ans
 
 def json_lines(r, pose_rows, o, a, b):
     """pcd_collision's resultJson() for every pose (docs/CLI.md)."""
-    from . import resolve_options, model_params, _N_MIN  # noqa: F401
+    from . import resolve_options, model_params
 
     o = resolve_options(o)
+    n_min = model_params(o, "a", exact=True).n_min  # pcd_collision's min(8, nmax)
     sensor = _str(o["sensor_a"]) if o["sensor_a"] == o["sensor_b"] else "null"
     sensor_a = _str(o["sensor_a"]) if a["kind"] == "cloud" else "null"
     sensor_b = _str(o["sensor_b"]) if b["kind"] == "cloud" else "null"
@@ -228,7 +229,7 @@ def json_lines(r, pose_rows, o, a, b):
                   f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
                   f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
                   f'"exhaustive":{_bool(o["exhaustive"])},"defer_kernel_fits":{_bool(o["defer_kernel_fits"])},"max_leaf_fits":{int(o["max_leaf_fits"])},'
-                  f'"noise_resolution":{_num(o["noise_resolution"])},"noise_resolution_gate":"{o["noise_resolution_gate"]}","noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{min(_N_MIN, int(o["nmax"]))},'
+                  f'"noise_resolution":{_num(o["noise_resolution"])},"noise_resolution_gate":"{o["noise_resolution_gate"]}","noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{n_min},'
                   f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
     inputs = (f'{{"a":{_input_json(a, r.surfaces["a"], r.merged_samples["a"])},'
               f'"b":{_input_json(b, r.surfaces["b"], r.merged_samples["b"])}}}')
