@@ -1415,6 +1415,8 @@ PYBIND11_MODULE (_core, m)
          "Returns (M, 6) float64. FileNotFoundError or IsADirectoryError for a path that is no file; ValueError with\n"
          "pcd_collision's message (\"path: FILE:LINE: reason\") for a malformed line or a file without a pose.");
   m.def ("poses_from_xyzrpy", &posesFromXyzRpy, py::arg ("poses"),
-         "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.");
+         "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.\n\n"
+         "Such a pose moves <a> into <b>'s frame (T_b_a); collide(a, b, T) and collide_batch take T_a_b, so pass\n"
+         "invert_poses() of these to answer as pcd_collision does.");
   m.def ("invert_poses", &invertPoses, py::arg ("poses"), "(M, 4, 4) rigid transforms -> their inverses (Eigen's).");
 }
