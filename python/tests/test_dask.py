@@ -620,7 +620,7 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
     # (its help names each): a flag added there and not here would be refused as unknown.
     shown = subprocess.run([_pcd_collision(), "-h"], capture_output=True, text=True).stdout
     flags = set(re.findall(r"(?:^|[ ,])(-[a-z_]+)\b", shown, re.M)) - {"-h", "-help", "-pose", "-poses", "-o"}
-    assert flags == {"-" + name for name in (*cli._VALUE, *cli._SWITCH)}
+    assert flags == {"-" + name for name in (*cli._VALUES, *cli._SWITCH)}
     # Both command lines refuse the same arguments as usage errors (exit 2), before any work, in
     # the same words: pcd_collision's parser judges its flags for both (before, the Dask command
     # line had its own copy of the rules, which had drifted into other words for 20 of these).

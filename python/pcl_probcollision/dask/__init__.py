@@ -110,9 +110,16 @@ _MESH_SEED = core.PCD_COLLISION_MESH_SEED
 _MESH_EXTENSIONS = (".ply", ".obj", ".stl", ".vtk")
 
 
+#: pcd_collision's options by kind: the switches, and those with a value (its type; "pair" for
+#: LOW,HIGH, "u64" for a non-negative 64-bit integer). The command line reads its flags by them.
 _SWITCHES = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kernel_fits", "surface", "surface_pooled",
              "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b")
-_INTEGERS = ("k", "seed", "max_leaf_fits", "nmax", "threads")
+_VALUES = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
+           "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
+           "split": str, "mesh_density": float, "max_leaf_fits": "u64", "noise_resolution": float,
+           "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str,
+           "orientation_b": str, "threads": int}
+_INTEGERS = tuple(name for name, kind in _VALUES.items() if kind in (int, "u64"))
 
 
 def _as_flags(options: Dict[str, Any]) -> list:

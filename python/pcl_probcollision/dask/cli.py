@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 
 from .. import _core as core
-from . import _MESH_EXTENSIONS, InputWarning, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
+from . import _MESH_EXTENSIONS, _SWITCHES, _VALUES, InputWarning, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
@@ -44,14 +44,7 @@ a malformed poses file, a failed query), 2 a usage error (a bad option or value,
 input type), found before the scheduler is reached.
 """
 
-_VALUE = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
-          "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
-          "split": str, "mesh_density": float, "max_leaf_fits": "u64", "noise_resolution": float,
-          "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str, "orientation_b": str,
-          "threads": int}
-_SWITCH = ("measured", "deterministic", "stochastic", "exhaustive", "defer_kernel_fits", "surface", "surface_pooled",
-           "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b", "json",
-           "v")
+_SWITCH = (*_SWITCHES, "json", "v")  # -json and -v are taken and change nothing: the output is always JSON lines
 _OWN = {"scheduler": str, "timeout": float, "chunk-size": int}
 _FLOAT = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")  # ASCII digits, as pcd_collision
 _INT = re.compile(r"[+-]?[0-9]+\Z")
@@ -65,7 +58,7 @@ def _as_flag_message(message):
     if match:
         return "option " + _flag(match.group(1)) + message[match.end():]
     match = re.match(r"(\w+) ", message)  # "epsilon 0.7 outside [0, 0.5)"
-    if match and match.group(1) in _VALUE:
+    if match and match.group(1) in _VALUES:
         return "option " + _flag(match.group(1)) + ": " + message[match.end():]
     return message
 
@@ -94,7 +87,7 @@ def _own_value(flag, text, kind):
 
 def _typed(name, text):
     """A value pcd_collision's parser has accepted, as collide_poses takes it."""
-    kind = _VALUE[name]
+    kind = _VALUES[name]
     if kind == "pair":
         return tuple(float(t) for t in text.split(","))
     return int(text) if kind in (int, "u64") else float(text) if kind is float else text
@@ -141,21 +134,21 @@ def parse(argv):
                 i += 1
             own[name] = _own_value(name, value, _OWN[name])
             continue
-        if name not in _VALUE and name not in _SWITCH:  # in pcd_collision's words
+        if name not in _VALUES and name not in _SWITCH:  # in pcd_collision's words
             raise Usage(core.pcd_collision_usage_error([arg]))
         flags.append(arg)
-        if name in _VALUE and not eq and i < len(argv):
+        if name in _VALUES and not eq and i < len(argv):
             value = argv[i]
             flags.append(value)
             i += 1
-        values[name] = value if name in _VALUE else None
+        values[name] = value if name in _VALUES else None
     if len(positional) != 3:
         raise Usage(f"expected <a> <b> <poses.txt>, got {len(positional)} argument(s)")
     error = core.pcd_collision_usage_error(positional[:2] + ["-poses", positional[2]] + flags)
     if error:
         raise Usage(error)
     for name, value in values.items():
-        if name in _VALUE:
+        if name in _VALUES:
             options[name] = _typed(name, value)
         elif name not in ("json", "v"):
             options[name] = True
