@@ -6,6 +6,7 @@
 #include "cloud_input.h"
 #include "input_warnings.h"
 #include "quiet_pcl_console.h"
+#include "result_json.h"
 #include "mesh_input.h"
 #include "mesh_sampling.h"
 
@@ -704,7 +705,126 @@ invertPoses (const py::object& obj)
   }
   return out;
 }
+/** \brief pcd_collision_json_lines: pcd_collision's JSON lines (tools/result_json.h) for answers
+  * held as columns (the Dask layer's BatchResults.fields). */
+std::vector<std::string>
+pcdCollisionJsonLines (const std::vector<std::string>& flags, const py::dict& input_a, const py::dict& input_b,
+                       const py::dict& fields, const py::object& poses, double build_ms)
+{
+  std::vector<std::string> args{"a.pcd", "b.pcd"};
+  args.insert (args.end (), flags.begin (), flags.end ());
+  const pcd_collision::ParseResult parsed = pcd_collision::parseCommandLine (args);
+  if (parsed.kind != pcd_collision::ParseResult::Kind::Run)
+    throw py::value_error (parsed.error);
+  const auto summary = [] (const py::dict& d, const char* name) {
+    pcd_collision::InputSummary s;
+    const auto get = [&] (const char* key) -> py::object {
+      if (!d.contains (key))
+        throw py::key_error (std::string (name) + ": missing '" + key + "'");
+      return d[key];
+    };
+    s.path = get ("path").cast<std::string> ();
+    s.mesh = get ("kind").cast<std::string> () == "mesh";
+    s.points = get ("points").cast<std::size_t> ();
+    s.load_ms = get ("load_ms").cast<double> ();
+    if (s.mesh)
+    {
+      s.vertices = get ("vertices").cast<std::size_t> ();
+      s.triangles = get ("triangles").cast<std::size_t> ();
+      s.spacing = get ("spacing").cast<double> ();
+      s.spacing_source = get ("spacing_source").cast<std::string> ();
+      s.sample_ms = get ("sample_ms").cast<double> ();
+    }
+    else
+    {
+      s.finite = get ("finite").cast<std::size_t> ();
+      s.width = get ("width").cast<std::uint64_t> ();
+      s.height = get ("height").cast<std::uint64_t> ();
+    }
+    if (!get ("merged_samples").is_none ())
+      s.merged_samples = get ("merged_samples").cast<std::size_t> ();
+    if (const py::object f = get ("surface"); !f.is_none ())
+    {
+      const py::dict facts = f.cast<py::dict> ();
+      s.surface = pcd_collision::SurfaceFacts{facts["orientation"].cast<std::string> (), facts["inside_known"].cast<bool> (),
+                                              facts["hidden_from_viewpoint"].cast<double> (),
+                                              facts["closed_share"].cast<double> (), facts["solid_share"].cast<double> ()};
+    }
+    return s;
+  };
+  const pcd_collision::InputSummary a = summary (input_a, "input_a"), b = summary (input_b, "input_b");
+  const auto rows = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (poses);
+  if (!rows || rows.ndim () != 2 || rows.shape (1) != 6)
+    throw py::value_error ("poses: expected shape (M, 6)");
+  const std::size_t m = static_cast<std::size_t> (rows.shape (0));
+  // One column a member, m rows (of width values).
+  const auto column = [&] (const char* key, py::ssize_t width = 1) {
+    if (!fields.contains (key))
+      throw py::key_error (std::string ("fields: missing '") + key + "'");
+    auto c = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (fields[key]);
+    if (!c || c.size () != static_cast<py::ssize_t> (m) * width)
+      throw py::value_error (std::string ("fields['") + key + "']: expected " + std::to_string (m) + " rows of " +
+                             std::to_string (width));
+    return c;
+  };
+  const auto probability = column ("probability"), verdict = column ("verdict"), answered_by = column ("answered_by"),
+             signed_distance = column ("signed_distance"), signed_distance_std = column ("signed_distance_std"),
+             unobserved = column ("unobserved"), sample_distance = column ("sample_distance"),
+             nearest_a = column ("nearest_point_a", 3), nearest_b = column ("nearest_point_b", 3),
+             lower_bound = column ("lower_bound"), budget_exhausted = column ("budget_exhausted"),
+             full_resolution = column ("full_resolution"), no_leaf_tested = column ("no_leaf_tested"),
+             points_a = column ("points_a"), points_b = column ("points_b"),
+             skipped = column ("points_skipped_nonfinite"), leaf_pairs = column ("leaf_pairs_tested"),
+             bv_tests = column ("bv_tests"), kernel_pairs = column ("kernel_leaf_pairs"),
+             degenerate_pairs = column ("degenerate_leaf_pairs"), iterations = column ("classifier_iterations"),
+             query_ms = column ("query_ms"), witness_side = column ("witness_side"),
+             witness_index = column ("witness_index"), witness_point = column ("witness_point", 3),
+             witness_normal = column ("witness_normal", 3);
+  const auto count = [] (double v) { return static_cast<std::size_t> (v); };
+  const auto vector3 = [] (const py::array_t<double, py::array::c_style | py::array::forcecast>& c, std::size_t i) {
+    const double* v = c.data () + 3 * i;
+    return Eigen::Vector3d (v[0], v[1], v[2]);
+  };
+  std::vector<std::string> lines;
+  lines.reserve (m);
+  for (std::size_t i = 0; i < m; ++i)
+  {
+    CollisionResult r;
+    r.status = CollisionResult::Status::Ok;
+    r.probability = probability.at (i);
+    r.verdict = static_cast<Verdict> (static_cast<int> (verdict.at (i)));
+    r.answered_by = static_cast<AnsweredBy> (static_cast<int> (answered_by.at (i)));
+    r.signed_distance = signed_distance.at (i);
+    r.signed_distance_std = signed_distance_std.at (i);
+    r.unobserved = unobserved.at (i) != 0.0;
+    r.sample_distance = sample_distance.at (i) != 0.0;
+    r.nearest_point_a = vector3 (nearest_a, i);
+    r.nearest_point_b = vector3 (nearest_b, i);
+    r.lower_bound = lower_bound.at (i) != 0.0;
+    r.budget_exhausted = budget_exhausted.at (i) != 0.0;
+    r.full_resolution = full_resolution.at (i) != 0.0;
+    r.no_leaf_tested = no_leaf_tested.at (i) != 0.0;
+    r.points_a = count (points_a.at (i));
+    r.points_b = count (points_b.at (i));
+    r.points_skipped_nonfinite = count (skipped.at (i));
+    r.leaf_pairs_tested = count (leaf_pairs.at (i));
+    r.bv_tests = count (bv_tests.at (i));
+    r.kernel_leaf_pairs = count (kernel_pairs.at (i));
+    r.degenerate_leaf_pairs = count (degenerate_pairs.at (i));
+    r.classifier_iterations = count (iterations.at (i));
+    r.build_ms = i == 0 ? build_ms : 0.0;  // the models are built once: the first pose's
+    r.query_ms = query_ms.at (i);
+    r.witness_side = static_cast<int> (witness_side.at (i));
+    r.witness_index = static_cast<int> (witness_index.at (i));
+    r.witness_point = vector3 (witness_point, i);
+    r.witness_normal = vector3 (witness_normal, i);
+    const pcd_collision::Pose pose{rows.at (i, 0), rows.at (i, 1), rows.at (i, 2), rows.at (i, 3), rows.at (i, 4), rows.at (i, 5)};
+    lines.push_back (pcd_collision::resultJson (parsed.options, a, b, r, pose, static_cast<long long> (i)));
+  }
+  return lines;
+}
 } // namespace
+
 
 PYBIND11_MODULE (_core, m)
 {
@@ -1409,6 +1529,15 @@ PYBIND11_MODULE (_core, m)
          "What pcd_collision makes of its flags (without the inputs): (CloudModelParams of <a>, of <b>, CollisionRequest),\n"
          "by its own modelParamsFor and requestFor; the noise is left unset (the caller's, per input). ValueError with\n"
          "its usage error.");
+  m.def ("pcd_collision_json_lines", &pcdCollisionJsonLines, py::arg ("flags"), py::arg ("input_a"),
+         py::arg ("input_b"), py::arg ("fields"), py::arg ("poses"), py::arg ("build_ms"),
+         "pcd_collision's -json lines (its own writer, docs/CLI.md) for answers held as columns.\n\n"
+         "flags: pcd_collision's flags (without the inputs and -poses); input_a/_b: dicts with path, kind ('cloud' or\n"
+         "'mesh'), points (count), finite, width, height (clouds), vertices, triangles, spacing, spacing_source\n"
+         "(meshes), load_ms, sample_ms, merged_samples (None: null) and surface (None, or a dict of orientation,\n"
+         "inside_known, hidden_from_viewpoint, closed_share, solid_share); fields: one array per CollisionResult\n"
+         "member, a row a pose, the witness and nearest points in b's frame; poses: (M, 6) as in the -poses file;\n"
+         "build_ms: the models' build, reported on the first pose. Returns M strings without newlines.");
   m.def ("read_poses", &readPoses, py::arg ("path"),
          "Reads pcd_collision's -poses file: six numbers a line (tx ty tz roll pitch yaw) separated by blanks\n"
          "and/or one comma, '#' comments and blank lines allowed.\n\n"

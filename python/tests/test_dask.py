@@ -109,6 +109,38 @@ def test_each_worker_builds_each_model_once(cluster):
     assert sum(after[w].get(t, 0) for w in after for t in tokens) >= 2
 
 
+def test_json_lines_name_what_is_missing_or_misshapen():
+    """pcd_collision_json_lines (pcd_collision's writer, bound for the Dask command line) refuses
+    columns it cannot read, naming them, and writes what it is given."""
+    cloud = {"path": "a.pcd", "kind": "cloud", "points": 3, "finite": 3, "width": 3, "height": 1, "load_ms": 1.0,
+             "merged_samples": 0, "surface": None}
+    vec = np.array([[1.0, 2.0, 3.0]])
+    fields = {k: np.array([0.0]) for k in ("probability", "verdict", "answered_by", "signed_distance",
+                                           "signed_distance_std", "unobserved", "sample_distance", "lower_bound",
+                                           "budget_exhausted", "full_resolution", "no_leaf_tested", "points_a",
+                                           "points_b", "points_skipped_nonfinite", "leaf_pairs_tested", "bv_tests",
+                                           "kernel_leaf_pairs", "degenerate_leaf_pairs", "classifier_iterations",
+                                           "query_ms", "witness_side", "witness_index")}
+    fields.update(nearest_point_a=vec, nearest_point_b=vec, witness_point=vec, witness_normal=vec,
+                  probability=np.array([0.25]), verdict=np.array([2], dtype=np.int8), witness_side=np.array([-1]))
+    pose = np.zeros((1, 6))
+    [line] = pc._core.pcd_collision_json_lines(["-sigma=0.002"], cloud, dict(cloud, path="b.pcd"), fields, pose, 7.5)
+    answer = json.loads(line)
+    assert (answer["verdict"], answer["probability"], answer["build_ms"]) == ("contact", 0.25, 7.5)
+    assert answer["witness"] == {"point": [1, 2, 3], "side": "b", "index": 0, "normal": [1, 2, 3]}
+    assert answer["inputs"]["b"]["path"] == "b.pcd" and answer["parameters"]["sigma_a"] == 0.002
+    with pytest.raises(KeyError, match="fields: missing 'query_ms'"):
+        pc._core.pcd_collision_json_lines([], cloud, cloud, {k: v for k, v in fields.items() if k != "query_ms"}, pose, 0.0)
+    with pytest.raises(KeyError, match="input_b: missing 'finite'"):
+        pc._core.pcd_collision_json_lines([], cloud, {k: v for k, v in cloud.items() if k != "finite"}, fields, pose, 0.0)
+    with pytest.raises(ValueError, match=r"fields\['witness_point'\]: expected 1 rows of 3"):
+        pc._core.pcd_collision_json_lines([], cloud, cloud, dict(fields, witness_point=np.zeros(2)), pose, 0.0)
+    with pytest.raises(ValueError, match=r"poses: expected shape \(M, 6\)"):
+        pc._core.pcd_collision_json_lines([], cloud, cloud, fields, np.zeros((1, 5)), 0.0)
+    with pytest.raises(ValueError, match="option -k: '0' must be >= 1"):
+        pc._core.pcd_collision_json_lines(["-k=0"], cloud, cloud, fields, pose, 0.0)
+
+
 def test_options_map_to_params_as_pcd_collision_maps_its_flags():
     """model_params and request_of are pcd_collision's modelParamsFor and requestFor (bound as
     pcd_collision_params), with the noise of each input set here."""

@@ -4,8 +4,6 @@ answered on Dask. Same flags (-sigma, -sensor, ...; docs/CLI.md), same JSON line
 `pcd_collision a b -poses FILE -json`, same warnings on stderr, same exit status (1 runtime failure,
 2 usage error). pcd_collision's own parser judges its flags and the poses file here too, so both
 refuse the same arguments in the same words."""
-import json
-import math
 import os
 import re
 import sys
@@ -166,98 +164,25 @@ def parse(argv):
     return positional, options, own
 
 
-def _num(v):
-    v = float(v)
-    return "null" if not math.isfinite(v) else "%.10g" % v
-
-
-def _nums(vs):
-    return "[" + ",".join(_num(v) for v in vs) + "]"
-
-
-def _str(s):
-    return json.dumps(s, ensure_ascii=False)
-
-
-def _bool(b):
-    return "true" if b else "false"
-
-
-def _surface_json(s):
-    if s is None:
-        return "null"
-    return (f'{{"orientation":{_str(s["orientation"])},"inside_known":{_bool(s["inside_known"])},'
-            f'"hidden_from_viewpoint":{_num(s["hidden_from_viewpoint"])},"closed_share":{_num(s["closed_share"])},'
-            f'"solid_share":{_num(s["solid_share"])}}}')
-
-
-def _input_json(spec, surface, merged):
+def _summary(spec, surface, merged):
+    """What pcd_collision's JSON line says of an input (pcd_collision_json_lines' input_a/_b)."""
+    d = {"path": spec["path"], "kind": spec["kind"], "points": len(spec["points"]), "load_ms": spec["load_ms"],
+         "merged_samples": merged, "surface": surface}
     if spec["kind"] == "cloud":
-        return (f'{{"path":{_str(spec["path"])},"kind":"cloud","points":{len(spec["points"])},'
-                f'"finite":{spec["finite"]},"width":{spec["width"]},"height":{spec["height"]},'
-                f'"merged_samples":{int(merged)},"surface":{_surface_json(surface)}}}')
-    return (f'{{"path":{_str(spec["path"])},"kind":"mesh","vertices":{len(spec["vertices"])},'
-            f'"triangles":{len(spec["triangles"])},"points":{len(spec["points"])},"spacing":{_num(spec["spacing"])},'
-            f'"spacing_source":{_str(spec["spacing_source"])},"merged_samples":{int(merged)},'
-            f'"surface":{_surface_json(surface)}}}')
-
-
-_VERDICTS = {0: "unknown", 1: "free", 2: "contact", 3: "collision"}
-_ANSWERED_BY = {0: "unknown", 1: "separators", 2: "surface", 3: "pooled"}  # answeredByName()
+        d.update(finite=spec["finite"], width=spec["width"], height=spec["height"])
+    else:
+        d.update(vertices=len(spec["vertices"]), triangles=len(spec["triangles"]), spacing=spec["spacing"],
+                 spacing_source=spec["spacing_source"], sample_ms=spec.get("sample_ms", 0.0))
+    return d
 
 
 def json_lines(r, pose_rows, o, a, b):
-    """pcd_collision's resultJson() for every pose (docs/CLI.md)."""
-    from . import resolve_options, model_params
+    """pcd_collision's JSON lines for every pose, written by pcd_collision's own writer (docs/CLI.md)."""
+    from . import _as_flags
 
-    o = resolve_options(o)
-    n_min = model_params(o, "a", exact=True).n_min  # pcd_collision's min(8, nmax)
-    sensor = _str(o["sensor_a"]) if o["sensor_a"] == o["sensor_b"] else "null"
-    sensor_a = _str(o["sensor_a"]) if a["kind"] == "cloud" else "null"
-    sensor_b = _str(o["sensor_b"]) if b["kind"] == "cloud" else "null"
-    sigma_a = _num(o["sigma_a"]) if o["sensor_a"] == "isotropic" and a["kind"] == "cloud" else "null"
-    sigma_b = _num(o["sigma_b"]) if o["sensor_b"] == "isotropic" and b["kind"] == "cloud" else "null"
-    parameters = (f'{{"sensor":{sensor},"sensor_a":{sensor_a},"sensor_b":{sensor_b},"sigma_a":{sigma_a},'
-                  f'"sigma_b":{sigma_b},"k":{int(o["k"])},"thresholds":{_nums(o["thresholds"])},'
-                  f'"traversal":"{"stochastic" if o["stochastic"] else "deterministic"}",'
-                  f'"positions":"{"measured" if o["measured"] else "projected"}","seed":{int(o["seed"])},'
-                  f'"exhaustive":{_bool(o["exhaustive"])},"defer_kernel_fits":{_bool(o["defer_kernel_fits"])},"max_leaf_fits":{int(o["max_leaf_fits"])},'
-                  f'"noise_resolution":{_num(o["noise_resolution"])},"noise_resolution_gate":"{o["noise_resolution_gate"]}","noise_stop":{_num(o["noise_stop"])},"surface":{_bool(o["surface"])},"surface_pooled":{_bool(o["surface_pooled"])},"surface_ladder":{_bool(o["surface_ladder"])},"surface_calibrated":{_bool(o["surface_calibrated"])},"distance":{_bool(o["distance"])},"closed_a":{_bool(o["closed_a"])},"closed_b":{_bool(o["closed_b"])},"orientation_a":{_str(o["orientation_a"])},"orientation_b":{_str(o["orientation_b"])},"nmax":{int(o["nmax"])},"nmin":{n_min},'
-                  f'"sigma_max":{_num(o["sigma_max"])},"epsilon":{_num(o["epsilon"])},"split":"{o["split"]}"}}')
-    inputs = (f'{{"a":{_input_json(a, r.surfaces["a"], r.merged_samples["a"])},'
-              f'"b":{_input_json(b, r.surfaces["b"], r.merged_samples["b"])}}}')
-    sample_ms = a.get("sample_ms", 0.0) + b.get("sample_ms", 0.0)
-    # The surface layer's signed distance: null without -surface or out of reach, as pcd_collision;
-    # unobserved always a boolean (false without -surface); sample_distance always a boolean and
-    # nearest_points the two samples with it (null otherwise: -distance).
-    def surface(i):
-        nearest = (f'[{_nums(r.nearest_point_a[i])},{_nums(r.nearest_point_b[i])}]' if r.sample_distance[i] else "null")
-        return (f'"signed_distance":{_num(r.signed_distance[i])},"signed_distance_std":{_num(r.signed_distance_std[i])},'
-                f'"unobserved":{_bool(r.unobserved[i])},"sample_distance":{_bool(r.sample_distance[i])},'
-                f'"nearest_points":{nearest},')
-
-    for i in range(len(r)):
-        build = r.build_ms if i == 0 else 0.0
-        query = r.query_ms[i]
-        if r.witness_side[i] == 0:
-            witness = "null"
-        else:
-            witness = (f'{{"point":{_nums(r.witness_point[i])},"side":"{"a" if r.witness_side[i] > 0 else "b"}",'
-                       f'"index":{int(r.witness_index[i])},"normal":{_nums(r.witness_normal[i])}}}')
-        yield (f'{{"pose_index":{i},"pose":{_nums(pose_rows[i])},"verdict":"{_VERDICTS[int(r.verdict[i])]}",'
-               f'"probability":{_num(r.probability[i])},"answered_by":"{_ANSWERED_BY[int(r.answered_by[i])]}",'
-               f'{surface(i)}"lower_bound":{_bool(r.lower_bound[i])},'
-               f'"budget_exhausted":{_bool(r.budget_exhausted[i])},'
-               f'"full_resolution":{_bool(r.full_resolution[i])},'
-               f'"no_leaf_tested":{_bool(r.no_leaf_tested[i])},"points_a":{int(r.points_a[i])},'
-               f'"points_b":{int(r.points_b[i])},"points_skipped_nonfinite":{int(r.points_skipped_nonfinite[i])},'
-               f'"leaf_pairs":{int(r.leaf_pairs_tested[i])},"bv_tests":{int(r.bv_tests[i])},'
-               f'"kernel_leaf_pairs":{int(r.kernel_leaf_pairs[i])},"degenerate_leaf_pairs":{int(r.degenerate_leaf_pairs[i])},'
-               f'"classifier_iterations":{int(r.classifier_iterations[i])},"build_ms":{_num(build)},'
-               f'"query_ms":{_num(query)},"witness":{witness},'
-               f'"timings_ms":{{"load_a":{_num(a["load_ms"])},"load_b":{_num(b["load_ms"])},'
-               f'"sample_meshes":{_num(sample_ms)},"build":{_num(build)},"query":{_num(query)}}},'
-               f'"inputs":{inputs},"parameters":{parameters}}}')
+    return core.pcd_collision_json_lines(_as_flags(o), _summary(a, r.surfaces["a"], r.merged_samples["a"]),
+                                         _summary(b, r.surfaces["b"], r.merged_samples["b"]), r.fields, pose_rows,
+                                         r.build_ms)
 
 
 class Progress:
