@@ -309,7 +309,15 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
       surface_ran = true;
       surface_reached = !result.no_leaf_tested;
       pooled = separators.probability < request.free_below;
-      if (pooled)
+      if (!surface_reached)
+      {
+        // No point within the surface layer's reach: it has nothing to say, and its P = 0 would
+        // turn the separators' contact into "free" (two coincident clouds of two points read free).
+        separators.bv_tests += result.bv_tests;
+        result = std::move (separators);
+        from_surface = pooled = false;
+      }
+      else if (pooled)
         pool (result, separators, request);
       else
         addSeparators (result, separators);

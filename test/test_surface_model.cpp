@@ -1078,9 +1078,11 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
     EXPECT_EQ (rc.answered_by, AnsweredBy::Separators);
     EXPECT_EQ (rp.answered_by, AnsweredBy::Pooled);
     const CollisionResult* expected = nullptr;
-    if (rc.no_leaf_tested || rc.probability > q.ladder.collision_above)
+    // The separators' answer stands where they are sure or reached nothing, and where the
+    // surface layer reached no point (it has nothing to say).
+    if (rc.no_leaf_tested || rc.probability > q.ladder.collision_above || rs.no_leaf_tested)
     {
-      (rc.no_leaf_tested ? far : sure) += 1;
+      (rc.no_leaf_tested || rs.no_leaf_tested ? far : sure) += 1;
       expected = &rc;
       EXPECT_TRUE (std::isnan (rl.signed_distance));
     }
@@ -1120,6 +1122,29 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
             << ", free after a fit " << free << "\n";
   EXPECT_GT (far, 0);
   EXPECT_GT (contact, 0);
+}
+
+// Found probing as a new user (2026-12-03): two coincident clouds of two points each. The
+// separators read contact (P = 0.5); the surface layer reaches no point of either and reads
+// P = 0, and the ladder used to hand that "free" on. It now keeps the separators' answer.
+TEST (SurfaceLayer, LadderKeepsTheSeparatorsWhereTheSurfaceLayerReachesNothing)
+{
+  pcl::PointCloud<pcl::PointXYZ> two;
+  two.push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
+  two.push_back (pcl::PointXYZ (0.01f, 0.0f, 0.0f));
+  CloudModelParams params = noisy (0.001);
+  const auto model = buildCloudModel (two, params);
+  const Answerers q (false);
+  CollisionResult rs, rc, rl;
+  ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.surface, rs));
+  ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.separators, rc));
+  ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.ladder, rl));
+  ASSERT_TRUE (rs.no_leaf_tested) << "the case needs a surface layer that reaches nothing";
+  ASSERT_FALSE (rc.no_leaf_tested);
+  EXPECT_EQ (rc.verdict, Verdict::InContact);
+  EXPECT_EQ (rl.answered_by, AnsweredBy::Separators);
+  EXPECT_EQ (rl.verdict, rc.verdict);
+  EXPECT_DOUBLE_EQ (rl.probability, rc.probability);
 }
 
 // A known limit of the separators, and so of the ladder (docs/SURFACE.md, "The ladder"): a small
