@@ -60,11 +60,12 @@ fieldSize (std::uint8_t datatype)
   }
 }
 /** \brief For a PCD with DATA ascii: every value of its first `points` data lines a number, as
-  * strtod reads it whole (nan and inf included), the rest of the file unread. PCL's reader
-  * reads a value that is not a number ("abc") as 0 and one with trailing garbage ("1.5x") as its
-  * numeric start, and says nothing. */
+  * strtod reads it whole (nan and inf included), and `values` of them a line (the header's
+  * COUNTs summed), the rest of the file unread. PCL's reader reads a value that is not a number
+  * ("abc") as 0, one with trailing garbage ("1.5x") as its numeric start, and a missing value as
+  * 0 (a short line became a point at the origin), and says nothing. */
 bool
-checkAsciiValues (const std::string& path, std::size_t points, std::string& error)
+checkAsciiValues (const std::string& path, std::size_t points, std::size_t values, std::string& error)
 {
   std::ifstream in (path, std::ios::binary);
   std::string line;
@@ -81,8 +82,10 @@ checkAsciiValues (const std::string& path, std::size_t points, std::string& erro
     std::istringstream words (line);
     std::string word;
     bool any = false;
-    for (std::size_t column = 1; words >> word; ++column)
+    std::size_t column = 0;
+    while (words >> word)
     {
+      ++column;
       any = true;
       char* end = nullptr;
       std::strtod (word.c_str (), &end);
@@ -92,6 +95,12 @@ checkAsciiValues (const std::string& path, std::size_t points, std::string& erro
                 word + "' is not a number";
         return false;
       }
+    }
+    if (any && column != values)
+    {
+      error = "'" + path + "' line " + std::to_string (line_number) + ": " + std::to_string (column) + " value" +
+              (column == 1 ? "" : "s") + ", expected " + std::to_string (values) + " (its header's FIELDS and COUNT)";
+      return false;
     }
     read += any ? 1 : 0;  // PCL skips blank lines
   }
@@ -320,7 +329,10 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
       error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
       return false;
     }
-    if (data_type == 0 && !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, error))
+    std::size_t values = 0;
+    for (const pcl::PCLPointField& f : blob.fields)
+      values += std::max<std::size_t> (1, f.count);
+    if (data_type == 0 && !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, values, error))
       return false;
   }
   if (static_cast<std::size_t> (blob.width) * blob.height == 0)

@@ -221,20 +221,22 @@ summaryOf (const Input& in, const pcl_probcollision::CloudModel* model)
 }
 
 std::string
-humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bool ladder)
+humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bool ladder, bool distance_asked)
 {
   char buf[512];
   const std::string prefix = pose_index >= 0 ? "pose " + std::to_string (pose_index) + ": " : std::string ();
   // The signed distance, when the surface layer computed one (NaN is never printed).
   // A query that stopped early (lower_bound) reports the first point that decided the collision,
-  // not the deepest: say so, as "P >=" says it of P.
+  // not the deepest: say so, as "P >=" says it of P. An asked distance (-distance) is never that
+  // bound, even where P is (the ladder's sure collisions: the separators stopped, the surface
+  // layer then visited every pair for the distance).
   char distance[128] = "";
   if (std::isfinite (r.signed_distance))
   {
     // Under the printed precision the sign is noise: "+0.0000", never "-0.0000" (JSON keeps the value).
     const double d = std::abs (r.signed_distance) < 5e-5 ? 0.0 : r.signed_distance;
     std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", d, r.signed_distance_std,
-                   r.lower_bound ? " (first deciding point)" : r.sample_distance ? " (nearest samples)" : "");
+                   r.lower_bound && !distance_asked ? " (first deciding point)" : r.sample_distance ? " (nearest samples)" : "");
   }
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
@@ -758,7 +760,7 @@ run (int argc, char** argv)
     }
     else
     {
-      std::fprintf (human, "%s\n", humanLine (result, index, o.surface_ladder).c_str ());
+      std::fprintf (human, "%s\n", humanLine (result, index, o.surface_ladder, o.distance).c_str ());
       if (!batch)
         std::fprintf (human, "%s\n", witnessLine (result).c_str ());
       std::fflush (human);

@@ -516,6 +516,27 @@ TEST_F (PcdCollisionTool, SurfaceLadderAnswersTheDemoPenetrationAsCollision)
   }
 }
 
+// Found probing as a new user (2026-12-03): the gripper 3 cm into the table is a sure collision
+// of the separators, so P is a lower bound (lower_bound), but with -distance the surface layer
+// then visits every pair for the distance, an estimate: the line no longer calls it the first
+// deciding point's, as -surface -distance does not either.
+TEST_F (PcdCollisionTool, AnAskedDistanceIsNeverLabelledTheFirstDecidingPoint)
+{
+  for (const char* setting : {"-surface_ladder", "-surface"})
+  {
+    SCOPED_TRACE (setting);
+    const ToolRun r = run ({kGripper.string (), kScene.string (), "-pose", "-0.15,0.05,-0.03,0,0,0", setting, "-distance"});
+    ASSERT_EQ (r.status, 0) << r.err;
+    EXPECT_NE (r.out.find ("collision"), std::string::npos) << r.out;
+    EXPECT_NE (r.out.find ("d = -0.0"), std::string::npos) << r.out;
+    EXPECT_EQ (r.out.find ("first deciding point"), std::string::npos) << r.out;
+  }
+  // Without -distance the ladder's stopped answer keeps the label where it has a distance.
+  const ToolRun stopped = run ({kGripper.string (), kScene.string (), "-pose", "-0.15,0.05,-0.03,0,0,0", "-surface"});
+  ASSERT_EQ (stopped.status, 0) << stopped.err;
+  EXPECT_NE (stopped.out.find ("first deciding point"), std::string::npos) << stopped.out;
+}
+
 // -distance: beyond the query's reach, the distance between the two inputs' nearest samples,
 // with both points in b's frame (JSON) and the marker "(nearest samples)" (human line); near
 // contact nothing changes. Without the flag, sample_distance is false and nearest_points null.
@@ -897,7 +918,8 @@ TEST_F (PcdCollisionTool, PcdWithoutXyz)
   expectFailure ({kGripper.string (), (dir_ / "noxyz.pcd").string ()}, 1, "noxyz.pcd", {dir_ / "noxyz.pcd"});
 }
 
-// PCL's reader takes "abc" for 0 and "1.5x" for 1.5 in an ASCII PCD; the tool names the value.
+// PCL's reader takes "abc" for 0, "1.5x" for 1.5 and a missing value for 0 in an ASCII PCD; the
+// tool names the value or the line.
 TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
 {
   const std::string header = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n"
@@ -908,6 +930,22 @@ TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
   writeFile (dir_ / "tail.pcd", header + "0 0 0\n\n1 1 1.5x\n2 2 2\n");
   expectFailure ({(dir_ / "tail.pcd").string (), kScene.string ()}, 1, "tail.pcd' line 14, value 3: '1.5x' is not a number",
                  {dir_ / "tail.pcd"});
+  // A line short of a value (PCL read it as 0: a point at the origin, said nothing) or with one
+  // too many (PCL dropped it) is refused, naming the line; so is a line of a wider point type.
+  writeFile (dir_ / "short.pcd", header + "0 0 0\n1 1\n2 2 2\n");
+  expectFailure ({kGripper.string (), (dir_ / "short.pcd").string ()}, 1,
+                 "short.pcd' line 13: 2 values, expected 3 (its header's FIELDS and COUNT)", {dir_ / "short.pcd"});
+  writeFile (dir_ / "long.pcd", header + "0 0 0\n1 1 1\n2 2 2 2\n");
+  expectFailure ({kGripper.string (), (dir_ / "long.pcd").string ()}, 1, "long.pcd' line 14: 4 values, expected 3",
+                 {dir_ / "long.pcd"});
+  const std::string rgb = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\n"
+                          "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n";
+  writeFile (dir_ / "rgb_short.pcd", rgb + "0 0 0 4278190080\n1 1 1\n");
+  expectFailure ({kGripper.string (), (dir_ / "rgb_short.pcd").string ()}, 1, "rgb_short.pcd' line 13: 3 values, expected 4",
+                 {dir_ / "rgb_short.pcd"});
+  writeFile (dir_ / "rgb.pcd", rgb + "0 0 0 4278190080\n1 1 1 4278190080\n");
+  const ToolRun colour = run ({kGripper.string (), (dir_ / "rgb.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
+  EXPECT_EQ (colour.status, 0) << colour.err;
   // nan, inf and exponents are numbers (a NaN point is skipped, as PCL does).
   writeFile (dir_ / "fine.pcd", header + "nan nan nan\n1e-1 -2.5E+0 1\n0.25 inf 3\n");
   const ToolRun r = run ({kGripper.string (), (dir_ / "fine.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
