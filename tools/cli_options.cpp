@@ -253,6 +253,10 @@ parsePoses (std::istream& in, const std::string& name, std::vector<Pose>& poses,
   while (std::getline (in, line))
   {
     ++number;
+    // A UTF-8 byte-order mark, as some editors write at a file's start: not a value, and
+    // invisible in a message ("'0' is not a number" with the mark in front).
+    if (number == 1 && line.compare (0, 3, "\xEF\xBB\xBF") == 0)
+      line.erase (0, 3);
     Pose pose{};
     std::string why;
     const int r = parsePoseLine (line, pose, why);
