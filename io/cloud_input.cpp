@@ -61,11 +61,13 @@ fieldSize (std::uint8_t datatype)
 }
 /** \brief For a PCD with DATA ascii: every value of its first `points` data lines a number, as
   * strtod reads it whole (nan and inf included), and `values` of them a line (the header's
-  * COUNTs summed), the rest of the file unread. PCL's reader reads a value that is not a number
+  * COUNTs summed), or `values_unpadded` (those of padding fields "_" left out: PCL's writer
+  * leaves them out of an ascii file, its reader skips their places), the rest of the file unread. PCL's reader reads a value that is not a number
   * ("abc") as 0, one with trailing garbage ("1.5x") as its numeric start, and a missing value as
   * 0 (a short line became a point at the origin), and says nothing. */
 bool
-checkAsciiValues (const std::string& path, std::size_t points, std::size_t values, std::string& error)
+checkAsciiValues (const std::string& path, std::size_t points, std::size_t values, std::size_t values_unpadded,
+                  std::string& error)
 {
   std::ifstream in (path, std::ios::binary);
   std::string line;
@@ -96,10 +98,12 @@ checkAsciiValues (const std::string& path, std::size_t points, std::size_t value
         return false;
       }
     }
-    if (any && column != values)
+    if (any && column != values && column != values_unpadded)
     {
       error = "'" + path + "' line " + std::to_string (line_number) + ": " + std::to_string (column) + " value" +
-              (column == 1 ? "" : "s") + ", expected " + std::to_string (values) + " (its header's FIELDS and COUNT)";
+              (column == 1 ? "" : "s") + ", expected " + std::to_string (values_unpadded) +
+              (values != values_unpadded ? " (or " + std::to_string (values) + " with its padding)" : std::string ()) +
+              " (its header's FIELDS and COUNT)";
       return false;
     }
     read += any ? 1 : 0;  // PCL skips blank lines
@@ -329,10 +333,11 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
       error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
       return false;
     }
-    std::size_t values = 0;
+    std::size_t values = 0, padding = 0;
     for (const pcl::PCLPointField& f : blob.fields)
-      values += std::max<std::size_t> (1, f.count);
-    if (data_type == 0 && !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, values, error))
+      (f.name == "_" ? padding : values) += std::max<std::size_t> (1, f.count);
+    if (data_type == 0 &&
+        !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, values + padding, values, error))
       return false;
   }
   if (static_cast<std::size_t> (blob.width) * blob.height == 0)

@@ -944,6 +944,16 @@ TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
   expectFailure ({kGripper.string (), (dir_ / "rgb_short.pcd").string ()}, 1, "rgb_short.pcd' line 13: 3 values, expected 4",
                  {dir_ / "rgb_short.pcd"});
   writeFile (dir_ / "rgb.pcd", rgb + "0 0 0 4278190080\n1 1 1 4278190080\n");
+  // A padding field ("_"): PCL's writer leaves its values out of an ascii file; with them or
+  // without, the lines are read, and a line short of a real value is refused.
+  const std::string padded = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z _\nSIZE 4 4 4 1\nTYPE F F F U\nCOUNT 1 1 1 4\nWIDTH 2\n"
+                             "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n";
+  writeFile (dir_ / "padded.pcd", padded + "0 0 0\n1 1 1 0 0 0 0\n");
+  const ToolRun pad = run ({kGripper.string (), (dir_ / "padded.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
+  EXPECT_EQ (pad.status, 0) << pad.err;
+  writeFile (dir_ / "padded_short.pcd", padded + "0 0 0\n1 1\n");
+  expectFailure ({kGripper.string (), (dir_ / "padded_short.pcd").string ()}, 1,
+                 "padded_short.pcd' line 13: 2 values, expected 3 (or 7 with its padding)", {dir_ / "padded_short.pcd"});
   const ToolRun colour = run ({kGripper.string (), (dir_ / "rgb.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
   EXPECT_EQ (colour.status, 0) << colour.err;
   // nan, inf and exponents are numbers (a NaN point is skipped, as PCL does).
