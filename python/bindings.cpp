@@ -705,17 +705,26 @@ invertPoses (const py::object& obj)
   }
   return out;
 }
+/** \brief What pcd_collision's parser makes of its flags (without the inputs); ValueError with its
+  * usage error. */
+pcd_collision::Options
+optionsOfFlags (const std::vector<std::string>& flags)
+{
+  std::vector<std::string> args{"a.pcd", "b.pcd"};
+  args.insert (args.end (), flags.begin (), flags.end ());
+  pcd_collision::ParseResult r = pcd_collision::parseCommandLine (args);
+  if (r.kind != pcd_collision::ParseResult::Kind::Run)
+    throw py::value_error (r.error);
+  return std::move (r.options);
+}
+
 /** \brief pcd_collision_json_lines: pcd_collision's JSON lines (tools/result_json.h) for answers
   * held as columns (the Dask layer's BatchResults.fields). */
 std::vector<std::string>
 pcdCollisionJsonLines (const std::vector<std::string>& flags, const py::dict& input_a, const py::dict& input_b,
                        const py::dict& fields, const py::object& poses, double build_ms)
 {
-  std::vector<std::string> args{"a.pcd", "b.pcd"};
-  args.insert (args.end (), flags.begin (), flags.end ());
-  const pcd_collision::ParseResult parsed = pcd_collision::parseCommandLine (args);
-  if (parsed.kind != pcd_collision::ParseResult::Kind::Run)
-    throw py::value_error (parsed.error);
+  const pcd_collision::Options options = optionsOfFlags (flags);
   const auto summary = [] (const py::dict& d, const char* name) {
     pcd_collision::InputSummary s;
     const auto get = [&] (const char* key) -> py::object {
@@ -819,12 +828,11 @@ pcdCollisionJsonLines (const std::vector<std::string>& flags, const py::dict& in
     r.witness_point = vector3 (witness_point, i);
     r.witness_normal = vector3 (witness_normal, i);
     const pcd_collision::Pose pose{rows.at (i, 0), rows.at (i, 1), rows.at (i, 2), rows.at (i, 3), rows.at (i, 4), rows.at (i, 5)};
-    lines.push_back (pcd_collision::resultJson (parsed.options, a, b, r, pose, static_cast<long long> (i)));
+    lines.push_back (pcd_collision::resultJson (options, a, b, r, pose, static_cast<long long> (i)));
   }
   return lines;
 }
 } // namespace
-
 
 PYBIND11_MODULE (_core, m)
 {
@@ -1517,13 +1525,9 @@ PYBIND11_MODULE (_core, m)
          "empty when its parser accepts them. The Dask command line judges pcd_collision's flags with it.");
   m.def ("pcd_collision_params",
          [] (const std::vector<std::string>& flags) {
-           std::vector<std::string> args{"a.pcd", "b.pcd"};
-           args.insert (args.end (), flags.begin (), flags.end ());
-           const pcd_collision::ParseResult r = pcd_collision::parseCommandLine (args);
-           if (r.kind != pcd_collision::ParseResult::Kind::Run)
-             throw py::value_error (r.error);
-           return py::make_tuple (pcd_collision::modelParamsFor (r.options, true),
-                                  pcd_collision::modelParamsFor (r.options, false), pcd_collision::requestFor (r.options));
+           const pcd_collision::Options o = optionsOfFlags (flags);
+           return py::make_tuple (pcd_collision::modelParamsFor (o, true), pcd_collision::modelParamsFor (o, false),
+                                  pcd_collision::requestFor (o));
          },
          py::arg ("flags"),
          "What pcd_collision makes of its flags (without the inputs): (CloudModelParams of <a>, of <b>, CollisionRequest),\n"
