@@ -778,6 +778,31 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   }
   if (mode != NormalOrientation::Propagate && seeded == 0)
     orientation_ = mode = NormalOrientation::Propagate;
+  // Seen from one viewpoint, the space behind the surface was never observed (the query's
+  // `unobserved`). Given normals say so too when they face a viewpoint outside the cloud as a
+  // scan's do (PCL's normal estimation turns them toward it): enough of them facing it, few
+  // away, and nothing hidden. A closed mesh's samples face it on one side and away on the other.
+  seen_from_view_ = mode == NormalOrientation::Viewpoint;
+  if (mode == NormalOrientation::PointNormals && view_outside)
+  {
+    std::size_t toward = 0, away = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (!in.given[i] || normals_[i].isZero ())
+        continue;
+      const Eigen::Vector3d sight = *in.viewpoint - points[i];
+      const double cosine = normals_[i].cast<double> ().dot (sight) / std::max (sight.norm (), 1e-300);
+      toward += cosine >= kMinViewCosine ? 1 : 0;
+      away += cosine <= -kMinViewCosine ? 1 : 0;
+    }
+    const double facing = static_cast<double> (toward + away);
+    if (facing >= kMinViewSeeds * static_cast<double> (n) && static_cast<double> (away) <= kMaxViewDisagreement * facing)
+    {
+      if (std::isnan (hidden_from_view_))
+        hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
+      seen_from_view_ = hidden_from_view_ <= SurfaceModel::kMaxHiddenShare;
+    }
+  }
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));

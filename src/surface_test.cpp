@@ -1013,11 +1013,12 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const ProbabilisticBVH& s_bvh = surface.hierarchy ();
   const SurfaceModel& s_model = surface.surface ();
   const SurfaceModel& q_model = query.surface ();
-  const bool behind_unseen = s_model.orientation () == NormalOrientation::Viewpoint;
+  const bool behind_unseen = s_model.seenFromViewpoint ();
   scratch.two_sided = !s_model.insideKnown ();
   // Behind a scan from one viewpoint or any open surface (winding about 1/2 behind a sheet) the
   // space is occupied; inside a closed surface means a winding number above 1/2.
-  const double behind_threshold = behind_unseen || !closedSurface (s_model) ? kBehindWinding : kInsideWinding;
+  const double behind_threshold =
+      s_model.orientation () == NormalOrientation::Viewpoint || !closedSurface (s_model) ? kBehindWinding : kInsideWinding;
   const Eigen::Matrix3d R_q = T_q.linear ();
   const Eigen::Matrix3d R_s = T_s.linear ();
   const Eigen::Isometry3d T_s_inverse = T_s.inverse ();
@@ -1311,7 +1312,7 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
     // The depth is measured to the nearest sample: uncertain by about one spacing.
     answer.signed_distance_std = s.medianSpacing ();
     // Inside a surface seen from one viewpoint: behind it, where no sample looked.
-    answer.unobserved = s.orientation () == NormalOrientation::Viewpoint;
+    answer.unobserved = s.seenFromViewpoint ();
   }
   answer.probability = 1.0;
 }

@@ -648,6 +648,45 @@ TEST (SurfaceLayer, BehindAScannedSheetIsNotFree)
   EXPECT_TRUE (r.unobserved);
 }
 
+// A scan saved with its normals (PCL's normal estimation turns them toward the sensor) is still
+// one scan: behind it no sample looked, whether the normals or the VIEWPOINT orient it. Normals
+// facing away from the VIEWPOINT, or a closed object's, are no scan's (found by the probe of
+// 2026-12-03: such a sheet never set `unobserved`).
+TEST (SurfaceLayer, BehindAScanSavedWithItsNormalsIsUnobserved)
+{
+  auto withNormals = [] (const pcl::PointCloud<pcl::PointXYZ>& in, const Eigen::Vector3f& n) {
+    pcl::PointCloud<pcl::PointNormal> out;
+    for (const auto& p : in)
+      out.push_back (pointNormal (p.x, p.y, p.z, n));
+    out.sensor_origin_ = in.sensor_origin_;
+    return out;
+  };
+  const Eigen::Vector3f up (0, 0, 1);
+  const auto scan = buildCloudModel (withNormals (sheet (0.4, 0.01, 0.0, up), up), noisy (0.001));
+  const auto turned = buildCloudModel (withNormals (sheet (0.4, 0.01, 0.0, -up), up), noisy (0.001));
+  auto ball_cloud = sphere (2000, 0.1, Eigen::Vector3d::Zero ());
+  ball_cloud.sensor_origin_ = Eigen::Vector4f (1, 0, 0, 0);
+  const auto ball = buildCloudModel (ball_cloud, noisy (0.001));
+  ASSERT_EQ (scan->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_TRUE (scan->surface ().seenFromViewpoint ());
+  EXPECT_EQ (scan->surface ().hiddenFromViewpoint (), 0.0);
+  EXPECT_FALSE (turned->surface ().seenFromViewpoint ());
+  EXPECT_FALSE (ball->surface ().seenFromViewpoint ());
+
+  // A plate 1 cm under the sheet, two-sided itself (propagated): only the sheet decides.
+  CloudModelParams two_sided = noisy (0.001);
+  two_sided.orientation = NormalOrientation::Propagate;
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, up), two_sided);
+  CollisionResult behind_scan, behind_turned;
+  ASSERT_TRUE (collide (*scan, *plate, shift (0, 0, -0.01), surfaceRequest (), behind_scan));
+  ASSERT_TRUE (collide (*turned, *plate, shift (0, 0, -0.01), surfaceRequest (), behind_turned));
+  EXPECT_EQ (behind_scan.verdict, Verdict::InCollision);
+  EXPECT_TRUE (behind_scan.unobserved);
+  // The same normals under a VIEWPOINT they do not face: behind them is inside, as given.
+  EXPECT_EQ (behind_turned.verdict, Verdict::InCollision);
+  EXPECT_FALSE (behind_turned.unobserved);
+}
+
 // Sparse table (spacing 10 sigma): a point between four samples, 3 sigma under the surface, is
 // inside; the surface is continuous between samples.
 TEST (SurfaceLayer, SparseSurfaceIsContinuousBetweenSamples)

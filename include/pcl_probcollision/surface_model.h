@@ -126,11 +126,18 @@ public:
     * few); a closed object sampled all round, seen from a point outside it, about half (its far
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
-  /** \brief Where Auto weighed a viewpoint outside the cloud: the share of points hidden from
-    * it behind others (a scan from there hides none). Above kMaxHiddenShare the viewpoint is not the
-    * cloud's (a mesh's samples with PCL's default sensor origin) and Auto propagates instead.
-    * NaN where not weighed. */
+  /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced one
+    * (seenFromViewpoint()): the share of points hidden from it behind others (a scan from there
+    * hides none). Above kMaxHiddenShare the viewpoint is not the cloud's (a mesh's samples with
+    * PCL's default sensor origin) and Auto propagates instead. NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
+  /** \brief Whether the samples are one scan's from the cloud's viewpoint, so that the space
+    * behind the surface was never observed (CollisionResult::unobserved): oriented toward the
+    * viewpoint (Viewpoint), or given normals that face a viewpoint outside the cloud as a scan's
+    * do (PointNormals: a scan saved with PCL's normals). For the latter at least 1 % of the
+    * normals lie within 78 degrees of the line of sight (toward the viewpoint or away), at most a
+    * tenth of those away, and at most kMaxHiddenShare of the points hidden behind others. */
+  bool seenFromViewpoint () const { return seen_from_view_; }
   /** \brief Shares of the closed-objects check's probes that must read outside in front
     * (closedShare) and inside behind (solidShare) for a propagated orientation to be trusted
     * (insideKnown). In front, all but stray normals read outside on a closed surface oriented
@@ -215,6 +222,7 @@ private:
   std::size_t unoriented_ = 0;
   std::size_t propagated_ = 0;
   double hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
+  bool seen_from_view_ = false;
   double closed_share_ = std::numeric_limits<double>::quiet_NaN ();
   double solid_share_ = std::numeric_limits<double>::quiet_NaN ();
 };
