@@ -111,6 +111,44 @@ checkAsciiValues (const std::string& path, std::size_t points, std::size_t value
   return true;
 }
 
+/** \brief A PCD header's VIEWPOINT line, if any, holds seven finite numbers (tx ty tz qw qx qy
+  * qz). PCL's reader stops at a value it cannot read ("nan", "inf") and leaves the sensor origin
+  * at 0 0 0 and the rest of the quaternion uninitialised, without a word: the orientation
+  * toward the viewpoint and `-o`'s header then rest on garbage. */
+bool
+checkViewpoint (const std::string& path, std::string& error)
+{
+  std::ifstream in (path, std::ios::binary);
+  std::string line;
+  for (std::size_t line_number = 1; std::getline (in, line) && line.compare (0, 4, "DATA") != 0; ++line_number)
+  {
+    if (line.compare (0, 9, "VIEWPOINT") != 0)
+      continue;
+    std::istringstream words (line.substr (9));
+    std::string word;
+    std::size_t column = 0;
+    while (words >> word)
+    {
+      ++column;
+      char* end = nullptr;
+      const double value = std::strtod (word.c_str (), &end);
+      if (end != word.c_str () + word.size () || !std::isfinite (value))
+      {
+        error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT value " + std::to_string (column) +
+                " '" + word + "' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)";
+        return false;
+      }
+    }
+    if (column != 7)
+    {
+      error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT has " + std::to_string (column) +
+              " values, expected 7 (tx ty tz qw qx qy qz)";
+      return false;
+    }
+  }
+  return true;
+}
+
 bool
 isPly (const std::string& path)
 {
@@ -260,13 +298,30 @@ struct CloudFile
   }
 };
 
-/** \brief Checks a field of the header: present with a known type (a negative index is absent). */
+/** \brief Checks a field of the header: present with a known type, one value per point, and
+  * named once (a negative index is absent). PCL's reader matches a coordinate with COUNT 2 or
+  * more to no point field and leaves it 0 in every point, and a name given twice reads its first
+  * field, both without a word. */
 bool
 checkField (const CloudFile& file, int index, const std::string& path, const char* name, std::string& error)
 {
-  if (fieldSize (file.blob.fields[static_cast<std::size_t> (index)].datatype) == 0)
+  const pcl::PCLPointField& field = file.blob.fields[static_cast<std::size_t> (index)];
+  if (fieldSize (field.datatype) == 0)
   {
     error = "'" + path + "': field '" + name + "' has an unknown type";
+    return false;
+  }
+  if (field.count > 1)
+  {
+    error = "'" + path + "': field '" + name + "' has COUNT " + std::to_string (field.count) +
+            " (a coordinate or normal component needs COUNT 1)";
+    return false;
+  }
+  const auto same = std::count_if (file.blob.fields.begin (), file.blob.fields.end (),
+                                   [&] (const pcl::PCLPointField& f) { return f.name == name; });
+  if (same > 1)
+  {
+    error = "'" + path + "': field '" + name + "' appears " + std::to_string (same) + " times in its FIELDS";
     return false;
   }
   return true;
@@ -333,6 +388,8 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
       error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
       return false;
     }
+    if (!checkViewpoint (path, error))
+      return false;
     std::size_t values = 0, padding = 0;
     for (const pcl::PCLPointField& f : blob.fields)
       (f.name == "_" ? padding : values) += std::max<std::size_t> (1, f.count);

@@ -963,6 +963,37 @@ TEST_F (PcdCollisionTool, AsciiPcdValueThatIsNotANumber)
   EXPECT_NE (r.out.find ("free"), std::string::npos) << r.out;
 }
 
+// A PCD header PCL reads into a wrong cloud without a word (found by the probe of 2026-12-03):
+// a coordinate with COUNT 3 (PCL matched it to no field and left y = 0 in every point: the mug
+// over its table read free instead of contact), a field named twice (the first one read), a
+// VIEWPOINT value PCL cannot read (origin 0 0 0, the quaternion left uninitialised).
+TEST_F (PcdCollisionTool, PcdHeaderThatPclMisreadsIsRefused)
+{
+  auto pcd = [] (const std::string& fields, const std::string& size, const std::string& type, const std::string& count,
+                 const std::string& viewpoint, const std::string& data) {
+    return "# .PCD v0.7\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " + size + "\nTYPE " + type + "\nCOUNT " + count +
+           "\nWIDTH 2\nHEIGHT 1\nVIEWPOINT " + viewpoint + "\nPOINTS 2\nDATA ascii\n" + data;
+  };
+  writeFile (dir_ / "count.pcd", pcd ("x y z", "4 4 4", "F F F", "1 3 1", "0 0 0 1 0 0 0", "0 1 1 1 0\n1 2 2 2 1\n"));
+  expectFailure ({kGripper.string (), (dir_ / "count.pcd").string ()}, 1,
+                 "count.pcd': field 'y' has COUNT 3 (a coordinate or normal component needs COUNT 1)", {dir_ / "count.pcd"});
+  writeFile (dir_ / "twice.pcd", pcd ("x y z x", "4 4 4 4", "F F F F", "1 1 1 1", "0 0 0 1 0 0 0", "0 0 0 5\n1 1 1 6\n"));
+  expectFailure ({kGripper.string (), (dir_ / "twice.pcd").string ()}, 1, "twice.pcd': field 'x' appears 2 times in its FIELDS",
+                 {dir_ / "twice.pcd"});
+  writeFile (dir_ / "nan_view.pcd", pcd ("x y z", "4 4 4", "F F F", "1 1 1", "nan 0 -5 1 0 0 0", "0 0 0\n1 1 1\n"));
+  expectFailure ({kGripper.string (), (dir_ / "nan_view.pcd").string ()}, 1,
+                 "nan_view.pcd' line 9: VIEWPOINT value 1 'nan' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)",
+                 {dir_ / "nan_view.pcd"});
+  writeFile (dir_ / "long_view.pcd", pcd ("x y z", "4 4 4", "F F F", "1 1 1", "0 0 -5 1 0 0 0 9", "0 0 0\n1 1 1\n"));
+  expectFailure ({kGripper.string (), (dir_ / "long_view.pcd").string ()}, 1,
+                 "long_view.pcd' line 9: VIEWPOINT has 8 values, expected 7", {dir_ / "long_view.pcd"});
+  // A wider field of another name is fine, as is a finite VIEWPOINT.
+  writeFile (dir_ / "wide.pcd", pcd ("x y z v", "4 4 4 4", "F F F F", "1 1 1 3", "0 0 -5 1 0 0 0", "0 0 0 1 2 3\n1 1 1 4 5 6\n"));
+  const ToolRun wide = run ({kGripper.string (), (dir_ / "wide.pcd").string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
+  EXPECT_EQ (wide.status, 0) << wide.err;
+  EXPECT_NE (wide.out.find ("free"), std::string::npos) << wide.out;
+}
+
 // Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass
 // between the samples. FCL's piano (legs 40 mm across, through the 9 mm floor at the identity)
 // reads free at 90 mm (1/100 of the room's diagonal, the default before), and the tool says why
