@@ -106,7 +106,7 @@ CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std
 
 void
 CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
-                        const std::vector<int>& cluster_of, std::vector<int>&& seeds)
+                        const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name)
 {
   // The hierarchy's source indices are merged points (the merged cloud's indices).
   std::vector<int> point_of_merged (seeds.size (), -1);
@@ -125,6 +125,15 @@ CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size,
   skipped_ = candidates - mapped;
   source_size_ = source_size;
   params_ = params;
+  if (merged_samples_ > 0 && bvh_.size () <= static_cast<std::size_t> (std::max (params.k, 1)))
+  {
+    std::ostringstream out;
+    out << name << ": noise_resolution " << params.noise_resolution << " merged its " << mapped << " samples into "
+        << bvh_.size () << " point" << (bvh_.size () == 1 ? "" : "s") << ", no more than the covariance estimation's k = "
+        << params.k << ": the model no longer resolves the object's shape (lower noise_resolution; 2 is the evaluated choice)";
+    warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+    PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", out.str ().c_str ());
+  }
 }
 
 void

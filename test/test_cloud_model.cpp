@@ -503,6 +503,25 @@ TEST (NoiseResolution, MergesSamplesWhenTheNoiseExceedsTheSpacing)
   EXPECT_LT (buildCloudModel (*a, merging (0.01, 2.0))->size (), model->size ());
 }
 
+// A noise_resolution so large that the merge leaves no more points than the covariance
+// estimation's k no longer resolves the object: the model says so (the probe of 2026-12-03: the
+// stereo mug merged within 30 deviations into one point read free 5 cm into its table).
+TEST (NoiseResolution, AMergeDownToAHandfulOfPointsIsWarnedOf)
+{
+  // 1,681 samples 5 mm apart over 20 cm, noise 10 mm.
+  const Cloud::Ptr a = sheet (0.2, 0.005, 0.01, 3);
+  const CloudModel::ConstPtr fine = buildCloudModel (*a, merging (0.01, 2.0));
+  ASSERT_GT (fine->size (), 10u);
+  EXPECT_EQ (fine->warning (), "");
+  const CloudModel::ConstPtr coarse = buildCloudModel (*a, merging (0.01, 12.0), nullptr, nullptr, "sheet");
+  ASSERT_LE (coarse->size (), 10u);
+  EXPECT_NE (coarse->warning ().find ("sheet: noise_resolution 12 merged its 1681 samples into " +
+                                      std::to_string (coarse->size ())),
+             std::string::npos)
+      << coarse->warning ();
+  EXPECT_NE (coarse->warning ().find ("no more than the covariance estimation's k = 10"), std::string::npos);
+}
+
 TEST (NoiseResolution, MergesNothingWhenTheNoiseIsBelowTheSpacing)
 {
   // Samples 10 mm apart, noise 1 mm, radius 2 mm: the model is the unmerged one.

@@ -131,10 +131,14 @@ public:
     return representatives_.empty () || hierarchy_source < 0 ? hierarchy_source
                                                              : representatives_[static_cast<std::size_t> (hierarchy_source)];
   }
-  /** \brief A warning about the input, empty when there is none: today, coordinates so far
-    * from the origin that their float spacing exceeds a tenth of the points' typical standard
-    * deviation (the input itself has then lost precision; the model cannot restore it).
-    * collide() passes it on in CollisionResult::message. */
+  /** \brief A warning about the input, empty when there is none: coordinates so far from the
+    * origin that their float spacing exceeds a tenth of the points' typical standard deviation
+    * (the input itself has then lost precision; the model cannot restore it), or a
+    * CloudModelParams::noise_resolution that merged the cloud into no more points than the
+    * covariance estimation's k (each neighbourhood then spans the whole object, and the model
+    * no longer resolves its shape: the stereo mug of ../shared/data merged within 30 noise
+    * deviations into one point read free 5 cm into its table). collide() passes it on in
+    * CollisionResult::message. */
   const std::string& warning () const { return warning_; }
 
   /** \brief Float spacing (one ulp) at the largest coordinate magnitude of the cloud divided by
@@ -156,9 +160,10 @@ private:
                    const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
                    const std::string& name);
   /** \brief Takes a model built from a merged cloud (impl/resolution.hpp) back to the caller's
-    * cloud: cluster_of maps its indices to merged points, seeds the merged points to its indices. */
+    * cloud: cluster_of maps its indices to merged points, seeds the merged points to its indices.
+    * Sets warning() where the merge left no more points than the covariance estimation's k. */
   void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
-                   const std::vector<int>& cluster_of, std::vector<int>&& seeds);
+                   const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
   void assessPrecision (double max_abs_coordinate, const std::string& name);
 

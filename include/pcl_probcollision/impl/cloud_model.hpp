@@ -115,7 +115,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     CloudModelParams once = params;
     once.noise_resolution = 0.0;
     const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (merged, once, nullptr, nullptr, name));
-    model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds));
+    model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds), name);
     model->neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();  // measured on the merged cloud
     model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
     return model;
