@@ -116,6 +116,10 @@ sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t s
   for (const auto& t : mesh.triangles)
   {
     const double n_expected = triangleArea (mesh, t) / (spacing * spacing);
+    // A triangle without area (a polygon repeating a vertex) draws nothing: the same surface
+    // gives the same samples, however its faces were split.
+    if (!(n_expected > 0.0))
+      continue;
     const auto n = static_cast<std::size_t> (std::floor (n_expected + pcl_probcollision::detail::uniformUnit (rng)));
     const Eigen::Vector3d a = vertex (mesh, t[0]), b = vertex (mesh, t[1]), c = vertex (mesh, t[2]);
     const Eigen::Vector3d face_normal = (b - a).cross (c - a);

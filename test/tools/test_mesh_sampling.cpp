@@ -127,3 +127,21 @@ TEST (MeshSampling, WithoutVerticesGivesTheSameAreaSamples)
       shared += p.getVector3fMap () == q.getVector3fMap () ? 1 : 0;
   EXPECT_EQ (shared, 0u);  // another seed: every position new
 }
+
+// A triangle of no area (a polygon that repeats a vertex, split into a fan) holds no surface and
+// draws nothing: the same surface gives the same samples (the probe of 2026-12-03: such
+// triangles shifted the draws, and a box 5 mm into a table read collision 0.99 instead of
+// contact 0.89).
+TEST (MeshSampling, TrianglesWithoutAreaDrawNothing)
+{
+  pcl_probcollision::io::TriangleMesh mesh;
+  mesh.vertices = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {1.0, 1.0, 0.0}};
+  mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
+  pcl_probcollision::io::TriangleMesh padded = mesh;
+  padded.triangles = {{0, 1, 2}, {2, 0, 0}, {1, 3, 2}, {1, 1, 3}, {0, 3, 0}};
+  const auto plain = pcl_probcollision::io::sampleMeshWithNormals (mesh, 0.05, 7);
+  const auto with_degenerate = pcl_probcollision::io::sampleMeshWithNormals (padded, 0.05, 7);
+  ASSERT_EQ (plain.size (), with_degenerate.size ());
+  for (std::size_t i = 0; i < plain.size (); ++i)
+    EXPECT_EQ (plain[i].getVector3fMap (), with_degenerate[i].getVector3fMap ()) << i;
+}
