@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -75,9 +76,12 @@ sampleMeshWithNormals (const TriangleMesh& mesh, double spacing, std::uint64_t s
     throw std::runtime_error ("mesh sample spacing must be finite and > 0");
   const double expected = meshArea (mesh) / (spacing * spacing);
   if (!(expected < static_cast<double> (max_points)))
-    throw std::runtime_error ("sampling the mesh at spacing " + std::to_string (spacing) + " would give about " +
-                              std::to_string (static_cast<long long> (std::min (expected, 1e18))) +
-                              " points (limit " + std::to_string (max_points) + "); raise -mesh_density");
+  {
+    char why[200];
+    std::snprintf (why, sizeof why, "sampling the mesh at spacing %g would give about %.3g points (limit %zu); raise -mesh_density",
+                   spacing, expected, max_points);
+    throw std::runtime_error (why);
+  }
 
   pcl::PointCloud<pcl::PointNormal> cloud;
   // A vertex's normal: the area-weighted mean of its triangles' (an edge or corner gets the

@@ -930,6 +930,24 @@ TEST (ProbabilisticCollisionReliability, NonFiniteOrNonRigidPosesFail)
     EXPECT_FALSE (q.ok);
     expectSane (q.r, false);
   }
+  // A rotation that is not one says by how much (a scale of 1 + 1e-5, a rotation rounded to a
+  // few digits), or that it reflects; one within the tolerance (1 + 1e-7) passes.
+  Eigen::Isometry3d nearly = Eigen::Isometry3d::Identity ();
+  nearly.linear () *= 1.0 + 1e-5;
+  const Query off = tryQuery (a, b, 0.002, CollisionRequest (), nearly);
+  EXPECT_FALSE (off.ok);
+  EXPECT_NE (off.r.message.find ("is not a rotation plus translation (R^T R departs from the identity by 2e-05, more than "
+                                 "the tolerance 1e-06)"),
+             std::string::npos)
+      << off.r.message;
+  Eigen::Isometry3d mirrored = Eigen::Isometry3d::Identity ();
+  mirrored.linear () (2, 2) = -1.0;
+  const Query mirror = tryQuery (a, b, 0.002, CollisionRequest (), mirrored);
+  EXPECT_FALSE (mirror.ok);
+  EXPECT_NE (mirror.r.message.find ("(a reflection: det R = -1)"), std::string::npos) << mirror.r.message;
+  Eigen::Isometry3d within = Eigen::Isometry3d::Identity ();
+  within.linear () *= 1.0 + 1e-7;
+  EXPECT_TRUE (tryQuery (a, b, 0.002, CollisionRequest (), within).ok);
   // Finite but absurd translations (beyond +-1e15) fail clearly. Regression (fuzz/fuzz_collide,
   // fuzz/regressions/slow-query-timeout-611fdb8a.bin): a 1e308 translation overflowed inside the
   // traversal and the query ran for minutes.

@@ -1093,6 +1093,10 @@ TEST_F (PcdCollisionTool, ErrorMessagesCarryNoSourcePaths)
     for (const char* leak : {".cpp", ".hpp", ".h ", ".h:", " @ ", "/src/", "/include/", "/impl/"})
       EXPECT_EQ (err.find (leak), std::string::npos) << leak << " in: " << err;
   }
+  // The sampler's refusal gives the spacing as asked, not rounded to 0.000000 by a fixed format.
+  const ToolRun fine = run ({a, b, "-mesh_density", "1e-9"});
+  EXPECT_NE (fine.err.find ("sampling the mesh at spacing 1e-09 would give about 2.12e+16 points (limit "), std::string::npos)
+      << fine.err;
 }
 
 TEST_F (PcdCollisionTool, OutputIntoMissingDirectory)
