@@ -405,6 +405,15 @@ collideOne (const ModelPtr& a, const ModelPtr& b, const py::object& pose, const 
   return result;
 }
 
+/** \brief ValueError naming `threads` for a count pcd_collision's -threads refuses (above the
+  * library's kMaxThreads, or negative): one rule, detail::threadsRangeError. */
+void
+checkThreads (int threads)
+{
+  if (const std::string why = detail::threadsRangeError (threads); !why.empty ())
+    throw py::value_error ("threads: " + why + ", got " + std::to_string (threads));
+}
+
 std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
              int threads)
@@ -417,8 +426,7 @@ collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, 
   }
   if (poses.ndim () != 3 || poses.shape (1) != 4 || poses.shape (2) != 4)
     throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (poses));
-  if (threads < 0)
-    throw py::value_error ("threads: must be >= 0 (0 = all cores), got " + std::to_string (threads));
+  checkThreads (threads);
   const CollisionRequest request = requestOf (request_obj);
   const auto p = poses.unchecked<3> ();
   std::vector<Eigen::Isometry3d> T (static_cast<std::size_t> (p.shape (0)));
@@ -1001,9 +1009,14 @@ PYBIND11_MODULE (_core, m)
                       "Where noise_resolution merged samples, also keep the unmerged model: the separators' contact\n"
                       "leaning to collision (P >= 0.5) is asked again at full resolution within 256 leaf-pair fits,\n"
                       "and its collision stands (CollisionResult.full_resolution). Default True.")
-      .def_readwrite ("threads", &CloudModelParams::threads,
-                      "Threads of the build (covariance estimation and hierarchy), >= 0; default 0: one per\n"
-                      "hardware thread. The model is the same for any count.")
+      .def_property ("threads", [] (const CloudModelParams& p) { return p.threads; },
+                     [] (CloudModelParams& p, int v) {
+                       checkThreads (v);
+                       p.threads = v;
+                     },
+                     "Threads of the build (covariance estimation and hierarchy), in [0, MAX_THREADS]; default 0:\n"
+                     "one per hardware thread. The model is the same for any count. ValueError outside that range,\n"
+                     "as pcd_collision refuses -threads.")
       .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
                      [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
       .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },
@@ -1364,7 +1377,8 @@ PYBIND11_MODULE (_core, m)
          py::arg ("request") = py::none (), py::arg ("threads") = 0,
          "collide() for each pose of an (M, 4, 4) array, on `threads` threads (0 = all cores), GIL released.\n\n"
          "Returns a list of M CollisionResult in pose order, each equal to collide(a, b, poses[i], request)\n"
-         "(timings aside). ValueError naming the first invalid pose.");
+         "(timings aside). ValueError naming the first invalid pose, or naming threads outside [0, MAX_THREADS]\n"
+         "(as pcd_collision refuses -threads).");
   m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
          "The verdict of a probability under a request's thresholds (Unknown for NaN). ValueError naming\n"
          "free_below or collision_above when out of range.");

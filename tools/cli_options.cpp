@@ -457,9 +457,8 @@ parseCommandLine (const std::vector<std::string>& args)
     {
       if (!parseInt (v, o.threads))
         return usage (bad + "is not an integer");
-      if (o.threads < 0 || o.threads > pcl_probcollision::detail::kMaxThreads)
-        return usage (bad + "must be in [0, " + std::to_string (pcl_probcollision::detail::kMaxThreads) +
-                      "] (0: one per hardware thread)");
+      if (const std::string why = pcl_probcollision::detail::threadsRangeError (o.threads); !why.empty ())
+        return usage (bad + why);
     }
     else if (a == "-sigma")
     {

@@ -71,7 +71,7 @@ class CloudModelParams:
     noise_resolution_whole_cloud: bool
     noise_stop: float
     keep_full_resolution: bool
-    threads: int
+    threads: int  # in [0, MAX_THREADS] (0: one per hardware thread); ValueError outside, as pcd_collision -threads
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
                  n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
                  k_sigma: float = ..., surface: bool = False,
@@ -212,7 +212,8 @@ class CloudModel:
     def __len__(self) -> int: ...
 
 MAX_COORDINATE: float  # the library's coordinate and pose-translation bound (1e15)
-MAX_THREADS: int  # the library's cap on a thread count (1024; pcd_collision -threads refuses more)
+MAX_THREADS: int  # the library's cap on a thread count (1024; pcd_collision -threads, collide_batch's threads
+                  # and CloudModelParams.threads refuse more with a ValueError)
 PCD_COLLISION_SENSOR: str  # pcd_collision's default -sensor ("isotropic")
 PCD_COLLISION_SIGMA: float  # pcd_collision's default -sigma (0.005)
 PCD_COLLISION_MESH_SEED: int  # the seed pcd_collision samples meshes with
@@ -225,6 +226,7 @@ def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDAr
 def load_model(path: Union[str, os.PathLike], params: Optional[CloudModelParams] = None,
                name: Optional[str] = None) -> CloudModel: ...
 def collide(a: CloudModel, b: CloudModel, pose: _Pose, request: Optional[CollisionRequest] = None) -> CollisionResult: ...
+# threads: in [0, MAX_THREADS] (0: one per hardware thread); ValueError naming threads outside it.
 def collide_batch(a: CloudModel, b: CloudModel, poses: npt.ArrayLike, request: Optional[CollisionRequest] = None,
                   threads: int = 0) -> List[CollisionResult]: ...
 def verdict_for(probability: float, request: CollisionRequest) -> Verdict: ...

@@ -681,6 +681,28 @@ def test_bad_params_and_request():
         pc.collide(GOOD, a, np.eye(4))  # a must be a CloudModel
 
 
+def test_thread_counts_above_the_cap_are_refused_as_pcd_collision_refuses_them():
+    # collide_batch(threads=10**6) was accepted and read as the library's cap (a probe, 2026-12-03)
+    # where pcd_collision refuses -threads above it: one rule now (detail::threadsRangeError), the
+    # same words, naming threads and the limit; CloudModelParams.threads too.
+    a = pc.build_model(GOOD)
+    limit = pc._core.MAX_THREADS
+    assert limit == 1024
+    words = pc._core.pcd_collision_usage_error(["a.pcd", "b.pcd", "-threads", str(limit + 1)])
+    assert words == f"option -threads: '{limit + 1}' must be in [0, {limit}] (0: one per hardware thread)"
+    for threads in (limit + 1, 10**6, -1):
+        message = rf"^threads: must be in \[0, {limit}\] \(0: one per hardware thread\), got {threads}$"
+        with pytest.raises(ValueError, match=message):
+            pc.collide_batch(a, a, np.eye(4)[None], threads=threads)
+        p = pc.CloudModelParams()
+        with pytest.raises(ValueError, match=message):
+            p.threads = threads
+        assert p.threads == 0
+    assert len(pc.collide_batch(a, a, np.stack([np.eye(4)] * 3), threads=limit)) == 3
+    p.threads = limit
+    assert p.threads == limit and len(pc.build_model(GOOD, params=p)) == len(pc.build_model(GOOD))
+
+
 @pytest.mark.parametrize("pose, exc, words", [
     (np.diag([2.0, 1, 1, 1]), ValueError, "rotation"),                     # scaled: not rigid
     (np.array([[1.0, 0.1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]), ValueError, "rotation"),  # sheared

@@ -3,6 +3,8 @@
 
 #include "cli_options.h"
 
+#include <pcl_probcollision/detail/parallel.h>
+
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -180,6 +182,21 @@ TEST (CliOptions, OrientationSetsEachInputsSurfaceOrientation)
   expectUsageError ({"-orientation", "propagate"}, "need -surface");
   expectUsageError ({"-surface", "-orientation_a", "Propagate"}, "-orientation_a: 'Propagate' must be one of auto");
   expectUsageError ({"-surface", "-orientation"}, "-orientation");
+}
+
+// -threads is refused above the library's cap by its one rule (detail::threadsRangeError), which
+// Python's collide_batch and CloudModelParams.threads share.
+TEST (CliOptions, ThreadsAboveTheLibrarysCapAreRefusedByItsRule)
+{
+  const int cap = pcl_probcollision::detail::kMaxThreads;
+  EXPECT_EQ (parse ({"-threads", std::to_string (cap)}).options.threads, cap);
+  const ParseResult over = parse ({"-threads", std::to_string (cap + 1)});
+  ASSERT_EQ (over.kind, Kind::Error);
+  EXPECT_EQ (over.error, "option -threads: '" + std::to_string (cap + 1) + "' " +
+                             pcl_probcollision::detail::threadsRangeError (cap + 1));
+  EXPECT_EQ (pcl_probcollision::detail::threadsRangeError (cap + 1), "must be in [0, 1024] (0: one per hardware thread)");
+  EXPECT_EQ (pcl_probcollision::detail::threadsRangeError (-1), pcl_probcollision::detail::threadsRangeError (cap + 1));
+  EXPECT_EQ (pcl_probcollision::detail::threadsRangeError (0), "");
 }
 
 // -surface_ladder implies -surface and cannot be combined with -surface_pooled.

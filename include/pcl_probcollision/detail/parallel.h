@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <exception>
 #include <limits>
+#include <string>
 #include <system_error>
 #include <thread>
 #include <vector>
@@ -18,6 +19,19 @@ namespace detail
   * and a count like INT_MAX asked for gigabytes of it (found in review). The answers do not
   * depend on the count, so the cap changes nothing but the speed of an absurd request. */
 constexpr int kMaxThreads = 1024;
+
+/** \brief Why a thread count is refused, empty when it lies in [0, kMaxThreads]: the one rule
+  * pcd_collision's -threads and the Python bindings' `threads` refuse by, in words that follow
+  * the option's name. The library itself throws for a negative count only and starts at most
+  * kMaxThreads: a count above it asked for threads it never started (Python's
+  * collide_batch(threads=10**6) read as 1,024, found by a probe). */
+inline std::string
+threadsRangeError (int threads)
+{
+  if (threads >= 0 && threads <= kMaxThreads)
+    return {};
+  return "must be in [0, " + std::to_string (kMaxThreads) + "] (0: one per hardware thread)";
+}
 
 /** \brief The number of threads a `threads` setting asks for: itself when > 0 (at most
   * kMaxThreads), else one per hardware thread (at least one). The one reading of the library's
