@@ -611,6 +611,11 @@ parseCommandLine (const std::vector<std::string>& args)
   if (o.surface_calibrated && !o.surface)
     return usage ("option -surface_calibrated needs -surface (or -surface_pooled, -surface_ladder): it maps the "
                   "surface layer's probability");
+  // Without merging the gate has nothing to let through: accepted, it changed nothing (found by
+  // a probe); -noise_resolution 0 is "never merge" too.
+  if (seen.count ("-noise_resolution_gate") && !(o.noise_resolution > 0.0))
+    return usage ("option -noise_resolution_gate needs -noise_resolution C > 0: it says where merging applies, and "
+                  "without -noise_resolution nothing is merged");
   if ((orientation || orientation_a || orientation_b) && !o.surface)
     return usage ("options -orientation, -orientation_a and -orientation_b need -surface (or -surface_pooled, "
                   "-surface_ladder): they orient the surface layer's surfaces");
@@ -648,6 +653,15 @@ parseCommandLine (const std::vector<std::string>& args)
   r.kind = ParseResult::Kind::Run;
   r.options = o;
   return r;
+}
+
+std::string
+inputKindsUsageError (const Options& o, bool mesh_a, bool mesh_b)
+{
+  if (o.mesh_spacing && !mesh_a && !mesh_b)
+    return "option -mesh_density: neither input is a mesh (both are point clouds; a .ply without faces is one), and "
+           "it sets a mesh's sample spacing only: it would change nothing";
+  return {};
 }
 
 std::string
@@ -698,7 +712,8 @@ helpText ()
     << pcl_probcollision::CloudModelParams::resolutionGateName (D::noise_resolution_gate)
     << "\n                  where -noise_resolution merges: every sample; only samples spaced\n"
        "                  closer than their noise; or a whole cloud sampled finer than its noise\n"
-       "                  (its median noise sigma at least its area-weighted spacing), else none\n"
+       "                  (its median noise sigma at least its area-weighted spacing), else none;\n"
+       "                  needs -noise_resolution C > 0\n"
        "  -noise_stop C   = "
     << fmt (D::noise_stop)
     << "      do not split a hierarchy node of at most "
@@ -766,7 +781,8 @@ helpText ()
        "  -mesh_density S = median nearest-neighbour spacing of the other cloud\n"
        "                  (both meshes: 1/100 of the smaller bounding-box diagonal, or wider\n"
        "                  for 500000 samples); mesh sample spacing,\n"
-       "                  data units: samples uniform by area (fixed seed) plus every vertex\n"
+       "                  data units: samples uniform by area (fixed seed) plus every vertex;\n"
+       "                  needs a mesh among the inputs\n"
        "\n"
        "Output:\n"
        "  -o FILE.pcd     write both clouds after the pose (a then b) with fields intensity (per-point\n"

@@ -174,6 +174,13 @@ pcl_probcollision::CollisionRequest requestFor (const Options& o);
   * SensorNoiseModel::fromName for a cloud). Shared as requestFor is. */
 pcl_probcollision::CloudModelParams modelParamsFor (const Options& o, bool input);
 
+/** \brief The usage error of options that ask for an input of a kind the inputs turn out not to
+  * be, or "" when none: -mesh_density sets a mesh's sample spacing, so with two clouds it would
+  * change nothing. Asked once the inputs' kinds are known (a .ply is a mesh, or a cloud when its
+  * header declares no face: isFacelessPly), by pcd_collision before it loads them and by the Dask
+  * layer (Python's pcd_collision_input_usage_error), so both refuse the same inputs. */
+std::string inputKindsUsageError (const Options& o, bool mesh_a, bool mesh_b);
+
 /** \brief The -h text; its syntax lines show every default. */
 std::string helpText ();
 

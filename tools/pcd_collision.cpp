@@ -99,14 +99,12 @@ requireReadable (const std::string& path)
     throw Failure{kRuntimeFailure, why};
 }
 
-/** \brief Loads an input; with_normals (-surface without -ignore_normals): a cloud file's
+/** \brief Loads an input of in.kind (a face-less .ply already a Cloud); with_normals (-surface without -ignore_normals): a cloud file's
   * normal_x normal_y normal_z too, kept in in.oriented when the file has them. */
 void
 loadInput (Input& in, bool with_normals, FILE* log)
 {
   requireReadable (in.path);
-  if (in.kind == InputKind::Mesh && isFacelessPly (in.path))
-    in.kind = InputKind::Cloud;
   const auto start = std::chrono::steady_clock::now ();
   std::string error;
   if (in.kind == InputKind::Cloud)
@@ -509,6 +507,13 @@ run (int argc, char** argv)
   a.kind = inputKindOf (a.path);
   b.path = o.input_b;
   b.kind = inputKindOf (b.path);
+  // A .ply whose header declares no face is a cloud: the kinds are known before the (slow)
+  // loading, and so is an option that needs a mesh among the inputs.
+  for (Input* in : {&a, &b})
+    if (in->kind == InputKind::Mesh && isFacelessPly (in->path))
+      in->kind = InputKind::Cloud;
+  if (const std::string why = inputKindsUsageError (o, a.kind == InputKind::Mesh, b.kind == InputKind::Mesh); !why.empty ())
+    throw Failure{kUsageError, why};
   const bool with_normals = o.surface && !o.ignore_normals;
   loadInput (a, with_normals, log);
   loadInput (b, with_normals, log);

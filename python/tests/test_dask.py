@@ -607,6 +607,33 @@ def test_cli_shows_progress_on_a_terminal_only(tmp_path, table_points):
     assert piped.returncode == 0 and "\r" not in piped.stderr and "poses]" not in piped.stderr
 
 
+def test_options_that_would_change_nothing_are_refused_as_pcd_collision_refuses_them(tmp_path, capsys):
+    """A probe (2026-12-03) found -mesh_density accepted with two clouds and -noise_resolution_gate
+    without -noise_resolution, both changing nothing; pcd_collision refuses them now, and so does
+    this layer, by the same rules (its parser; inputKindsUsageError once the inputs are read) in the
+    same words, before the scheduler is reached."""
+    from pcl_probcollision.dask import cli
+    poses = tmp_path / "p.txt"
+    poses.write_text("0 0 1 0 0 0\n")
+    table = str(DATA / "table_mug.pcd")
+    clouds = [table, table, str(poses)]
+    cpp = subprocess.run([_pcd_collision(), table, table, "-poses", str(poses), "-mesh_density", "0.01"],
+                         capture_output=True, text=True)
+    assert cpp.returncode == 2 and "Loading" not in cpp.stderr, cpp.stderr
+    assert cpp.stderr.startswith("pcd_collision: error: option -mesh_density: neither input is a mesh"), cpp.stderr
+    assert cli.main(clouds + ["--scheduler", "local", "-mesh_density", "0.01"]) == 2
+    err = capsys.readouterr().err
+    assert err.split("error: ", 1)[1] == cpp.stderr.split("error: ", 1)[1] and "Scheduler" not in err, err
+    with pytest.raises(ValueError, match=r"^option mesh_density: neither input is a mesh \(both are point clouds"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), mesh_density=0.01)
+    with pytest.raises(ValueError, match=r"^option noise_resolution_gate needs noise_resolution C > 0"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution_gate="spacing")
+    # A mesh among the inputs takes the spacing; merging takes its gate.
+    r = pcd.collide_poses(str(DATA / "gripper.obj"), patch(), np.array([[0, 0, 1, 0, 0, 0]]), mesh_density=0.01)
+    assert r.inputs[0]["spacing"] == 0.01
+    pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution=2, noise_resolution_gate="everywhere")
+
+
 def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
     """One dash for pcd_collision's options and two for this command's own (found in review: any
     number of dashes was taken, `--sigma` too), decimal numbers only in both (pcd_collision took
@@ -662,7 +689,8 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
                ["-max_leaf_fits", "-1"], ["-noise_stop", "1e999"], ["-noise_resolution", "-1"], ["-mesh_density", "0"],
                ["-sensor", "bogus"], ["-sensor", "kinect", "-sigma", "0.01"], ["-closed"], ["-orientation", "propagate"],
                ["-surface_pooled", "-surface_ladder"], ["-sigma_max", "-1"], ["-split", "kd"],
-               ["-noise_resolution_gate", "x"], ["-stochastic", "-deterministic"], ["-surface_calibrated"],
+               ["-noise_resolution_gate", "x"], ["-noise_resolution_gate", "cloud"], ["-stochastic", "-deterministic"],
+               ["-surface_calibrated"],
                ["-sigma=0.01", "-sigma", "0.02"], ["-json=1"], ["-bogus", "1"], ["-sigma"]]
     for bad in refused:
         cpp = subprocess.run([_pcd_collision(), *args[:2], "-poses", str(poses), *bad], capture_output=True, text=True)

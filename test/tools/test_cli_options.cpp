@@ -66,9 +66,9 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);
-  EXPECT_EQ (parse ({"-noise_resolution_gate", "everywhere"}).options.noise_resolution_gate,
+  EXPECT_EQ (parse ({"-noise_resolution", "2", "-noise_resolution_gate", "everywhere"}).options.noise_resolution_gate,
              pcl_probcollision::CloudModelParams::ResolutionGate::Everywhere);
-  EXPECT_EQ (parse ({"-noise_resolution_gate", "spacing"}).options.noise_resolution_gate,
+  EXPECT_EQ (parse ({"-noise_resolution_gate", "spacing", "-noise_resolution", "2"}).options.noise_resolution_gate,
              pcl_probcollision::CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing);
   EXPECT_EQ (o.noise_stop, 0.0);  // every node split as the hierarchy's rules say
   EXPECT_FALSE (o.defer_kernel_fits);
@@ -182,6 +182,32 @@ TEST (CliOptions, OrientationSetsEachInputsSurfaceOrientation)
   expectUsageError ({"-orientation", "propagate"}, "need -surface");
   expectUsageError ({"-surface", "-orientation_a", "Propagate"}, "-orientation_a: 'Propagate' must be one of auto");
   expectUsageError ({"-surface", "-orientation"}, "-orientation");
+}
+
+// Options that would change nothing are refused, as conflicting ones are (found by a probe,
+// 2026-12-03): -noise_resolution_gate says where -noise_resolution merges, so without merging
+// (no -noise_resolution, or 0) it was accepted and ignored; -mesh_density sets a mesh's sample
+// spacing, so with two clouds it was too. The gate is judged by the parser; the inputs' kinds
+// once they are known (a .ply is a mesh or, without faces, a cloud), by inputKindsUsageError.
+TEST (CliOptions, OptionsThatWouldChangeNothingAreRefused)
+{
+  expectUsageError ({"-noise_resolution_gate", "spacing"},
+                    "option -noise_resolution_gate needs -noise_resolution C > 0: it says where merging applies");
+  expectUsageError ({"-noise_resolution", "0", "-noise_resolution_gate", "everywhere"}, "-noise_resolution_gate needs");
+  EXPECT_EQ (parse ({"-noise_resolution", "0.5", "-noise_resolution_gate", "cloud"}).kind, Kind::Run);
+  EXPECT_EQ (parse ({"-noise_resolution", "0"}).kind, Kind::Run);  // "never merge", said explicitly
+
+  const Options with = parse ({"-mesh_density", "0.01"}).options, without = parse ({}).options;
+  const std::string refused = inputKindsUsageError (with, false, false);
+  EXPECT_EQ (refused.rfind ("option -mesh_density: neither input is a mesh", 0), 0u) << refused;
+  EXPECT_NE (refused.find ("it would change nothing"), std::string::npos) << refused;
+  for (const bool mesh_a : {false, true})
+    for (const bool mesh_b : {false, true})
+    {
+      EXPECT_EQ (inputKindsUsageError (without, mesh_a, mesh_b), "");
+      if (mesh_a || mesh_b)
+        EXPECT_EQ (inputKindsUsageError (with, mesh_a, mesh_b), "") << mesh_a << mesh_b;
+    }
 }
 
 // -threads is refused above the library's cap by its one rule (detail::threadsRangeError), which

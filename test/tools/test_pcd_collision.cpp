@@ -994,6 +994,34 @@ TEST_F (PcdCollisionTool, PcdHeaderThatPclMisreadsIsRefused)
   EXPECT_NE (wide.out.find ("free"), std::string::npos) << wide.out;
 }
 
+// Options that changed nothing were accepted (a probe, 2026-12-03): -mesh_density with two clouds
+// (it sets a mesh's sample spacing) and -noise_resolution_gate without -noise_resolution. Both are
+// usage errors now, naming the option and why, found before any input is loaded; a .ply without
+// faces is a cloud (its header says so), a mesh among the inputs takes -mesh_density.
+TEST_F (PcdCollisionTool, OptionsThatWouldChangeNothingAreUsageErrors)
+{
+  const std::string sheet = (dir_ / "sheet.ply").string ();
+  writeFile (sheet, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "end_header\n0 0 0\n0.01 0 0\n0 0.01 0\n");
+  const std::string why = "option -mesh_density: neither input is a mesh (both are point clouds; a .ply without faces is "
+                          "one), and it sets a mesh's sample spacing only: it would change nothing";
+  expectFailure ({kScene.string (), kScene.string (), "-mesh_density", "0.01"}, 2, why);
+  expectFailure ({sheet, kScene.string (), "-mesh_density", "0.01", "-json"}, 2, why, {sheet});
+  const ToolRun refused = run ({sheet, kScene.string (), "-mesh_density", "0.01"});
+  EXPECT_EQ (refused.err.find ("Loading"), std::string::npos) << refused.err;
+  for (const std::string& cloud : {sheet, kScene.string ()})
+  {
+    const ToolRun r = run ({kGripper.string (), cloud, "-mesh_density", "0.01", "-pose", "0,0,1,0,0,0"});
+    EXPECT_EQ (r.status, 0) << r.err;
+    EXPECT_NE (r.err.find ("at spacing 0.01, -mesh_density"), std::string::npos) << r.err;
+  }
+  expectFailure ({kGripper.string (), kScene.string (), "-noise_resolution_gate", "everywhere"}, 2,
+                 "option -noise_resolution_gate needs -noise_resolution C > 0");
+  const ToolRun gated = run ({kGripper.string (), kScene.string (), "-noise_resolution", "2", "-noise_resolution_gate",
+                              "everywhere", "-pose", "0,0,1,0,0,0"});
+  EXPECT_EQ (gated.status, 0) << gated.err;
+}
+
 // Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass
 // between the samples. FCL's piano (legs 40 mm across, through the 9 mm floor at the identity)
 // reads free at 90 mm (1/100 of the room's diagonal, the default before), and the tool says why

@@ -185,8 +185,10 @@ _NOT_PARAMS = {"sensor", "sensor_a", "sensor_b", "sigma", "sigma_a", "sigma_b", 
 
 
 def _params(o: Dict[str, Any]):
-    """pcd_collision's modelParamsFor (<a>, <b>) and requestFor of resolved options."""
-    given = {k: v for k, v in o.items() if k not in _NOT_PARAMS and (o["surface"] or not k.startswith("orientation"))}
+    """pcd_collision's modelParamsFor (<a>, <b>) and requestFor of resolved options (the merging's
+    gate only where it merges: pcd_collision refuses -noise_resolution_gate without it)."""
+    given = {k: v for k, v in o.items() if k not in _NOT_PARAMS and (o["surface"] or not k.startswith("orientation"))
+             and (o["noise_resolution"] or k != "noise_resolution_gate")}
     return core.pcd_collision_params(_as_flags(given))
 
 
@@ -267,6 +269,15 @@ def check_mesh_noise(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, An
             if spec["kind"] == "mesh" and options.get(flag) is not None:
                 raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
                                  f"with no sensor noise; the option applies to a cloud")
+
+
+def check_input_kinds(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, Any]) -> None:
+    """pcd_collision's rule for options that need a mesh among the inputs (its own
+    inputKindsUsageError: mesh_density with two clouds would change nothing): ValueError, the
+    option named without its dash as resolve_options names it."""
+    error = core.pcd_collision_input_usage_error(_as_flags(options), a["kind"] == "mesh", b["kind"] == "mesh")
+    if error:
+        raise ValueError(re.sub(r"(?<![\w'])-(?=[a-z])", "", error))
 
 
 def input_facts(spec: Dict[str, Any], o: Dict[str, Any], side: str):
@@ -581,6 +592,7 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     stored = o["surface"] and not o["ignore_normals"]
     A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
     check_mesh_noise(A, B, options)
+    check_input_kinds(A, B, options)
     # pcd_collision's warnings about the inputs (units, noise, rounding to float), in its order.
     facts = (input_facts(A, o, "a"), input_facts(B, o, "b"))
     _warn(core.scale_warning(*facts))
