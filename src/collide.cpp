@@ -149,7 +149,11 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   result.unobserved = s.unobserved;
   result.no_leaf_tested = !s.reached;
   result.lower_bound = s.stopped_early;
-  result.leaf_pairs_tested = s.leaf_pairs;
+  // Leaf pairs whose boxes met within reach but whose points all lay beyond it tested nothing:
+  // with no_leaf_tested they count as node tests alone (bv_tests), as the ladder counts a
+  // surface layer that reached nothing. Counted, they read "leaf pairs 1" beside "no leaf pair
+  // tested" (found by a probe).
+  result.leaf_pairs_tested = s.reached ? s.leaf_pairs : 0;
   result.bv_tests = s.bv_tests;
   result.witness_side = s.witness_side;
   if (s.witness_side != 0)

@@ -45,7 +45,7 @@ struct SurfaceAnswer
   /** \brief Stopped at the first point with P_in > collision_above (decision mode): P and the
     * distance are then bounds (the deepest point may lie elsewhere). */
   bool stopped_early = false;
-  std::size_t leaf_pairs = 0;    ///< leaf pairs within reach
+  std::size_t leaf_pairs = 0;    ///< leaf pairs within reach (their boxes; collide() counts them where a point was reached)
   std::size_t points_tested = 0; ///< point-against-surface evaluations, both sides
   std::size_t bv_tests = 0;      ///< node pairs tested by its traversal
 };

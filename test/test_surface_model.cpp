@@ -1186,6 +1186,36 @@ TEST (SurfaceLayer, LadderKeepsTheSeparatorsWhereTheSurfaceLayerReachesNothing)
   EXPECT_DOUBLE_EQ (rl.probability, rc.probability);
 }
 
+// A surface-layer answer whose leaf boxes met within reach but none of whose points came within
+// reach of the other surface counted the pairs: `leaf pairs 1` beside `witness: none (no leaf
+// pair tested)`, JSON `no_leaf_tested: true` with `leaf_pairs: 1` (a probe, 2026-12-03). Those
+// pairs tested nothing: with no_leaf_tested the count is 0, their work in bv_tests alone, as the
+// ladder counts a surface layer that reached nothing.
+TEST (SurfaceLayer, AnAnswerThatReachedNoPointCountsNoLeafPair)
+{
+  pcl::PointCloud<pcl::PointXYZ> two;  // two coincident clouds of two points: no point has a normal
+  two.push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
+  two.push_back (pcl::PointXYZ (0.01f, 0.0f, 0.0f));
+  const auto model = buildCloudModel (two, noisy (0.001));
+  for (const bool exhaustive : {false, true})
+  {
+    const Answerers q (exhaustive);
+    CollisionResult rs, rp;
+    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.surface, rs));
+    EXPECT_TRUE (rs.no_leaf_tested);
+    EXPECT_EQ (rs.leaf_pairs_tested, 0u);
+    EXPECT_GT (rs.bv_tests, 0u);  // the boxes met
+    EXPECT_EQ (rs.witness_side, 0);
+    EXPECT_EQ (rs.probability, 0.0);
+    // Pooled with the separators, which tested their pair: theirs is the only count.
+    CollisionResult rc;
+    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.separators, rc));
+    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.pooled, rp));
+    EXPECT_FALSE (rp.no_leaf_tested);
+    EXPECT_EQ (rp.leaf_pairs_tested, rc.leaf_pairs_tested);
+  }
+}
+
 // A known limit of the separators, and so of the ladder (docs/SURFACE.md, "The ladder"): a small
 // ball pushed 10 mm through a sparse scanned table (samples 60 mm apart, 60 times the noise) at
 // positions between the samples. Where it passes between the table's leaf boxes the separators

@@ -96,7 +96,9 @@ struct CollisionResult
   /** \brief True when no leaf pair was tested (P = 0): every pair of boxes the traversal met was
     * disjoint, and its reach weight (METHOD.md 6.3) fell under CollisionRequest::rho_min (in
     * Stochastic mode: its draw failed). The objects may still lie within a few noise deviations
-    * of each other: boxes of projected points are tight across their surface. */
+    * of each other: boxes of projected points are tight across their surface. For the surface
+    * layer: no point came within reach of the other's surface (nor lies inside it), though leaf
+    * boxes may have met (counted in bv_tests; leaf_pairs_tested is then 0). */
   bool no_leaf_tested = false;
   /** \brief True when the answer rests on surface the samples do not show (the surface layer
     * only; docs/SURFACE.md): the deciding point lies over a hole in the other cloud's samples
@@ -140,7 +142,8 @@ struct CollisionResult
   /** \brief Leaf pairs tested: fitted; passed over unfitted because their start plane could
     * not raise the maximum (RobustClassifier::classify's skip_at_or_below); or set aside by
     * their start plane to be fitted later, which a query that stops at a collision first
-    * never fits. */
+    * never fits. The surface layer's: the leaf pairs within its reach, 0 when no point came
+    * within reach (no_leaf_tested). */
   std::size_t leaf_pairs_tested = 0;
   std::size_t kernel_leaf_pairs = 0;         ///< of which needed an RFF rung
   std::size_t degenerate_leaf_pairs = 0;     ///< of which had no separating direction

@@ -275,6 +275,27 @@ TEST_F (PcdCollisionTool, JsonFieldsAndTypes)
   EXPECT_EQ (j["parameters"]["sigma_a"].type, T::Null);  // a mesh gets no noise
 }
 
+// The surface layer on two coincident clouds of two points (no point has a normal, so none comes
+// within reach of the other surface, though their leaf boxes meet): the summary said `leaf pairs 1`
+// beside `witness: none (no leaf pair tested)`, the JSON `no_leaf_tested` true with `leaf_pairs`
+// 1 (a probe, 2026-12-03). No leaf pair was tested: both now say 0.
+TEST_F (PcdCollisionTool, ASurfaceAnswerThatReachedNoPointReportsNoLeafPair)
+{
+  const std::string two = (dir_ / "two.pcd").string ();
+  writeFile (two, "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+                  "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 0\n0.01 0 0\n");
+  const auto v = runJson ({two, two, "-sigma", "0.001", "-surface"});
+  ASSERT_EQ (v.size (), 1u);
+  EXPECT_TRUE (v[0]["no_leaf_tested"].boolean);
+  EXPECT_EQ (v[0]["leaf_pairs"].number, 0.0);
+  EXPECT_GT (v[0]["bv_tests"].number, 0.0);  // the boxes met
+  EXPECT_EQ (v[0]["witness"].type, Value::Type::Null);
+  const ToolRun r = run ({two, two, "-sigma", "0.001", "-surface"});
+  ASSERT_EQ (r.status, 0) << r.err;
+  EXPECT_NE (r.out.find ("; leaf pairs 0;"), std::string::npos) << r.out;
+  EXPECT_NE (r.out.find ("witness: none (no leaf pair tested)"), std::string::npos) << r.out;
+}
+
 // docs/CLI.md documents every key -json writes: each one appears in the key table of the
 // -json section, as `key` or "key", and the example line there has the keys of a real run.
 TEST_F (PcdCollisionTool, JsonKeysAreDocumented)
