@@ -1188,13 +1188,20 @@ groupByFirst (std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::si
   pairs.swap (scratch.grouped);
 }
 
-/** \brief Distance from x (in `model`'s local frame) to its nearest sample. */
+/** \brief Distance from x (in `model`'s local frame) to its nearest sample, whose hierarchy index
+  * goes to nearest. */
 double
-nearestSampleDistance (const CloudModel& model, const Eigen::Vector3d& x)
+nearestSampleDistance (const CloudModel& model, const Eigen::Vector3d& x, int& nearest)
 {
   double best = std::numeric_limits<double>::infinity ();
-  for (const Eigen::Vector3d& p : model.hierarchy ().means ())
-    best = std::min (best, (p - x).squaredNorm ());
+  nearest = -1;
+  const auto& means = model.hierarchy ().means ();
+  for (std::size_t i = 0; i < means.size (); ++i)
+    if (const double d = (means[i] - x).squaredNorm (); d < best)
+    {
+      best = d;
+      nearest = static_cast<int> (i);
+    }
   return std::sqrt (best);
 }
 /** \brief A point of one object found inside the other, away from its surface. */
@@ -1205,7 +1212,21 @@ struct DeepPoint
   int index = -1;         ///< hierarchy index in its own model
   Eigen::Vector3d point = Eigen::Vector3d::Zero ();  ///< in A's local frame
   double depth = 0.0;     ///< distance to the other's nearest sample
+  /** \brief That sample's outward normal, in A's local frame (zero where it has none): the way
+    * out of the other object from there. */
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
 };
+
+/** \brief The depth of x (in `surface`'s local frame, mapped into A's by T_s) below `surface`:
+  * the distance to its nearest sample, and that sample's outward normal in A's frame. */
+void
+setDepth (const CloudModel& surface, const Eigen::Isometry3d& T_s, const Eigen::Vector3d& x, DeepPoint& deep)
+{
+  int nearest = -1;
+  deep.depth = nearestSampleDistance (surface, x, nearest);
+  deep.normal = nearest >= 0 ? Eigen::Vector3d (T_s.linear () * surface.surface ().normals ()[static_cast<std::size_t> (nearest)].cast<double> ())
+                             : Eigen::Vector3d::Zero ();
+}
 
 /** \brief Whether x (in `surface`'s local frame) lies inside it by its winding number. Outside its
   * bounding box a point is outside it (behind an open sheet's box edge the winding number is
@@ -1276,13 +1297,14 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
     if (!insideOf (surface, x))
       continue;
     // In decision mode the first inside node decides; otherwise the deepest one sets the depth.
-    const double depth = nearestSampleDistance (surface, x);
-    if (!deep.found || depth > deep.depth)
+    DeepPoint here;
+    setDepth (surface, T_s, x, here);
+    if (!deep.found || here.depth > deep.depth)
     {
+      deep = here;
       deep.found = true;
       deep.index = first;
       deep.point = T_q * q_bvh.means ()[static_cast<std::size_t> (first)];
-      deep.depth = depth;
     }
     if (!exhaustive)
       return deep;
@@ -1307,7 +1329,11 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
     answer.witness_side = deep.side;
     answer.witness_index = deep.index;
     answer.witness_point = deep.point;
-    answer.witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+    // Toward A's side, as a point near the surface gets it: the other surface's outward normal at
+    // its nearest sample for a point of A (out of B), turned inward for a point of B (A's outward
+    // normal points away from A). NaN where that sample has no normal (an unoriented point).
+    answer.witness_normal = deep.normal.isZero () ? Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ())
+                                                  : Eigen::Vector3d (deep.side > 0 ? deep.normal : -deep.normal);
     answer.signed_distance = -deep.depth;
     // The depth is measured to the nearest sample: uncertain by about one spacing.
     answer.signed_distance_std = s.medianSpacing ();
@@ -1337,7 +1363,7 @@ containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry
     deep.side = side;
     deep.index = 0;
     deep.point = point;
-    deep.depth = nearestSampleDistance (surface, x);
+    setDepth (surface, T_s, x, deep);
     return deep;
   };
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();

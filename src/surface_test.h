@@ -36,7 +36,9 @@ struct SurfaceAnswer
   /** \brief The deciding point: side +1 = A, -1 = B, 0 = none; its hierarchy index. */
   int witness_side = 0;
   int witness_index = -1;
-  /** \brief Its position, and the other surface's normal there pointing toward A's side. */
+  /** \brief Its position, and the other surface's normal there pointing toward A's side (for a
+    * point deep inside the other object, the outward normal of the other's sample nearest it,
+    * so turned: the way out; NaN where that sample has none). */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   /** \brief The deciding point lies over a bridged hole, or clearly behind a surface oriented

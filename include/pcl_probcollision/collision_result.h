@@ -130,7 +130,10 @@ struct CollisionResult
     * ProbabilisticCollision::compute (T_target_input, ...); this is the one place the rule is
     * stated. The normal can be NaN even with a witness: the separator's gradient collapsed
     * there (coincident or exact points, a degenerate classifier;
-    * ClassifierResult::witness_normal). */
+    * ClassifierResult::witness_normal). The surface layer's is the other surface's outward
+    * normal there, turned toward A's side; for a point found deep inside the other object (or
+    * one object wholly inside the other), that of the other's sample nearest the point: the way
+    * out (NaN where that sample has no normal). */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
 

@@ -8,6 +8,8 @@
 #include <pcl/common/io.h>
 #include <pcl/io/pcd_io.h>
 
+#include <Eigen/Core>
+
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
@@ -294,6 +296,57 @@ TEST_F (PcdCollisionTool, ASurfaceAnswerThatReachedNoPointReportsNoLeafPair)
   ASSERT_EQ (r.status, 0) << r.err;
   EXPECT_NE (r.out.find ("; leaf pairs 0;"), std::string::npos) << r.out;
   EXPECT_NE (r.out.find ("witness: none (no leaf pair tested)"), std::string::npos) << r.out;
+}
+
+// One object wholly inside the other (a 4 cm cube in the middle of a closed 40 cm box, both
+// meshes): out of every leaf's reach, the winding number finds it (-surface, and the ladder's
+// containment rung). Its witness normal was [null, null, null] (a probe, 2026-12-03); it is now
+// the way out, as at contact: the containing surface's outward normal at its sample nearest the
+// witness, turned toward a's side (out of the box for a point of the cube as <a>, into it for a
+// point of the cube as <b>).
+TEST_F (PcdCollisionTool, AContainmentAnswersWitnessNormalIsTheWayOut)
+{
+  const auto box = [] (double h) {
+    std::ostringstream obj;
+    for (const int x : {-1, 1})
+      for (const int y : {-1, 1})
+        for (const int z : {-1, 1})
+          obj << "v " << x * h << " " << y * h << " " << z * h << "\n";
+    // Outward winding: the x = -h face is (1 2 4) (1 4 3), its normal -x.
+    obj << "f 1 2 4\nf 1 4 3\nf 5 7 8\nf 5 8 6\nf 1 5 6\nf 1 6 2\nf 3 4 8\nf 3 8 7\nf 1 3 7\nf 1 7 5\n"
+           "f 2 6 8\nf 2 8 4\n";
+    return obj.str ();
+  };
+  const std::string cube = (dir_ / "cube.obj").string (), room = (dir_ / "room.obj").string ();
+  writeFile (cube, box (0.02));
+  writeFile (room, box (0.2));
+  for (const char* mode : {"-surface", "-surface_ladder"})
+    for (const bool cube_is_a : {true, false})
+    {
+      SCOPED_TRACE (std::string (mode) + (cube_is_a ? ", the cube as <a>" : ", the cube as <b>"));
+      const auto v = runJson ({cube_is_a ? cube : room, cube_is_a ? room : cube, mode, "-mesh_density", "0.01"});
+      ASSERT_EQ (v.size (), 1u);
+      EXPECT_EQ (v[0]["verdict"].text, "collision");
+      EXPECT_NEAR (v[0]["signed_distance"].number, -0.18, 0.01);  // the cube's point to the room's nearest sample
+      const Value& w = v[0]["witness"];
+      ASSERT_EQ (w.type, Value::Type::Object);
+      EXPECT_EQ (w["side"].text, cube_is_a ? "a" : "b");
+      ASSERT_EQ (w["normal"].array.size (), 3u);
+      Eigen::Vector3d n, p;
+      for (int i = 0; i < 3; ++i)
+      {
+        ASSERT_EQ (w["normal"][i].type, Value::Type::Number) << "normal " << i;
+        n[i] = w["normal"][i].number;
+        p[i] = w["point"][i].number;
+      }
+      EXPECT_NEAR (n.norm (), 1.0, 1e-6);
+      // A face's normal: one axis, the room's wall nearest the cube's point, whose coordinate
+      // along that axis is its largest (the cube is centred).
+      Eigen::Index k = 0;
+      EXPECT_GT (n.cwiseAbs ().maxCoeff (&k), 0.999) << n.transpose ();
+      EXPECT_NEAR (std::abs (p[k]), p.cwiseAbs ().maxCoeff (), 1e-6) << p.transpose ();
+      EXPECT_GT ((cube_is_a ? 1.0 : -1.0) * n[k] * p[k], 0.0) << "normal " << n.transpose () << " at " << p.transpose ();
+    }
 }
 
 // docs/CLI.md documents every key -json writes: each one appears in the key table of the
