@@ -208,6 +208,8 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
       if (w.size () != 3 || (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian") ||
           w[2] != "1.0")
         return fail (number, "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      if (counts)
+        counts->ascii = w[1] == "ascii";
       continue;
     }
     // An element of entries without properties takes no bytes: PCL's reader then steps through
@@ -228,6 +230,8 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
         counts->vertices = element_count;
       if (counts && element == "face")
         counts->faces = element_count;
+      if (counts)
+        counts->elements.push_back ({element, element_count, {}});
       continue;
     }
     if (key == "property")
@@ -240,6 +244,8 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
       const std::string& name = w.back ();
       if (!names.insert (name).second)
         return fail (number, "property '" + name + "' given twice in element '" + element + "'");
+      if (counts)
+        counts->elements.back ().properties.push_back ({name, list ? w[3] : w[1], list ? w[2] : std::string ()});
       // PCL's reader sizes a vertex list by the first vertex and writes later, longer ones past
       // its buffer (an assertion, an abort); and it packs red, green and blue into one field
       // by their order: other orders or a missing one write past it (found by fuzzing).
@@ -261,12 +267,135 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
       if (!colours.empty () && colours != std::vector<std::string>{"red", "green", "blue"} &&
           colours != std::vector<std::string>{"red", "green", "blue", "alpha"})
         return fail (number, "vertex colours must be red, green, blue (and alpha), in that order");
+      if (counts)
+        counts->header_lines = number;
       return true;
     }
     return fail (number, "unknown keyword '" + key + "'");
   }
   error = "'" + path + "' is not a readable PLY file (no end_header)";
   return false;
+}
+
+namespace
+{
+/** \brief The range of a PLY integer type (false for a floating-point one). */
+bool
+plyIntegerRange (const std::string& type, long long& low, long long& high)
+{
+  static const struct
+  {
+    const char* names[2];
+    long long low, high;
+  } kIntegers[] = {{{"char", "int8"}, -128, 127},          {{"uchar", "uint8"}, 0, 255},
+                   {{"short", "int16"}, -32768, 32767},    {{"ushort", "uint16"}, 0, 65535},
+                   {{"int", "int32"}, -2147483648LL, 2147483647LL}, {{"uint", "uint32"}, 0, 4294967295LL}};
+  for (const auto& t : kIntegers)
+    if (type == t.names[0] || type == t.names[1])
+    {
+      low = t.low;
+      high = t.high;
+      return true;
+    }
+  return false;
+}
+
+/** \brief Whether word is a value of a PLY property of type `type` as checkPlyValues wants it:
+  * an integer within the type's range, or a decimal number (nan and inf included; strtod's hex
+  * floats are not, PCL's reader takes them for NaN). */
+bool
+isPlyValue (const std::string& word, const std::string& type)
+{
+  const char* begin = word.c_str ();
+  char* end = nullptr;
+  long long low = 0, high = 0;
+  if (plyIntegerRange (type, low, high))
+  {
+    errno = 0;
+    const long long v = std::strtoll (begin, &end, 10);
+    return !word.empty () && end == begin + word.size () && errno == 0 && v >= low && v <= high;
+  }
+  std::strtod (begin, &end);
+  return !word.empty () && end == begin + word.size () && word.find_first_of ("xX") == std::string::npos;
+}
+} // namespace
+
+bool
+checkPlyValues (const std::string& path, const PlyCounts& layout, std::string& error)
+{
+  if (!layout.ascii)
+    return true;
+  std::ifstream in (path, std::ios::binary);
+  std::string line;
+  std::size_t line_number = 0;
+  while (line_number < layout.header_lines && std::getline (in, line))
+    ++line_number;
+  std::vector<std::string> words;
+  for (const PlyCounts::Element& element : layout.elements)
+    for (long long entry = 0; entry < element.count; ++entry)
+    {
+      if (!std::getline (in, line))
+      {
+        error = "'" + path + "' is truncated: it ends at line " + std::to_string (line_number) + ", within the " +
+                std::to_string (element.count) + " entries of element '" + element.name + "' its header declares";
+        return false;
+      }
+      ++line_number;
+      // PCL's reader takes one line an entry, its values between blanks (a CR ending included).
+      words.clear ();
+      std::istringstream split (line);
+      for (std::string word; split >> word;)
+        words.push_back (word);
+      const std::string where = "'" + path + "' line " + std::to_string (line_number);
+      auto refuse = [&] (std::size_t index, const std::string& type, const std::string& property) {
+        long long low = 0, high = 0;
+        error = where + ", value " + std::to_string (index + 1) + ": '" + words[index] + "' is not " +
+                (plyIntegerRange (type, low, high) ? "an integer within the range of " + type + " (property '" + property + "')"
+                                                   : std::string ("a number"));
+        return false;
+      };
+      // The values the header asks for, in order: one a scalar property, a list's count and as
+      // many values after it.
+      std::size_t next = 0;  // the next word's index
+      bool listed = false;   // the element has a list: its line's length depends on the counts
+      bool short_line = false;
+      for (const PlyCounts::Property& property : element.properties)
+      {
+        long long n = 1;
+        if (!property.count_type.empty ())
+        {
+          listed = true;
+          if (next >= words.size ())
+          {
+            short_line = true;
+            break;
+          }
+          if (!isPlyValue (words[next], property.count_type) || (n = std::strtoll (words[next].c_str (), nullptr, 10)) < 0)
+            return refuse (next, property.count_type, property.name);
+          ++next;
+        }
+        for (long long k = 0; k < n && !short_line; ++k, ++next)
+        {
+          if (next >= words.size ())
+            short_line = true;
+          else if (!isPlyValue (words[next], property.type))
+            return refuse (next, property.type, property.name);
+        }
+        if (short_line)
+          break;
+      }
+      if (short_line || next < words.size ())
+      {
+        const std::string values = std::to_string (words.size ()) + " value" + (words.size () == 1 ? "" : "s");
+        error = where + ": " + values + ", " +
+                (!listed ? "expected " + std::to_string (element.properties.size ())
+                         : short_line ? std::string ("too few") : "expected " + std::to_string (next)) +
+                " (its header's properties of element '" + element.name + "'" +
+                (listed ? ", a list's count and as many values" : "") + ")";
+        return false;
+      }
+    }
+  return true;
 }
 
 bool
@@ -363,7 +492,8 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
   const char* format = ply ? "PLY" : "PCD";
   if (ply)
   {
-    if (!checkPlyHeader (path, error))
+    PlyCounts layout;
+    if (!checkPlyHeader (path, error, &layout) || !checkPlyValues (path, layout, error))
       return false;
     pcl::PLYReader reader;
     int version = 0;

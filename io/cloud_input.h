@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace pcl_probcollision
 {
@@ -61,13 +62,38 @@ double readField (const std::uint8_t* p, std::uint8_t datatype);
   * blue (and alpha) in that order, no element count beyond the file's bytes. False with the
   * file, the header line and the reason. PCL's reader aborted on each of these (found by
   * fuzzing); the cloud and the mesh readers check it first. counts, when given, gets the
-  * vertex and face element counts (isFacelessPly). */
+  * vertex and face element counts (isFacelessPly) and the layout checkPlyValues walks. */
 struct PlyCounts
 {
   long long vertices = 0;  ///< entries of the element "vertex"
   long long faces = 0;     ///< entries of the element "face"
+  /** \brief One property of an element: its PLY type, and for a list its count's type. */
+  struct Property
+  {
+    std::string name;
+    std::string type;
+    std::string count_type;  ///< empty for a scalar property
+  };
+  struct Element
+  {
+    std::string name;
+    long long count = 0;
+    std::vector<Property> properties;
+  };
+  std::vector<Element> elements;  ///< in the header's order, which is the data's
+  bool ascii = false;             ///< format ascii 1.0
+  std::size_t header_lines = 0;   ///< lines up to and including end_header
 };
 bool checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts = nullptr);
+
+/** \brief For an ascii PLY whose header checkPlyHeader accepted into layout (a binary one passes
+  * unread): every entry's line holds its element's values (a list's count and that many more),
+  * each a number of its property's type (an integer type's an integer within its range; nan and
+  * inf are numbers), else false with the file, the line and the value. PCL's reader takes a value
+  * it cannot parse for NaN, so a point with `abc` was skipped as non-finite, and for an integer
+  * property for 0 (a face's vertex index), and said nothing; a line short of a value failed as
+  * "corrupt" without its line. Every entry is checked, its line counted from the file's start. */
+bool checkPlyValues (const std::string& path, const PlyCounts& layout, std::string& error);
 
 /** \brief True for a .ply file whose header declares vertices and no face: a point cloud, which
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,

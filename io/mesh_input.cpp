@@ -386,7 +386,8 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
     {
       if (ext == "ply")
       {
-        if (!checkPlyHeader (path, error))
+        PlyCounts layout;
+        if (!checkPlyHeader (path, error, &layout) || !checkPlyValues (path, layout, error))
           return false;
         read = pcl::io::loadPLYFile (path, polygon_mesh) >= 0;
       }

@@ -818,6 +818,15 @@ def test_malformed_pcd_files(tmp_path, table_path, capfd):
             pc.load_model(f)
     with pytest.raises(ValueError, match=r"word\.pcd' line 11, value 2: 'abc' is not a number"):
         pc.load_model(tmp_path / "word.pcd")
+    # An ascii PLY's likewise (PCL's reader took `abc` for NaN, a point skipped; a probe, 2026-12-03).
+    ply = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+    (tmp_path / "word.ply").write_bytes(ply + b"0 0 0\n1 abc 1\n")
+    (tmp_path / "short.ply").write_bytes(ply + b"0 0 0\n1 1\n")
+    for read in (pc.load_model, pc.read_cloud, pc._core.read_cloud_with_normals):
+        with pytest.raises(ValueError, match=r"word\.ply' line 9, value 2: 'abc' is not a number"):
+            read(tmp_path / "word.ply")
+        with pytest.raises(ValueError, match=r"short\.ply' line 9: 2 values, expected 3"):
+            read(tmp_path / "short.ply")
     # The exception is the one report: PCL's reader printed its own lines on stderr before.
     assert capfd.readouterr().err == ""
 

@@ -143,7 +143,7 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
   } cases[] = {
       {"novertex.ply", "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + faces + "end_header\n3 0 1 2\n", "is not a readable ply mesh"},
       {"truncated.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "end_header\n0 0 0\n1 0 0\n",
-       "is not a readable ply mesh (malformed or truncated)"},
+       "is truncated: it ends at line 11, within the 3 entries of element 'vertex' its header declares"},
       {"noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
        "is not a readable PLY file (header line 9: unknown keyword '0')"},
       {"negative_count.ply", "ply\nformat ascii 1.0\nelement vertex -3\n" + xyz + faces + "end_header\n3 0 1 2\n",

@@ -1068,6 +1068,58 @@ TEST_F (PcdCollisionTool, PcdHeaderThatPclMisreadsIsRefused)
   EXPECT_NE (wide.out.find ("free"), std::string::npos) << wide.out;
 }
 
+// An ascii PLY value that is not a number: PCL's reader takes it for NaN (and an integer
+// property's for 0), so a point with `abc` was skipped and counted as non-finite, said nowhere
+// else (a probe, 2026-12-03). Refused now as in an ascii PCD, naming the file, the line and the
+// value; so is a line short of a value or with one too many, which PCL's reader refused as
+// "corrupt" without its line, and a mesh's face index that is not one. Binary PLY is unchanged.
+TEST_F (PcdCollisionTool, AsciiPlyValueThatIsNotANumber)
+{
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "end_header\n";
+  const auto refused = [&] (const std::string& name, const std::string& text, const std::string& mention) {
+    writeFile (dir_ / name, text);
+    expectFailure ({kGripper.string (), (dir_ / name).string ()}, 1, name + "' " + mention, {dir_ / name});
+  };
+  refused ("word.ply", header + "0 0 0\n1 abc 1\n2 2 2\n", "line 9, value 2: 'abc' is not a number");
+  refused ("tail.ply", header + "0 0 0\n1 1 1.5x\n2 2 2\n", "line 9, value 3: '1.5x' is not a number");
+  refused ("hex.ply", header + "0 0 0\n0x1p3 1 1\n2 2 2\n", "line 9, value 1: '0x1p3' is not a number");
+  refused ("short.ply", header + "0 0 0\n1 1\n2 2 2\n", "line 9: 2 values, expected 3 (its header's properties of element 'vertex')");
+  refused ("long.ply", header + "0 0 0\n1 1 1\n2 2 2 2\n", "line 10: 4 values, expected 3");
+  refused ("blank.ply", header + "0 0 0\n\n1 1 1\n", "line 9: 0 values, expected 3");
+  refused ("cut.ply", header + "0 0 0\n1 1 1\n", "is truncated: it ends at line 9, within the 3 entries of element 'vertex' its header declares");
+  // An integer property: PCL read "1.5" and "abc" as 0, and 300 as a uchar as 44.
+  const std::string ints = "ply\nformat ascii 1.0\nelement vertex 2\nproperty int x\nproperty int y\nproperty int z\n"
+                           "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  refused ("int.ply", ints + "0 0 0 1 2 3\n1 1.5 1 1 2 3\n", "line 12, value 2: '1.5' is not an integer within the range of int (property 'y')");
+  refused ("colour.ply", ints + "0 0 0 1 2 3\n1 1 1 1 300 3\n", "line 12, value 5: '300' is not an integer within the range of uchar");
+  // A mesh's face index that is not a number (PCL's reader made it vertex 0).
+  writeFile (dir_ / "face.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                                    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 x 2\n");
+  expectFailure ({(dir_ / "face.ply").string (), kScene.string ()}, 1, "face.ply' line 13, value 3: 'x' is not an integer",
+                 {dir_ / "face.ply"});
+  writeFile (dir_ / "face_short.ply", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n");
+  expectFailure ({(dir_ / "face_short.ply").string (), kScene.string ()}, 1, "face_short.ply' line 13: 3 values, too few",
+                 {dir_ / "face_short.ply"});
+  // nan, inf, exponents, signs, CR line ends and colours are read; a NaN point is skipped and counted as
+  // before, in ascii and in binary (whose values are not text: unchanged).
+  writeFile (dir_ / "fine.ply", "ply\nformat ascii 1.0\nelement vertex 4\n" + xyz +
+                                    "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+                                    "nan nan nan 0 0 0\r\n1e-1 -2.5E+0 1 255 0 0\r\n0.25 inf 3 0 255 0\r\n+1 2. .5 0 0 255\r\n");
+  std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 2\n" + xyz + "end_header\n";
+  for (const float v : {std::nanf (""), 0.0f, 0.0f, 1.0f, 2.0f, 3.0f})
+    binary.append (reinterpret_cast<const char*> (&v), sizeof v);
+  writeFile (dir_ / "binary.ply", binary);
+  for (const auto& [name, skipped] : {std::pair<std::string, double> ("fine.ply", 2), std::pair<std::string, double> ("binary.ply", 1)})
+  {
+    const auto v = runJson ({kGripper.string (), (dir_ / name).string (), "-pose", "0,0,10,0,0,0", "-mesh_density", "0.01"});
+    ASSERT_EQ (v.size (), 1u) << name;
+    EXPECT_EQ (v[0]["verdict"].text, "free") << name;
+    EXPECT_EQ (v[0]["points_skipped_nonfinite"].number, skipped) << name;
+  }
+}
+
 // Options that changed nothing were accepted (a probe, 2026-12-03): -mesh_density with two clouds
 // (it sets a mesh's sample spacing) and -noise_resolution_gate without -noise_resolution. Both are
 // usage errors now, naming the option and why, found before any input is loaded; a .ply without
