@@ -59,6 +59,17 @@ fieldSize (std::uint8_t datatype)
     default: return 0;
   }
 }
+/** \brief Whether strtod reads the whole word as a number (nan and inf included), and which. */
+bool
+wholeNumber (const std::string& word, double* value = nullptr)
+{
+  char* end = nullptr;
+  const double v = std::strtod (word.c_str (), &end);
+  if (value)
+    *value = v;
+  return !word.empty () && end == word.c_str () + word.size ();
+}
+
 /** \brief For a PCD with DATA ascii: every value of its first `points` data lines a number, as
   * strtod reads it whole (nan and inf included), and `values` of them a line (the header's
   * COUNTs summed), or `values_unpadded` (those of padding fields "_" left out: PCL's writer
@@ -89,9 +100,7 @@ checkAsciiValues (const std::string& path, std::size_t points, std::size_t value
     {
       ++column;
       any = true;
-      char* end = nullptr;
-      std::strtod (word.c_str (), &end);
-      if (end != word.c_str () + word.size ())
+      if (!wholeNumber (word))
       {
         error = "'" + path + "' line " + std::to_string (line_number) + ", value " + std::to_string (column) + ": '" +
                 word + "' is not a number";
@@ -130,9 +139,8 @@ checkViewpoint (const std::string& path, std::string& error)
     while (words >> word)
     {
       ++column;
-      char* end = nullptr;
-      const double value = std::strtod (word.c_str (), &end);
-      if (end != word.c_str () + word.size () || !std::isfinite (value))
+      double value = 0.0;
+      if (!wholeNumber (word, &value) || !std::isfinite (value))
       {
         error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT value " + std::to_string (column) +
                 " '" + word + "' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)";
