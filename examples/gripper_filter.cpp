@@ -29,7 +29,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
+#include <system_error>
 
 using PointT = pcl::PointXYZRGB;
 using Cloud = pcl::PointCloud<PointT>;
@@ -71,6 +73,39 @@ makeGripper (float step)
   return g;
 }
 
+/** \brief The depth argument as a finite number, read whole ("0.01x" is refused, not read as 0.01). */
+bool
+parseDepth (const char* text, double& depth)
+{
+  char* end = nullptr;
+  depth = std::strtod (text, &end);
+  return *text != '\0' && *end == '\0' && std::isfinite (depth);
+}
+
+/** \brief Why `out` cannot be written without harm, or "": it is the scan (the same file through any
+  * link), a directory, or in a directory that does not exist. */
+std::string
+outputProblem (const std::string& out, const std::string& scan)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  bool same = fs::exists (out, ec) && fs::exists (scan, ec) && fs::equivalent (out, scan, ec);
+  if (!same)
+  {
+    const fs::path a = fs::weakly_canonical (out, ec);
+    const fs::path b = fs::weakly_canonical (scan, ec);
+    same = !ec && a == b;
+  }
+  if (same)
+    return "is the input scan; refusing to overwrite it";
+  if (fs::is_directory (out, ec))
+    return "is a directory";
+  const fs::path dir = fs::path (out).has_parent_path () ? fs::path (out).parent_path () : fs::path (".");
+  if (!fs::is_directory (dir, ec))
+    return "cannot be written: directory '" + dir.string () + "' does not exist";
+  return "";
+}
+
 bool
 saveAtomically (const std::string& path, const Cloud& cloud)
 {
@@ -94,11 +129,23 @@ main (int argc, char** argv)
 {
   const std::string scan_path = argc > 1 ? argv[1] : "../shared/data/scans/table_scene_mug_stereo_textured.pcd";
   const std::string out_path = argc > 2 ? argv[2] : "gripper_contacts.pcd";
-  const double depth = argc > 3 ? std::atof (argv[3]) : 0.01;
   if (argc > 4 || (argc > 1 && (std::string (argv[1]) == "-h" || std::string (argv[1]) == "--help")))
   {
     std::printf ("Usage: %s [SCAN.pcd] [OUTPUT.pcd] [DEPTH]\n", argv[0]);
     return argc > 4 ? 2 : 0;
+  }
+  double depth = 0.01;
+  if (argc > 3 && !parseDepth (argv[3], depth))
+  {
+    std::fprintf (stderr, "gripper_filter: error: DEPTH '%s' is not a finite number (metres below the table)\n", argv[3]);
+    return 2;
+  }
+  // Checked before the work, so that a long run does not end in an error or overwrite the scan.
+  const std::string problem = outputProblem (out_path, scan_path);
+  if (!problem.empty ())
+  {
+    std::fprintf (stderr, "gripper_filter: error: OUTPUT '%s' %s\n", out_path.c_str (), problem.c_str ());
+    return 2;
   }
 
   // 1. Load and clean up the scan with stock PCL filters.

@@ -1,0 +1,32 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# The example refuses, before any work and with exit 2, an OUTPUT that is its SCAN (the scan, a
+# copy made here, is left byte-identical), a DEPTH that is not a number, and an OUTPUT in a
+# directory that does not exist.
+# cmake -DEXE=... -DSCAN=... -DWORK=DIR -P refuse_gripper_filter.cmake
+file(MAKE_DIRECTORY "${WORK}")
+set(copy "${WORK}/scan_copy.pcd")
+file(COPY_FILE "${SCAN}" "${copy}")
+file(SHA256 "${copy}" before)
+function(expect_refused what expected_text)
+  execute_process(COMMAND "${EXE}" ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2)
+    message(FATAL_ERROR "${what}: exit ${rc}, expected 2 (${out}${err})")
+  endif()
+  string(FIND "${err}" "${expected_text}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "${what}: the error does not say '${expected_text}': ${err}")
+  endif()
+  message(STATUS "${what}: ${err}")
+endfunction()
+expect_refused("OUTPUT is SCAN" "is the input scan" "${copy}" "${copy}")
+expect_refused("OUTPUT is SCAN by another path" "is the input scan" "${copy}" "${WORK}/../${WORK_NAME}/scan_copy.pcd")
+expect_refused("DEPTH 0.01x" "DEPTH '0.01x' is not a finite number" "${copy}" "${WORK}/out.pcd" "0.01x")
+expect_refused("DEPTH nan" "DEPTH 'nan' is not a finite number" "${copy}" "${WORK}/out.pcd" "nan")
+expect_refused("OUTPUT in a missing directory" "does not exist" "${copy}" "${WORK}/no_such_dir/out.pcd")
+file(SHA256 "${copy}" after)
+if(NOT before STREQUAL after)
+  message(FATAL_ERROR "the scan was changed")
+endif()
+if(EXISTS "${WORK}/out.pcd")
+  message(FATAL_ERROR "a refused run wrote ${WORK}/out.pcd")
+endif()
