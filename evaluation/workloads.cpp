@@ -25,7 +25,7 @@ void
 calibratedSurface (std::vector<OursSetting>& settings)
 {
   for (OursSetting& s : settings)
-    s.request.surface_calibrated = true;
+    s.request.surface_calibrated = s.request.surface;  // the maps are the surface layer's
 }
 
 std::vector<OursSetting>

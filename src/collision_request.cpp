@@ -32,6 +32,13 @@ CollisionRequest::validate () const
   if (traversal != TraversalMode::ExpectedWeight && traversal != TraversalMode::Stochastic &&
       traversal != TraversalMode::ExpandedBV)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "traversal mode " << static_cast<int> (traversal) << " is unknown");
+  // Each of these changes how the surface layer's answer is used: without it they would change
+  // nothing, and the answer would be the separators' under a request that names the surface.
+  if (!surface && (surface_pooled || surface_ladder || surface_calibrated))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         where << (surface_pooled ? "surface_pooled" : surface_ladder ? "surface_ladder" : "surface_calibrated")
+                               << " needs surface: set surface too (pcd_collision's -surface_pooled and "
+                                  "-surface_ladder imply -surface)");
   if (surface_pooled && surface_ladder)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          where << "surface_pooled and surface_ladder exclude each other: pick one way to combine the "

@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace pcl_probcollision;
@@ -105,6 +106,32 @@ TEST (CollisionRequest, ValidateRefusesPooledWithLadder)
   r.surface_pooled = true;
   r.surface_ladder = false;
   EXPECT_NO_THROW (r.validate ());
+}
+
+// surface_pooled, surface_ladder and surface_calibrated act on the surface layer's answer: without
+// surface they would change nothing, and the separators would answer a request that names it.
+TEST (CollisionRequest, ValidateRefusesSurfaceSwitchesWithoutSurface)
+{
+  const std::vector<std::pair<std::string, bool CollisionRequest::*>> switches = {
+      {"surface_pooled", &CollisionRequest::surface_pooled},
+      {"surface_ladder", &CollisionRequest::surface_ladder},
+      {"surface_calibrated", &CollisionRequest::surface_calibrated}};
+  for (const auto& [name, member] : switches)
+  {
+    CollisionRequest r;
+    r.*member = true;
+    try
+    {
+      r.validate ();
+      ADD_FAILURE () << name << " without surface did not throw";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find (name + " needs surface"), std::string::npos) << e.what ();
+    }
+    r.surface = true;
+    EXPECT_NO_THROW (r.validate ()) << name;
+  }
 }
 
 TEST (CollisionRequest, ValidateMessageCarriesTheMethodPrefix)

@@ -95,7 +95,8 @@ struct CollisionRequest
     * penetration), or pooled with them as surface_pooled does where they answered free (between
     * sparse samples a part can pass unseen by the separators). Most free poses then cost the
     * separators alone. The rule was chosen on evaluation runs with seeds other than the reported
-    * one (docs/SURFACE.md, "The ladder"); experimental, off by default. Excludes surface_pooled. */
+    * one (docs/SURFACE.md, "The ladder"); experimental, off by default. Excludes surface_pooled.
+    * Like surface_pooled and surface_calibrated, refused by validate() without surface. */
   bool surface_ladder = false;
   /** \brief With surface on: P (the surface layer's, or the pool's) goes through a calibration
     * map inside the default contact band [0.1, 0.9]: strictly increasing, onto the band, the

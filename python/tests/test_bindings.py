@@ -404,6 +404,11 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
     assert pooled.signed_distance == surface.signed_distance
     assert "surface_pooled=True" in repr(pc.CollisionRequest(surface=True, surface_pooled=True))
     assert not pc.CollisionRequest().surface_calibrated
+    # Without surface each switch would change nothing: the separators' answer under a request
+    # naming the surface layer (the demo's pose 2 read 0.820 here against the CLI's 0.908).
+    for switch in ("surface_pooled", "surface_ladder", "surface_calibrated"):
+        with pytest.raises(ValueError, match=switch + " needs surface"):
+            pc.collide(A, B, T, pc.CollisionRequest(**{switch: True}))
     assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
 
 
