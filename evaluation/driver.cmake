@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # The driver: every method on every workload, CSV out (scripts/evaluate.sh renders the charts).
 add_executable(evaluate_collision evaluate_collision.cpp workloads.cpp scenes.cpp fit_scenes.cpp)
-target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io
+# pcd_collision_cli: the command-line tool's number parsing (one reader of a number on a command line).
+target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io pcd_collision_cli
   pcl_probcollision pcl_io FLANN::FLANN)
 target_compile_options(evaluate_collision PRIVATE -Wall -Wextra)
 
@@ -24,7 +25,7 @@ endif()
 
 # One W2 query's clouds as PCD files, to run it alone through pcd_collision (docs/PERFORMANCE.md).
 add_executable(dump_primitive dump_primitive.cpp)
-target_link_libraries(dump_primitive PRIVATE eval_metrics pcl_io)
+target_link_libraries(dump_primitive PRIVATE eval_metrics pcd_collision_cli pcl_io)
 target_compile_options(dump_primitive PRIVATE -Wall -Wextra)
 if(BUILD_TESTING)
   # The resting-contact query of the first scenario: its name, both clouds and an exact 0 gap.
@@ -32,6 +33,13 @@ if(BUILD_TESTING)
     COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test --seed 1 sphere_sphere/0s)
   set_tests_properties(eval.DumpPrimitiveWritesOneQuery PROPERTIES PASS_REGULAR_EXPRESSION
     "^sphere_sphere/0s: robot [1-9][0-9]* points, env [1-9][0-9]* points, exact distance 0 m; pcd_collision ")
+  add_test(NAME eval.EvaluateCollisionChecksItsOptions
+    COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:evaluate_collision> -DDATA=${PCL_PROBCOLLISION_SHARED_DATA}
+      -DWORK=${CMAKE_CURRENT_BINARY_DIR}/check_options -P ${CMAKE_CURRENT_SOURCE_DIR}/check_options.cmake)
+  add_test(NAME eval.DumpPrimitiveRefusesABadSeed
+    COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test --seed 5x sphere_sphere/0s)
+  set_tests_properties(eval.DumpPrimitiveRefusesABadSeed PROPERTIES PASS_REGULAR_EXPRESSION
+    "--seed '5x' is not a whole number")
   add_test(NAME eval.DumpPrimitiveRefusesAnUnknownName
     COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test no_such_scenario)
   set_tests_properties(eval.DumpPrimitiveRefusesAnUnknownName PROPERTIES PASS_REGULAR_EXPRESSION

@@ -11,6 +11,8 @@
 // point counts, exact signed distance and the pcd_collision command that answers it.
 #include "primitives.h"
 
+#include <cli_options.h>
+
 #include <pcl/io/pcd_io.h>
 
 #include <cstdio>
@@ -40,25 +42,26 @@ main (int argc, char** argv)
   {
     const std::string a = argv[i];
     const bool has_value = i + 1 < argc;
-    try
+    if (a == "--out" && has_value)
+      out = argv[++i];
+    else if (a == "--seed" && has_value)
     {
-      if (a == "--out" && has_value)
-        out = argv[++i];
-      else if (a == "--seed" && has_value)
-        seed = std::stoull (argv[++i]);
-      else if (a == "--scale" && has_value)
-        scale = std::stod (argv[++i]);
-      else if (a == "--quick")
-        quick = true;
-      else if (!a.empty () && a[0] != '-' && prefix.empty ())
-        prefix = a;
-      else
-        return usage (("unknown or incomplete argument '" + a + "'").c_str ());
+      std::uint64_t v = 0;
+      if (!pcd_collision::parseUint64 (argv[++i], v))
+        return usage (("--seed '" + std::string (argv[i]) + "' is not a whole number").c_str ());
+      seed = v;
     }
-    catch (const std::exception&)  // std::stoull, std::stod: not a number, or out of range
+    else if (a == "--scale" && has_value)
     {
-      return usage ((a + " '" + argv[i] + "' is not a number").c_str ());
+      if (!pcd_collision::parseDouble (argv[++i], scale) || !(scale > 0.0))
+        return usage (("--scale '" + std::string (argv[i]) + "' is not a number above 0").c_str ());
     }
+    else if (a == "--quick")
+      quick = true;
+    else if (!a.empty () && a[0] != '-' && prefix.empty ())
+      prefix = a;
+    else
+      return usage (("unknown or incomplete argument '" + a + "'").c_str ());
   }
   if (out.empty () || prefix.empty ())
     return usage ("--out and PREFIX are required");

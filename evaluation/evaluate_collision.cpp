@@ -27,6 +27,9 @@
 //                      [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...]
 //                      [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
+// Counts are whole numbers, --noise values above 0, --merge/--gate/--cloud-merge/--stop/--cap
+// values at least 0, --drop below 100, --only names of settings the run has, and DIR lies outside
+// --data; anything else exits 2 naming the option, before any work. --help prints the usage.
 // --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
 // --surface-calibrated passes the surface layer's P through its calibration maps
 // (CollisionRequest::surface_calibrated, off by default). --fit-scene runs W1's pipeline on a
@@ -46,6 +49,8 @@
 #include "primitives.h"
 #include "workloads.h"
 
+#include <cli_options.h>
+
 #include <pcl_probcollision/collision_request.h>
 
 #include <pcl/io/pcd_io.h>
@@ -57,6 +62,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <iostream>
 #include <map>
 #include <tuple>
@@ -80,6 +86,7 @@ struct Options
   int rescans = 0;                ///< re-scans of both objects (0: 8 quick, 10 full)
   std::size_t rescan_poses = 0;   ///< near-band poses re-scanned per cell (0: 20 quick, 100 full)
   bool ours_only = false;         ///< skip the baselines, W2 and W3 (for quick studies)
+  bool help = false;              ///< --help: the usage, nothing run
   /** \brief --surface-calibrated: the surface layer's P through its calibration maps
     * (CollisionRequest::surface_calibrated, off by default). */
   bool surface_calibrated = false;
@@ -1445,12 +1452,42 @@ list (const std::string& value)
   return items;
 }
 
+const char* const kUsage =
+  "usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
+  " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...]"
+  " [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...] [--stop C,C,...] [--cap N,N,...]"
+  " [--only SETTING,...] [--drop F,...] [--workloads W,...]";
+
+/** \brief An option's whole-number value (decimal digits only: "5x", "2.5" and "-1" are refused,
+  * not truncated or wrapped), read as the command-line tool reads them (tools/cli_options.h). */
+std::uint64_t
+count (const std::string& option, const std::string& text, std::uint64_t max = std::numeric_limits<std::uint64_t>::max ())
+{
+  std::uint64_t v = 0;
+  if (!pcd_collision::parseUint64 (text, v) || v > max)
+    throw std::invalid_argument ("option " + option + ": '" + text + "' is not a whole number from 0 to " + std::to_string (max));
+  return v;
+}
+
+/** \brief An option's comma-separated finite numbers, each at least `min` (strictly above it when
+  * `above`), naming the option and the value that is not. */
 std::vector<double>
-numbers (const std::vector<std::string>& items)
+numbers (const std::string& option, const std::string& text, double min, bool above)
 {
   std::vector<double> out;
-  for (const std::string& item : items)
-    out.push_back (std::stod (item));
+  for (const std::string& item : list (text))
+  {
+    double v = 0.0;
+    if (!pcd_collision::parseDouble (item, v))
+      throw std::invalid_argument ("option " + option + ": '" + item + "' is not a finite number");
+    if (above ? !(v > min) : !(v >= min))
+    {
+      std::ostringstream what;
+      what << "option " << option << ": " << item << " must be " << (above ? "above " : "at least ") << min;
+      throw std::invalid_argument (what.str ());
+    }
+    out.push_back (v);
+  }
   return out;
 }
 
@@ -1460,6 +1497,26 @@ positive (std::vector<double> values)
 {
   values.erase (std::remove_if (values.begin (), values.end (), [] (double v) { return !(v > 0.0); }), values.end ());
   return values;
+}
+
+/** \brief Refuses an --out that is the --data directory or lies inside it: the outputs (queries.csv
+  * among them) would overwrite the inputs (DATA/scenes/queries.csv). */
+void
+checkOutputDirectory (const Options& o)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical (o.out_dir, ec);
+  fs::path data = fs::weakly_canonical (o.data_dir, ec);
+  if (ec)
+    return;  // an unreadable --data fails where it is read, naming the file
+  // "data/" and "data" alike: no empty last element.
+  if (data.filename ().empty ())
+    data = data.parent_path ();
+  const auto mismatch = std::mismatch (data.begin (), data.end (), out.begin (), out.end ());
+  if (mismatch.first == data.end ())
+    throw std::invalid_argument ("--out '" + o.out_dir + "' lies in --data '" + o.data_dir +
+                                 "': its outputs would overwrite the inputs; write them elsewhere");
 }
 
 Options
@@ -1474,22 +1531,24 @@ parse (int argc, char** argv)
         throw std::invalid_argument ("option " + a + " needs a value");
       return argv[++i];
     };
-    if (a == "--out")
+    if (a == "--help" || a == "-h")
+      o.help = true;
+    else if (a == "--out")
       o.out_dir = value ();
     else if (a == "--data")
       o.data_dir = value ();
     else if (a == "--quick")
       o.quick = true;
     else if (a == "--seed")
-      o.seed = std::stoull (value ());
+      o.seed = count (a, value ());
     else if (a == "--poses")
-      o.poses = std::stoull (value ());
+      o.poses = count (a, value ());
     else if (a == "--sigma-poses")
-      o.sigma_poses = std::stoull (value ());
+      o.sigma_poses = count (a, value ());
     else if (a == "--rescans")
-      o.rescans = std::stoi (value ());
+      o.rescans = static_cast<int> (count (a, value (), 1000));
     else if (a == "--rescan-poses")
-      o.rescan_poses = std::stoull (value ());
+      o.rescan_poses = count (a, value ());
     else if (a == "--ours-only")
       o.ours_only = true;
     else if (a == "--surface-calibrated")
@@ -1499,19 +1558,28 @@ parse (int argc, char** argv)
     else if (a == "--dump")
       o.dump = true;
     else if (a == "--noise")
-      o.noise = numbers (list (value ()));
+      o.noise = numbers (a, value (), 0.0, true);
     else if (a == "--merge")
-      o.merge = positive (numbers (list (value ())));
+      o.merge = positive (numbers (a, value (), 0.0, false));
     else if (a == "--gate")
-      o.gate = positive (numbers (list (value ())));
+      o.gate = positive (numbers (a, value (), 0.0, false));
     else if (a == "--cloud-merge")
-      o.cloud_merge = positive (numbers (list (value ())));
+      o.cloud_merge = positive (numbers (a, value (), 0.0, false));
     else if (a == "--stop")
-      o.stop = positive (numbers (list (value ())));
+      o.stop = positive (numbers (a, value (), 0.0, false));
     else if (a == "--cap")
-      o.cap = positive (numbers (list (value ())));
+      o.cap = positive (numbers (a, value (), 0.0, false));
     else if (a == "--drop")
-      o.drop = numbers (list (value ()));
+    {
+      o.drop = numbers (a, value (), 0.0, false);
+      for (const double f : o.drop)
+        if (!(f < 100.0))
+        {
+          std::ostringstream what;
+          what << "option --drop: " << f << " % leaves no sample (below 100)";
+          throw std::invalid_argument (what.str ());
+        }
+    }
     else if (a == "--only")
       o.only = list (value ());
     else if (a == "--workloads")
@@ -1522,12 +1590,34 @@ parse (int argc, char** argv)
           throw std::invalid_argument ("--workloads: unknown workload '" + w + "' (W1, W2 or W3)");
     }
     else
-      throw std::invalid_argument ("unknown option " + a +
-                                   " (usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
-                                   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...] [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...] [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...])");
+      throw std::invalid_argument ("unknown option " + a + " (" + kUsage + ")");
   }
+  if (o.help)
+    return o;
   if (o.out_dir.empty () || o.data_dir.empty ())
-    throw std::invalid_argument ("--out and --data are required");
+    throw std::invalid_argument (std::string ("--out and --data are required (") + kUsage + ")");
+  checkOutputDirectory (o);
+  // --only names settings the run knows (the full sweep's, and --drop's).
+  if (!o.only.empty ())
+  {
+    std::vector<std::string> known;
+    for (const OursSetting& setting : oursSettings (true, o.merge, o.gate, o.stop, o.cap, o.cloud_merge))
+      known.push_back (setting.name);
+    for (const double f : o.drop)
+    {
+      std::ostringstream name;
+      name << "drop" << f;
+      known.push_back (name.str ());
+    }
+    for (const std::string& name : o.only)
+      if (std::find (known.begin (), known.end (), name) == known.end ())
+      {
+        std::string names;
+        for (const std::string& k : known)
+          names += (names.empty () ? "" : ", ") + k;
+        throw std::invalid_argument ("--only: unknown setting '" + name + "' (this run's: " + names + ")");
+      }
+  }
   return o;
 }
 } // namespace
@@ -1538,6 +1628,11 @@ main (int argc, char** argv)
   try
   {
     const Options o = parse (argc, argv);
+    if (o.help)
+    {
+      std::cout << kUsage << "\n(docs/RESULTS.md says what each option does)" << std::endl;
+      return 0;
+    }
     std::filesystem::create_directories (o.out_dir);  // before hours of work, not after
     const auto start = Clock::now ();
     Results results;

@@ -1,0 +1,31 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# evaluate_collision's command line: --help exits 0 with the usage; a value that is not what its
+# option takes, an unknown --only setting and an --out inside --data exit 2 naming the option and
+# value, before any output directory is made.
+# cmake -DEXE=... -DDATA=... -DWORK=DIR -P check_options.cmake
+file(REMOVE_RECURSE "${WORK}")
+function(expect code pattern)
+  execute_process(COMMAND "${EXE}" ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL code)
+    message(FATAL_ERROR "evaluate_collision ${ARGN}: exit ${rc}, expected ${code}: ${out}${err}")
+  endif()
+  if(NOT "${out}${err}" MATCHES "${pattern}")
+    message(FATAL_ERROR "evaluate_collision ${ARGN}: does not say '${pattern}': ${out}${err}")
+  endif()
+  message(STATUS "${ARGN}: ${out}${err}")
+endfunction()
+expect(0 "^usage: evaluate_collision --out DIR" --help)
+set(base --out "${WORK}/out" --data "${DATA}")
+expect(2 "option --seed: 'abc' is not a whole number" ${base} --seed abc)
+expect(2 "option --seed: '5x' is not a whole number" ${base} --seed 5x)
+expect(2 "option --seed: '-1' is not a whole number" ${base} --seed -1)
+expect(2 "option --rescans: '2.5' is not a whole number" ${base} --rescans 2.5)
+expect(2 "option --noise: '1O' is not a finite number" ${base} --noise 0.5,1O)
+expect(2 "option --noise: -1 must be above 0" ${base} --noise -1)
+expect(2 "option --merge: -2 must be at least 0" ${base} --merge -2)
+expect(2 "option --drop: 100 % leaves no sample" ${base} --drop 100)
+expect(2 "--only: unknown setting 'bogus' \\(this run's: default, " ${base} --only default,bogus)
+expect(2 "--out '.*' lies in --data" --out "${DATA}/scenes" --data "${DATA}/")
+if(EXISTS "${WORK}/out")
+  message(FATAL_ERROR "a refused run made ${WORK}/out")
+endif()
