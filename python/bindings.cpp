@@ -36,6 +36,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -215,6 +216,9 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
       throw py::value_error ("viewpoint: expected 7 numbers tx ty tz qw qx qy qz (a PCD's VIEWPOINT)");
     }
     const double* d = v.data ();
+    for (int i = 0; i < 7; ++i)
+      if (!std::isfinite (d[i]))
+        throw py::value_error ("viewpoint: value " + std::to_string (i + 1) + " is not finite (tx ty tz qw qx qy qz)");
     cloud.sensor_origin_ = Eigen::Vector4f (static_cast<float> (d[0]), static_cast<float> (d[1]), static_cast<float> (d[2]), 0.f);
     cloud.sensor_orientation_ = Eigen::Quaternionf (static_cast<float> (d[3]), static_cast<float> (d[4]),
                                                     static_cast<float> (d[5]), static_cast<float> (d[6]));
@@ -414,6 +418,54 @@ checkThreads (int threads)
     throw py::value_error ("threads: " + why + ", got " + std::to_string (threads));
 }
 
+/** CloudModelParams.noise_resolution_gate by name (the constructor and the attribute). */
+void
+setResolutionGate (CloudModelParams& p, const std::string& v)
+{
+  if (!CloudModelParams::resolutionGateFromName (v, p.noise_resolution_gate))
+    throw py::value_error ("noise_resolution_gate: expected one of everywhere, spacing, cloud, got '" + v + "'");
+}
+
+/** CloudModelParams.split: the hierarchy's split style by name, 'pca' or 'octree'. */
+std::string
+splitName (const CloudModelParams& p)
+{
+  return p.hierarchy.split_style == BVHParams::SplitStyle::Octree ? "octree" : "pca";
+}
+
+void
+setSplit (CloudModelParams& p, const std::string& v)
+{
+  if (v != "pca" && v != "octree")
+    throw py::value_error ("split: expected 'pca' or 'octree', got '" + v + "'");
+  p.hierarchy.split_style = v == "octree" ? BVHParams::SplitStyle::Octree : BVHParams::SplitStyle::Pca;
+}
+
+/** The k-th pose of an (M, 4, 4) array: ValueError naming it when it is not finite or its last row
+  * is not 0 0 0 1, and with `rigid` when collide()'s rigid check (detail::poseError) fails. */
+Eigen::Isometry3d
+poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool rigid)
+{
+  const std::string name = "poses[" + std::to_string (k) + "]";
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      m (i, j) = p (k, i, j);
+  if (!m.allFinite ())
+    throw py::value_error (name + ": the pose is not finite (NaN or infinite entries)");
+  if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
+    throw py::value_error (name + ": the last row of a 4x4 pose must be [0, 0, 0, 1]");
+  Eigen::Isometry3d T;
+  T.matrix () = m;
+  if (rigid)
+  {
+    const std::string error = pcl_probcollision::detail::poseError (T, name);
+    if (!error.empty ())
+      throw py::value_error (error);
+  }
+  return T;
+}
+
 std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
              int threads)
@@ -431,17 +483,7 @@ collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, 
   const auto p = poses.unchecked<3> ();
   std::vector<Eigen::Isometry3d> T (static_cast<std::size_t> (p.shape (0)));
   for (py::ssize_t k = 0; k < p.shape (0); ++k)
-  {
-    Eigen::Matrix4d m;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        m (i, j) = p (k, i, j);
-    if (!m.allFinite ())
-      throw py::value_error ("poses[" + std::to_string (k) + "]: the pose is not finite (NaN or infinite entries)");
-    if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
-      throw py::value_error ("poses[" + std::to_string (k) + "]: the last row of a 4x4 pose must be [0, 0, 0, 1]");
-    T[static_cast<std::size_t> (k)].matrix () = m;
-  }
+    T[static_cast<std::size_t> (k)] = poseAt (p, k, false);
   std::vector<CollisionResult> results;
   {
     py::gil_scoped_release release;
@@ -702,11 +744,9 @@ invertPoses (const py::object& obj)
   auto o = out.mutable_unchecked<3> ();
   for (py::ssize_t k = 0; k < p.shape (0); ++k)
   {
-    Eigen::Isometry3d T;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j)
-        T.matrix () (i, j) = p (k, i, j);
-    const Eigen::Isometry3d inv = T.inverse ();
+    // Rigid, as collide() checks: Eigen's isometry inverse transposes the rotation, which for a
+    // scaled or sheared matrix is no inverse at all.
+    const Eigen::Isometry3d inv = poseAt (p, k, true).inverse ();
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         o (k, i, j) = inv.matrix () (i, j);
@@ -937,9 +977,10 @@ PYBIND11_MODULE (_core, m)
       "(experimental, issue #16; costs a normal fit and an orientation pass per point); orientation: how its\n"
       "normals are oriented (NormalOrientation, default Auto); closed_objects: the cloud samples closed solids,\n"
       "so a propagated orientation, once checked by the winding number, says where the inside is.")
-      .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, int n_min,
+      .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, std::optional<int> n_min,
                           double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation,
-                          bool closed_objects) {
+                          bool closed_objects, int threads, double noise_resolution, const std::string& noise_resolution_gate,
+                          bool keep_full_resolution, double noise_stop, const std::string& split) {
               CloudModelParams p;
               p.k = k;
               p.noise = noise;
@@ -948,20 +989,32 @@ PYBIND11_MODULE (_core, m)
               p.orientation = orientation;
               p.closed_objects = closed_objects;
               p.hierarchy.n_max = n_max;
-              p.hierarchy.n_min = n_min;
+              // As pcd_collision's -nmax: n_min follows a smaller n_max unless given.
+              p.hierarchy.n_min = n_min ? *n_min : std::min (p.hierarchy.n_min, n_max);
               p.hierarchy.sigma_max = sigma_max;
               p.hierarchy.epsilon = epsilon;
               p.hierarchy.k_sigma = k_sigma;
+              checkThreads (threads);
+              p.threads = threads;
+              p.noise_resolution = noise_resolution;
+              setResolutionGate (p, noise_resolution_gate);
+              p.keep_full_resolution = keep_full_resolution;
+              p.hierarchy.noise_stop = noise_stop;
+              setSplit (p, split);
               return p;
             }),
             py::kw_only (), py::arg ("k") = dp.k, py::arg_v ("noise", dp.noise, "SensorNoiseModel.none()"),
             py::arg ("surface_projection") = dp.surface_projection, py::arg ("n_max") = dp.hierarchy.n_max,
-            py::arg ("n_min") = dp.hierarchy.n_min, py::arg ("sigma_max") = dp.hierarchy.sigma_max,
+            py::arg_v ("n_min", py::none (), "min(8, n_max)"), py::arg ("sigma_max") = dp.hierarchy.sigma_max,
             py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
             py::arg ("surface") = dp.surface, py::arg ("orientation") = dp.orientation,
-            py::arg ("closed_objects") = dp.closed_objects,
-            "Every argument defaults to the C++ CloudModelParams default. The other members (threads,\n"
-            "noise_resolution and its gate, keep_full_resolution, noise_stop, split) are set as attributes.")
+            py::arg ("closed_objects") = dp.closed_objects, py::arg ("threads") = dp.threads,
+            py::arg ("noise_resolution") = dp.noise_resolution,
+            py::arg ("noise_resolution_gate") = std::string (CloudModelParams::resolutionGateName (dp.noise_resolution_gate)),
+            py::arg ("keep_full_resolution") = dp.keep_full_resolution, py::arg ("noise_stop") = dp.hierarchy.noise_stop,
+            py::arg ("split") = splitName (dp),
+            "Every argument defaults to the C++ CloudModelParams default, n_min to min(8, n_max) as pcd_collision's\n"
+            "-nmax sets it. Each is also an attribute.")
       .def_readwrite ("k", &CloudModelParams::k)
       .def_readwrite ("noise", &CloudModelParams::noise)
       .def_readwrite ("surface_projection", &CloudModelParams::surface_projection)
@@ -980,10 +1033,7 @@ PYBIND11_MODULE (_core, m)
       .def_property (
         "noise_resolution_gate",
         [] (const CloudModelParams& p) { return std::string (CloudModelParams::resolutionGateName (p.noise_resolution_gate)); },
-        [] (CloudModelParams& p, const std::string& v) {
-          if (!CloudModelParams::resolutionGateFromName (v, p.noise_resolution_gate))
-            throw py::value_error ("noise_resolution_gate: expected one of everywhere, spacing, cloud, got '" + v + "'");
-        },
+        &setResolutionGate,
         "Where noise_resolution merges (pcd_collision's -noise_resolution_gate): 'everywhere' (every sample),\n"
         "'spacing' (only samples spaced within their noise sigma) or 'cloud' (the whole cloud where it is\n"
         "sampled finer than its noise, else nothing). Default: CloudModelParams' ('cloud').")
@@ -1031,15 +1081,7 @@ PYBIND11_MODULE (_core, m)
                      [] (CloudModelParams& p, double v) { p.hierarchy.noise_stop = v; },
                      "Do not split a hierarchy node of at most n_noise_max (160) points whose extent is within\n"
                      "noise_stop noise standard deviations (BVHParams::noise_stop); default 0: off.")
-      .def_property ("split",
-                     [] (const CloudModelParams& p) {
-                       return std::string (p.hierarchy.split_style == BVHParams::SplitStyle::Octree ? "octree" : "pca");
-                     },
-                     [] (CloudModelParams& p, const std::string& v) {
-                       if (v != "pca" && v != "octree")
-                         throw py::value_error ("split: expected 'pca' or 'octree', got '" + v + "'");
-                       p.hierarchy.split_style = v == "octree" ? BVHParams::SplitStyle::Octree : BVHParams::SplitStyle::Pca;
-                     },
+      .def_property ("split", &splitName, &setSplit,
                      "Hierarchy split style, 'pca' (default) or 'octree' (pcd_collision's -split).")
       .def ("validate", &CloudModelParams::validate, "Raises ValueError naming the first member out of range.")
       .def ("__repr__", [] (const CloudModelParams& p) {
@@ -1049,7 +1091,11 @@ PYBIND11_MODULE (_core, m)
                ", sigma_max=" + num (p.hierarchy.sigma_max) + ", epsilon=" + num (p.hierarchy.epsilon) +
                ", k_sigma=" + num (p.hierarchy.k_sigma) + ", surface=" + (p.surface ? "True" : "False") +
                ", orientation=NormalOrientation." + enumName (p.orientation) +
-               ", closed_objects=" + (p.closed_objects ? "True" : "False") + ")";
+               ", closed_objects=" + (p.closed_objects ? "True" : "False") + ", threads=" + std::to_string (p.threads) +
+               ", noise_resolution=" + num (p.noise_resolution) + ", noise_resolution_gate='" +
+               CloudModelParams::resolutionGateName (p.noise_resolution_gate) + "', keep_full_resolution=" +
+               (p.keep_full_resolution ? "True" : "False") + ", noise_stop=" + num (p.hierarchy.noise_stop) +
+               ", split='" + splitName (p) + "')";
       });
 
   // --- CollisionRequest ---------------------------------------------------------------------------
@@ -1442,10 +1488,17 @@ PYBIND11_MODULE (_core, m)
   m.def ("between_samples_warning", &pcl_probcollision::io::betweenSamplesWarning, py::arg ("both_meshes"),
          py::arg ("free"), py::arg ("leaf_pairs_tested"), py::arg ("where"), py::arg ("spacing"),
          "pcd_collision's warning for a free answer between two meshes' samples (where: 'pose 3'); '' when none.");
-  m.def ("is_faceless_ply", [] (const std::filesystem::path& p) { return pcl_probcollision::io::isFacelessPly (p.string ()); },
-         py::arg ("path"), "True for a .ply whose header declares no face (pcd_collision reads it as a cloud).");
+  m.def ("is_faceless_ply",
+         [] (const std::filesystem::path& p) {
+           requireRegularFile (p);
+           return pcl_probcollision::io::isFacelessPly (p.string ());
+         },
+         py::arg ("path"),
+         "True for a .ply whose header declares no face (pcd_collision reads it as a cloud). FileNotFoundError or\n"
+         "IsADirectoryError for a path that is no file.");
   m.def ("read_mesh",
          [] (const std::filesystem::path& path) {
+           requireRegularFile (path);
            pcl_probcollision::io::TriangleMesh mesh;
            std::string error;
            if (!pcl_probcollision::io::loadTriangleMesh (path.string (), mesh, error))
@@ -1462,7 +1515,9 @@ PYBIND11_MODULE (_core, m)
                f (static_cast<py::ssize_t> (i), d) = mesh.triangles[i][static_cast<std::size_t> (d)];
            return py::make_tuple (V, F);
          },
-         py::arg ("path"), "A triangle mesh (.ply .obj .stl .vtk) as pcd_collision reads it: (vertices (V, 3), triangles (T, 3)).");
+         py::arg ("path"),
+         "A triangle mesh (.ply .obj .stl .vtk) as pcd_collision reads it: (vertices (V, 3), triangles (T, 3)).\n"
+         "FileNotFoundError or IsADirectoryError for a path that is no file; ValueError for a file that is no mesh.");
   m.def ("sample_mesh",
          [] (const py::object& vertices, const py::object& triangles, double spacing, std::uint64_t seed) {
            const auto mesh = meshOf (vertices, triangles);
@@ -1574,5 +1629,24 @@ PYBIND11_MODULE (_core, m)
          "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.\n\n"
          "Such a pose moves <a> into <b>'s frame (T_b_a); collide(a, b, T) and collide_batch take T_a_b, so pass\n"
          "invert_poses() of these to answer as pcd_collision does.");
-  m.def ("invert_poses", &invertPoses, py::arg ("poses"), "(M, 4, 4) rigid transforms -> their inverses (Eigen's).");
+  m.def ("check_poses",
+         [] (const py::object& obj) {
+           auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
+           if (!a)
+           {
+             PyErr_Clear ();
+             throw py::type_error ("poses: expected a numeric array of shape (M, 4, 4)");
+           }
+           if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
+             throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
+           const auto p = a.unchecked<3> ();
+           for (py::ssize_t k = 0; k < p.shape (0); ++k)
+             poseAt (p, k, true);
+         },
+         py::arg ("poses"),
+         "ValueError naming the first of (M, 4, 4) poses that collide() would refuse (not finite, not rigid within\n"
+         "its tolerance, beyond MAX_COORDINATE) or whose last row is not 0 0 0 1; None when all are good.");
+  m.def ("invert_poses", &invertPoses, py::arg ("poses"),
+         "(M, 4, 4) rigid transforms -> their inverses (Eigen's). ValueError naming the first that is not rigid\n"
+         "(the rotation's tolerance is collide()'s) or whose last row is not 0 0 0 1.");
 }

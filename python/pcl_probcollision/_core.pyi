@@ -73,9 +73,12 @@ class CloudModelParams:
     keep_full_resolution: bool
     threads: int  # in [0, MAX_THREADS] (0: one per hardware thread); ValueError outside, as pcd_collision -threads
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
-                 n_max: int = ..., n_min: int = ..., sigma_max: float = ..., epsilon: float = ...,
+                 n_max: int = ..., n_min: Optional[int] = None, sigma_max: float = ..., epsilon: float = ...,
                  k_sigma: float = ..., surface: bool = False,
-                 orientation: NormalOrientation = NormalOrientation.Auto, closed_objects: bool = False) -> None: ...
+                 orientation: NormalOrientation = NormalOrientation.Auto, closed_objects: bool = False,
+                 threads: int = 0, noise_resolution: float = 0.0, noise_resolution_gate: str = "cloud",
+                 keep_full_resolution: bool = True, noise_stop: float = 0.0, split: str = "pca") -> None: ...
+        # n_min None: min(8, n_max), as pcd_collision's -nmax sets it.
     def validate(self) -> None: ...
 
 class CollisionRequest:
@@ -134,6 +137,16 @@ class CollisionResult:
     @property
     def no_leaf_tested(self) -> bool: ...
     @property
+    def full_resolution(self) -> bool:
+        """True when the answer is the unmerged models' (CloudModelParams.keep_full_resolution)."""
+    @property
+    def sample_distance(self) -> bool:
+        """True when signed_distance is the distance between the two clouds' nearest samples (request.distance)."""
+    @property
+    def nearest_point_a(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def nearest_point_b(self) -> npt.NDArray[np.float64]: ...
+    @property
     def unobserved(self) -> bool:
         """True when the surface layer's answer rests on surface the samples do not show (a bridged hole or
         occlusion shadow, or space behind a scanned sheet); always False without request.surface."""
@@ -183,6 +196,8 @@ class CloudModel:
     def skipped_points(self) -> int: ...
     @property
     def merged_samples(self) -> int: ...
+    @property
+    def keeps_full_resolution(self) -> bool: ...
     @property
     def origin(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -273,4 +288,5 @@ def pcd_collision_json_lines(flags: Sequence[str], input_a: Dict[str, Any], inpu
     """pcd_collision's -json lines, by its own writer, for answers held as columns."""
 def read_poses(path: Union[str, os.PathLike]) -> npt.NDArray[np.float64]: ...
 def poses_from_xyzrpy(poses: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+def check_poses(poses: npt.ArrayLike) -> None: ...
 def invert_poses(poses: npt.ArrayLike) -> npt.NDArray[np.float64]: ...

@@ -110,7 +110,7 @@ def test_defaults_are_the_cpp_defaults():
                  "per_point: bool = False", "rho_min: float = 0.001", "seed: int = 1", "surface: bool = False"):
         assert text in doc, text
     doc = pc.CloudModelParams.__init__.__doc__
-    for text in ("k: int = 10", "n_max: int = 20", "n_min: int = 8", "sigma_max: float = 0.05", "epsilon: float = 0.02",
+    for text in ("k: int = 10", "n_max: int = 20", "n_min: Optional[int] = min(8, n_max)", "sigma_max: float = 0.05", "epsilon: float = 0.02",
                  "noise: pcl_probcollision._core.SensorNoiseModel = SensorNoiseModel.none()", "surface: bool = False",
                  "orientation: pcl_probcollision._core.NormalOrientation = <NormalOrientation.Auto: 0>",
                  "closed_objects: bool = False"):
@@ -984,3 +984,99 @@ def test_load_model_reads_a_faceless_ply_as_pcd_collision_does(tmp_path):
                     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
     with pytest.raises(ValueError, match="triangle.ply' is a mesh"):
         pc.load_model(mesh)
+
+
+def test_the_stub_names_what_the_module_has():
+    # _core.pyi lacked full_resolution, sample_distance, nearest_point_a/_b and
+    # keeps_full_resolution (a probe, 2026-12-03): every public name of the module and of each of
+    # its classes is in the stub, and the stub names nothing the module lacks.
+    import ast
+    core = pc._core
+    tree = ast.parse(pathlib.Path(pc.__file__).with_name("_core.pyi").read_text())
+
+    def names(body):
+        out = set()
+        for node in body:
+            if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+                out.add(node.name)
+            elif isinstance(node, ast.AnnAssign):
+                out.add(node.target.id)
+            elif isinstance(node, ast.Assign):
+                out |= {t.id for t in node.targets if isinstance(t, ast.Name)}
+        return out
+
+    top = names(tree.body) - {"_Pose"}
+    assert top == {n for n in dir(core) if not n.startswith("_")}
+    enum_members = {"name", "value"}  # the stub's enum.IntEnum has them
+    classes = [node for node in tree.body if isinstance(node, ast.ClassDef)]
+    assert len(classes) >= 8
+    for node in classes:
+        have = {n for n in dir(getattr(core, node.name)) if not n.startswith("_")}
+        stub = names(node.body) - {"__init__", "__len__"}
+        if any(isinstance(b, ast.Name) and b.id == "enum" or isinstance(b, ast.Attribute) for b in node.bases):
+            have -= enum_members
+        assert have == stub, (node.name, sorted(have - stub), sorted(stub - have))
+
+
+def test_missing_mesh_files_raise_file_not_found():
+    # read_mesh of a missing file raised ValueError and is_faceless_ply answered False (a probe,
+    # 2026-12-03): both now raise what open() would, as read_cloud and load_model do.
+    for f in (pc.read_mesh, pc._core.is_faceless_ply, pc.read_cloud):
+        with pytest.raises(FileNotFoundError):
+            f("/no/such/dir/mesh.ply")
+        with pytest.raises(IsADirectoryError):
+            f(DATA)
+
+
+def test_cloud_model_params_takes_every_member_as_a_keyword():
+    # CloudModelParams(split=..., threads=..., noise_resolution=...) raised TypeError, and
+    # n_max=5 failed validation with n_min left at 8 where pcd_collision's -nmax 5 works (a probe,
+    # 2026-12-03).
+    p = pc.CloudModelParams(threads=1, noise_resolution=2.0, noise_resolution_gate="spacing",
+                            keep_full_resolution=False, noise_stop=1.5, split="octree", n_max=5)
+    assert (p.threads, p.noise_resolution, p.noise_resolution_gate, p.keep_full_resolution, p.noise_stop, p.split) == \
+        (1, 2.0, "spacing", False, 1.5, "octree")
+    assert (p.n_max, p.n_min) == (5, 5)
+    p.validate()
+    assert pc.CloudModelParams(n_max=5, n_min=3).n_min == 3
+    assert pc.CloudModelParams().n_min == 8 and pc.CloudModelParams(n_max=40).n_min == 8
+    flags = pc._core.pcd_collision_params(["-nmax=5"])[0]
+    assert (flags.n_max, flags.n_min) == (5, 5)
+    # The repr holds every member and builds the same parameters back.
+    q = eval(repr(p), {"CloudModelParams": pc.CloudModelParams, "SensorNoiseModel": pc.SensorNoiseModel,
+                       "NormalOrientation": pc.NormalOrientation})
+    assert repr(q) == repr(p)
+    with pytest.raises(ValueError, match="split: expected 'pca' or 'octree', got 'kd'"):
+        pc.CloudModelParams(split="kd")
+    with pytest.raises(ValueError, match="noise_resolution_gate"):
+        pc.CloudModelParams(noise_resolution_gate="nowhere")
+    with pytest.raises(ValueError, match="threads"):
+        pc.CloudModelParams(threads=-1)
+
+
+def test_invert_poses_refuses_what_collide_refuses():
+    # invert_poses took a scaled matrix and returned its "inverse" by transposing the rotation
+    # (a probe, 2026-12-03): it now checks as collide() does, naming the pose.
+    good = np.eye(4)[None].repeat(2, axis=0)
+    good[1, :3, 3] = (1.0, 2.0, 3.0)
+    np.testing.assert_allclose(pc.invert_poses(good)[1, :3, 3], (-1.0, -2.0, -3.0))
+    scaled = good.copy()
+    scaled[1, :3, :3] *= 2.0
+    with pytest.raises(ValueError, match=r"poses\[1\] is not a rotation plus translation"):
+        pc.invert_poses(scaled)
+    reflected = good.copy()
+    reflected[0, 0, 0] = -1.0
+    with pytest.raises(ValueError, match="a reflection"):
+        pc.invert_poses(reflected)
+    row = good.copy()
+    row[0, 3, 0] = 1.0
+    with pytest.raises(ValueError, match=r"poses\[0\]: the last row"):
+        pc.invert_poses(row)
+
+
+def test_a_viewpoint_that_is_not_finite_is_refused():
+    # build_model(viewpoint=[inf, ...]) went on to a misleading message (a probe, 2026-12-03).
+    with pytest.raises(ValueError, match="viewpoint: value 1 is not finite"):
+        pc.build_model(GOOD, viewpoint=[np.inf, 0, 0, 1, 0, 0, 0])
+    with pytest.raises(ValueError, match="viewpoint: value 5 is not finite"):
+        pc.build_model(GOOD, viewpoint=[0, 0, 0, 1, np.nan, 0, 0])

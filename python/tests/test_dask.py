@@ -183,6 +183,12 @@ def test_options_are_pcd_collision_flags():
         pcd.collide_poses(patch(), patch(), np.zeros((3, 5)))
     with pytest.raises(ValueError, match="last row"):
         pcd.collide_poses(patch(), patch(), np.zeros((2, 4, 4)))
+    # A pose collide() refuses is refused here, naming it as the caller passed it, not by a
+    # worker as "pose T_a_b" (a probe, 2026-12-03).
+    scaled = np.eye(4)[None].repeat(3, axis=0)
+    scaled[2, :3, :3] *= 1.5
+    with pytest.raises(ValueError, match=r"^pose poses\[2\] is not a rotation plus translation \(R\^T R departs"):
+        pcd.collide_poses(patch(), patch(), scaled)
     with pytest.raises(FileNotFoundError):
         pcd.collide_poses("/nonexistent/a.pcd", patch(), np.zeros((1, 6)))
     with pytest.raises(ValueError, match="thresholds|free_below|collision_above"):

@@ -518,18 +518,17 @@ class BatchResults:
 
 
 def as_pose_matrices(poses) -> np.ndarray:
-    """(M, 4, 4) or (M, 6) (pcd_collision's -pose rows) -> (M, 4, 4) float64 T_b_a."""
+    """(M, 4, 4) or (M, 6) (pcd_collision's -pose rows) -> (M, 4, 4) float64 T_b_a. ValueError naming
+    the first pose collide() would refuse, here rather than on a worker (core.check_poses)."""
     P = np.asarray(poses, dtype=np.float64)
     if P.ndim == 1 and P.shape == (6,):
         P = P[None, :]
     if P.ndim == 2 and P.shape[1] == 6:
-        return core.poses_from_xyzrpy(P)
-    if P.ndim == 3 and P.shape[1:] == (4, 4):
-        bad = np.flatnonzero(~((P[:, 3, :3] == 0).all(axis=1) & (P[:, 3, 3] == 1)))
-        if bad.size:
-            raise ValueError(f"poses[{bad[0]}]: the last row of a 4x4 pose must be [0, 0, 0, 1]")
-        return np.ascontiguousarray(P)
-    raise ValueError(f"poses: expected shape (M, 4, 4) or (M, 6), got {P.shape}")
+        P = core.poses_from_xyzrpy(P)
+    elif not (P.ndim == 3 and P.shape[1:] == (4, 4)):
+        raise ValueError(f"poses: expected shape (M, 4, 4) or (M, 6), got {P.shape}")
+    core.check_poses(P)
+    return np.ascontiguousarray(P)
 
 
 def connect(scheduler: str, timeout: float = 10.0):
