@@ -259,6 +259,12 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
       // by their order: other orders or a missing one write past it (found by fuzzing).
       if (element == "vertex" && list)
         return fail (number, "a list property in the vertex element ('" + name + "') is not read");
+      // PCL's reader takes a face's vertex indices as int or uint only: others (uchar, short,
+      // ...) left every face out without a word, and the mesh read "no triangles".
+      if (element == "face" && list && (name == "vertex_indices" || name == "vertex_index") &&
+          w[3] != "int" && w[3] != "uint" && w[3] != "int32" && w[3] != "uint32")
+        return fail (number, "the face list '" + name + "' has " + w[3] +
+                               " indices; PCL's PLY reader reads int or uint indices only");
       if (element == "vertex")
         for (const std::string prefix : {"", "diffuse_"})
           for (const char* c : {"red", "green", "blue", "alpha"})

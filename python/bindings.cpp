@@ -1593,14 +1593,18 @@ PYBIND11_MODULE (_core, m)
          "pcd_collision's usage error for these arguments (its argv without the program's name), in its words;\n"
          "empty when its parser accepts them. The Dask command line judges pcd_collision's flags with it.");
   m.def ("pcd_collision_input_usage_error",
-         [] (const std::vector<std::string>& flags, bool mesh_a, bool mesh_b) {
-           return pcd_collision::inputKindsUsageError (optionsOfFlags (flags), mesh_a, mesh_b);
+         [] (const std::vector<std::string>& flags, bool mesh_a, bool mesh_b, const std::string& name_a,
+             const std::string& name_b) {
+           pcd_collision::Options o = optionsOfFlags (flags);
+           o.input_a = name_a;
+           o.input_b = name_b;
+           return pcd_collision::inputKindsUsageError (o, mesh_a, mesh_b);
          },
-         py::arg ("flags"), py::arg ("mesh_a"), py::arg ("mesh_b"),
+         py::arg ("flags"), py::arg ("mesh_a"), py::arg ("mesh_b"), py::arg ("name_a") = "a.pcd", py::arg ("name_b") = "b.pcd",
          "pcd_collision's usage error for flags that need an input of a kind the inputs are not (its\n"
-         "inputKindsUsageError: -mesh_density with two clouds), once their kinds are known (mesh_a, mesh_b:\n"
-         "whether <a>, <b> is a mesh); empty when there is none. ValueError with its usage error for flags its\n"
-         "parser refuses.");
+         "inputKindsUsageError: -mesh_density with two clouds, -sigma_a or -sensor_a for a mesh), once their\n"
+         "kinds are known (mesh_a, mesh_b: whether <a>, <b> is a mesh; name_a, name_b: how the message names\n"
+         "them); empty when there is none. ValueError with its usage error for flags its parser refuses.");
   m.def ("pcd_collision_params",
          [] (const std::vector<std::string>& flags) {
            const pcd_collision::Options o = optionsOfFlags (flags);

@@ -626,14 +626,10 @@ parseCommandLine (const std::vector<std::string>& args)
   // sigmas, which only an isotropic input uses.
   o.sensor_a = sensor_a.value_or (sensor.value_or (Defaults::sensor));
   o.sensor_b = sensor_b.value_or (sensor.value_or (Defaults::sensor));
-  // A mesh is sampled exactly, with a zero covariance: a noise model or sigma named for it alone
-  // would be ignored (-sensor and -sigma, for both inputs, apply to the clouds among them).
-  for (const auto& [input, path, given_sigma, given_sensor] :
-       {std::tuple ("a", o.input_a, sigma_a.has_value (), sensor_a.has_value ()),
-        std::tuple ("b", o.input_b, sigma_b.has_value (), sensor_b.has_value ())})
-    if ((given_sigma || given_sensor) && inputKindOf (path) == InputKind::Mesh)
-      return usage (std::string ("option -") + (given_sigma ? "sigma_" : "sensor_") + input + ": <" + input + "> '" +
-                    path + "' is a mesh, sampled exactly with no sensor noise; the option applies to a cloud");
+  // Whether an input is a mesh is known only from its contents (a .ply without faces is a cloud):
+  // inputKindsUsageError judges these.
+  o.noise_option_a = sigma_a ? "-sigma_a" : sensor_a ? "-sensor_a" : "";
+  o.noise_option_b = sigma_b ? "-sigma_b" : sensor_b ? "-sensor_b" : "";
   const std::string iso = "isotropic";
   if (sigma && (o.sensor_a != iso || o.sensor_b != iso))
     return usage ("option -sigma needs the isotropic model for both inputs (got " + o.sensor_a + " for <a>, " +
@@ -661,6 +657,13 @@ inputKindsUsageError (const Options& o, bool mesh_a, bool mesh_b)
   if (o.mesh_spacing && !mesh_a && !mesh_b)
     return "option -mesh_density: neither input is a mesh (both are point clouds; a .ply without faces is one), and "
            "it sets a mesh's sample spacing only: it would change nothing";
+  // A mesh is sampled exactly, with a zero covariance: a noise model or sigma named for it alone
+  // would be ignored (-sensor and -sigma, for both inputs, apply to the clouds among them).
+  for (const auto& [input, path, option, mesh] : {std::tuple ("a", o.input_a, o.noise_option_a, mesh_a),
+                                                  std::tuple ("b", o.input_b, o.noise_option_b, mesh_b)})
+    if (mesh && !option.empty ())
+      return "option " + option + ": <" + input + "> '" + path +
+             "' is a mesh, sampled exactly with no sensor noise; the option applies to a cloud";
   return {};
 }
 

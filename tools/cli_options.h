@@ -91,6 +91,9 @@ struct Options
     * one each. Only meaningful when that input's sensor is "isotropic". */
   double sigma_a = Defaults::sigma;
   double sigma_b = Defaults::sigma;
+  /** \brief The option that set one input's noise alone ("-sigma_a" or "-sensor_a", likewise for
+    * b), empty when none did: refused for a mesh once the kinds are known (inputKindsUsageError). */
+  std::string noise_option_a, noise_option_b;
   int k = Defaults::k;
 
   double free_below = Defaults::free_below;
@@ -176,7 +179,8 @@ pcl_probcollision::CloudModelParams modelParamsFor (const Options& o, bool input
 
 /** \brief The usage error of options that ask for an input of a kind the inputs turn out not to
   * be, or "" when none: -mesh_density sets a mesh's sample spacing, so with two clouds it would
-  * change nothing. Asked once the inputs' kinds are known (a .ply is a mesh, or a cloud when its
+  * change nothing; -sigma_a, -sensor_a (or _b) set one input's noise, which a mesh, sampled
+  * exactly, does not have. Asked once the inputs' kinds are known (a .ply is a mesh, or a cloud when its
   * header declares no face: isFacelessPly), by pcd_collision before it loads them and by the Dask
   * layer (Python's pcd_collision_input_usage_error), so both refuse the same inputs. */
 std::string inputKindsUsageError (const Options& o, bool mesh_a, bool mesh_b);

@@ -1102,6 +1102,27 @@ TEST_F (PcdCollisionTool, AsciiPlyValueThatIsNotANumber)
                                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n");
   expectFailure ({(dir_ / "face_short.ply").string (), kScene.string ()}, 1, "face_short.ply' line 13: 3 values, too few",
                  {dir_ / "face_short.ply"});
+  // A face list whose indices PCL's reader does not take (uchar, ushort, short, char): it read "no
+  // triangles" (a probe, 2026-12-03); now the header line and the type are named. int and uint read.
+  for (const char* type : {"uchar", "ushort", "short", "char", "int8", "uint16"})
+  {
+    const std::string name = std::string ("face_") + type + ".ply";
+    writeFile (dir_ / name, "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "element face 1\nproperty list uchar " +
+                                type + " vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    expectFailure ({(dir_ / name).string (), kScene.string ()}, 1,
+                   name + "' is not a readable PLY file (header line 8: the face list 'vertex_indices' has " + type +
+                     " indices; PCL's PLY reader reads int or uint indices only)",
+                   {dir_ / name});
+  }
+  for (const char* type : {"int", "uint"})
+  {
+    const std::string name = std::string ("face_") + type + ".ply";
+    writeFile (dir_ / name, "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "element face 1\nproperty list uchar " +
+                                type + " vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    const auto v = runJson ({(dir_ / name).string (), kScene.string (), "-pose", "0,0,10,0,0,0"});
+    ASSERT_EQ (v.size (), 1u) << name;
+    EXPECT_EQ (v[0]["verdict"].text, "free") << name;
+  }
   // nan, inf, exponents, signs, CR line ends and colours are read; a NaN point is skipped and counted as
   // before, in ascii and in binary (whose values are not text: unchanged).
   writeFile (dir_ / "fine.ply", "ply\nformat ascii 1.0\nelement vertex 4\n" + xyz +
@@ -1146,6 +1167,13 @@ TEST_F (PcdCollisionTool, OptionsThatWouldChangeNothingAreUsageErrors)
   const ToolRun gated = run ({kGripper.string (), kScene.string (), "-noise_resolution", "2", "-noise_resolution_gate",
                               "everywhere", "-pose", "0,0,1,0,0,0"});
   EXPECT_EQ (gated.status, 0) << gated.err;
+  // -sigma_a / -sensor_a go by the input's contents too: a .ply without faces is a cloud and takes
+  // them (it was refused as "is a mesh" by its extension, a probe of 2026-12-03); a mesh does not.
+  const ToolRun sheet_sigma = run ({sheet, kScene.string (), "-sigma_a", "0.002", "-pose", "0,0,1,0,0,0", "-json"});
+  EXPECT_EQ (sheet_sigma.status, 0) << sheet_sigma.err;
+  EXPECT_NE (sheet_sigma.out.find ("\"sigma_a\":0.002"), std::string::npos) << sheet_sigma.out;
+  expectFailure ({kGripper.string (), kScene.string (), "-sensor_a", "kinect"}, 2,
+                 "option -sensor_a: <a> '" + kGripper.string () + "' is a mesh, sampled exactly with no sensor noise");
 }
 
 // Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass

@@ -261,21 +261,13 @@ def prepare_input(x, name: Optional[str] = None, normals: bool = False) -> Dict[
     raise TypeError(f"expected a file path, an (N, 3) numpy array or an Open3D PointCloud, got {type(x).__name__}")
 
 
-def check_mesh_noise(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, Any]) -> None:
-    """pcd_collision's rule: a mesh is sampled exactly, so a noise model or sigma given to it alone
-    would be ignored (sensor and sigma, for both inputs, apply to the clouds among them): ValueError."""
-    for side, spec in (("a", a), ("b", b)):
-        for flag in ("sigma_" + side, "sensor_" + side):
-            if spec["kind"] == "mesh" and options.get(flag) is not None:
-                raise ValueError(f"option {flag}: <{side}> '{spec['path'] or spec['name']}' is a mesh, sampled exactly "
-                                 f"with no sensor noise; the option applies to a cloud")
-
-
 def check_input_kinds(a: Dict[str, Any], b: Dict[str, Any], options: Dict[str, Any]) -> None:
-    """pcd_collision's rule for options that need a mesh among the inputs (its own
-    inputKindsUsageError: mesh_density with two clouds would change nothing): ValueError, the
-    option named without its dash as resolve_options names it."""
-    error = core.pcd_collision_input_usage_error(_as_flags(options), a["kind"] == "mesh", b["kind"] == "mesh")
+    """pcd_collision's rules for options that need an input of some kind (its own
+    inputKindsUsageError: mesh_density with two clouds would change nothing; sigma_a, sensor_a
+    (or _b) for a mesh, sampled exactly, would be ignored): ValueError, the option named without
+    its dash as resolve_options names it."""
+    error = core.pcd_collision_input_usage_error(_as_flags(options), a["kind"] == "mesh", b["kind"] == "mesh",
+                                                 a["path"] or a["name"], b["path"] or b["name"])
     if error:
         raise ValueError(re.sub(r"(?<![\w'])-(?=[a-z])", "", error))
 
@@ -590,7 +582,6 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     T = as_pose_matrices(poses)
     stored = o["surface"] and not o["ignore_normals"]
     A, B = prepare_input(a, "a", stored), prepare_input(b, "b", stored)
-    check_mesh_noise(A, B, options)
     check_input_kinds(A, B, options)
     # pcd_collision's warnings about the inputs (units, noise, rounding to float), in its order.
     facts = (input_facts(A, o, "a"), input_facts(B, o, "b"))

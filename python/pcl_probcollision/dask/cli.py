@@ -13,7 +13,7 @@ import warnings
 import numpy as np
 
 from .. import _core as core
-from . import _MESH_EXTENSIONS, _SWITCHES, _VALUES, InputWarning, check_input_kinds, check_mesh_noise, collide_poses, connect, prepare_input, resolve_options
+from . import _MESH_EXTENSIONS, _SWITCHES, _VALUES, InputWarning, check_input_kinds, collide_poses, connect, prepare_input, resolve_options
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
@@ -231,7 +231,6 @@ def main(argv):
             a = prepare_input(path_a, "input", stored)
             b = prepare_input(path_b, "target", stored)
             try:  # a noise model given to a mesh, a mesh's spacing to two clouds: usage errors, before the scheduler
-                check_mesh_noise(a, b, options)
                 check_input_kinds(a, b, options)
             except ValueError as e:
                 raise Usage(_as_flag_message(str(e))) from None
