@@ -5,16 +5,22 @@
 #   scripts/demo-picture.sh [--out=FILE] [--tool=PATH]   (PATH: build/tools/pcd_collision unset)
 # Prints both answers; ctest's demo_picture_script checks them and the PNG.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-out=docs/images/demo_pose2.png
-tool=build/tools/pcd_collision
+usage="usage: scripts/demo-picture.sh [--out=FILE] [--tool=PATH]"
+# A relative --out or --tool is the caller's: made absolute before the script moves to the root.
+absolute() { case "$1" in /*) echo "$1" ;; *) echo "$PWD/$1" ;; esac; }
+out=""
+tool=""
 for a in "$@"; do
   case "$a" in
-    --out=*) out="${a#--out=}" ;;
-    --tool=*) tool="${a#--tool=}" ;;
-    *) echo "usage: scripts/demo-picture.sh [--out=FILE] [--tool=PATH]" >&2; exit 2 ;;
+    --out=?*) out=$(absolute "${a#--out=}") ;;
+    --tool=?*) tool=$(absolute "${a#--tool=}") ;;
+    -h|--help) echo "$usage"; exit 0 ;;
+    *) echo "$usage" >&2; exit 2 ;;
   esac
 done
+cd "$(dirname "$0")/.."
+out=${out:-docs/images/demo_pose2.png}
+tool=${tool:-build/tools/pcd_collision}
 [ -x "$tool" ] || { echo "demo-picture.sh: $tool: no such executable (build it: cmake --build build)" >&2; exit 2; }
 command -v gnuplot > /dev/null || { echo "demo-picture.sh: gnuplot not found (scripts/install-deps.sh)" >&2; exit 2; }
 

@@ -49,8 +49,12 @@ def brier(points, gamma):
 
 
 def main(dirs):
-    if not dirs:
-        sys.exit("usage: fit-surface-calibration.py RUN_DIR... (each holding a queries.csv)")
+    if dirs in (["-h"], ["--help"]):
+        print(__doc__)
+        return
+    if not dirs or any(d.startswith("-") for d in dirs):
+        print("usage: fit-surface-calibration.py RUN_DIR... (each holding a queries.csv)", file=sys.stderr)
+        sys.exit(2)
     rows = []
     for d in dirs:
         path = d.rstrip("/") + "/queries.csv"

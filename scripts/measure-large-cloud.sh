@@ -9,9 +9,22 @@
 # and 2 cm into it.
 # Usage: bash scripts/measure-large-cloud.sh [path/to/pcd_collision] [work dir]
 set -euo pipefail
+usage="usage: bash scripts/measure-large-cloud.sh [path/to/pcd_collision] [work dir]"
+case "${1:-}" in
+  -h|--help) echo "$usage"; exit 0 ;;
+  -*) echo "$usage" >&2; exit 2 ;;
+esac
+[ $# -le 2 ] || { echo "$usage" >&2; exit 2; }
+# Relative paths are the caller's: made absolute before the script moves to the root.
+absolute() { case "$1" in /*) echo "$1" ;; *) echo "$PWD/$1" ;; esac; }
+exe=${1:+$(absolute "$1")}
+work=${2:+$(absolute "$2")}
 cd "$(dirname "$0")/.."
-exe=${1:-build/tools/pcd_collision}
-work=${2:-build/large-cloud}
+exe=${exe:-build/tools/pcd_collision}
+work=${work:-build/large-cloud}
+[ -x "$exe" ] || { echo "measure-large-cloud.sh: $exe: no such executable (cmake --build build)" >&2; exit 2; }
+command -v /usr/bin/time > /dev/null && [ -x /usr/bin/time ] ||
+  { echo "measure-large-cloud.sh: /usr/bin/time not found (Debian package time)" >&2; exit 2; }
 mkdir -p "$work"
 cloud="$work/floor_5M.pcd"
 

@@ -31,10 +31,7 @@ import sys
 
 import numpy as np
 
-try:
-    import pcl_probcollision as pc
-except ImportError as e:  # the module is built into build/python
-    sys.exit(f"probe-face-contact: cannot import pcl_probcollision ({e}); set PYTHONPATH=build/python")
+pc = None  # pcl_probcollision, imported by main() once its arguments are read (--help needs no build)
 
 
 def box_samples(n, size, rng):
@@ -49,14 +46,32 @@ def box_samples(n, size, rng):
     return pts * size
 
 
+def at_least(low):
+    """An argparse type: an integer at least `low` (--seed -1 reached numpy as a traceback)."""
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not an integer") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{text} must be at least {low}")
+        return value
+    return parse
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--noise", default="0.0025,0.005,0.01,0.02",
                     help="comma-separated noise sigmas in m (default 0.0025,0.005,0.01,0.02)")
-    ap.add_argument("--points", type=int, default=2000, help="samples on the cube (default 2000; the slab gets 8x)")
-    ap.add_argument("--rescans", type=int, default=6, help="re-scans per gap (default 6)")
-    ap.add_argument("--seed", type=int, default=1, help="first seed (default 1)")
+    ap.add_argument("--points", type=at_least(1), default=2000, help="samples on the cube (default 2000; the slab gets 8x)")
+    ap.add_argument("--rescans", type=at_least(1), default=6, help="re-scans per gap (default 6)")
+    ap.add_argument("--seed", type=at_least(0), default=1, help="first seed (default 1; numpy takes no negative seed)")
     args = ap.parse_args()
+    global pc
+    try:
+        import pcl_probcollision as pc
+    except ImportError as e:  # the module is built into build/python
+        sys.exit(f"probe-face-contact: cannot import pcl_probcollision ({e}); set PYTHONPATH=build/python")
     try:
         sigmas = [float(s) for s in args.noise.split(",")]
     except ValueError:

@@ -77,6 +77,9 @@ def main():
     ap.add_argument("--chunk-size", type=int, default=None)
     args = ap.parse_args()
     exe = pathlib.Path(args.build) / "python" / "pcl_probcollision_bench_batch"
+    if not os.access(exe, os.X_OK):
+        sys.exit(f"bench_python.py: {exe}: no such executable (cmake --build {args.build} --target "
+                 f"pcl_probcollision_bench_batch)")
     meshes = pathlib.Path(args.shared) / "meshes"
 
     V, F = pc.read_mesh(meshes / "piano_room_rob.obj")

@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: BSD-3-Clause
+"""The scripts' command lines (a probe, 2026-12-03): --help prints the usage and exits 0, a bad
+argument exits 2 naming it (no traceback), and a relative output path is the caller's."""
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCRIPTS = ROOT / "scripts"
+
+
+def run(args, cwd=None):
+    return subprocess.run(args, capture_output=True, text=True, cwd=cwd, timeout=120)
+
+
+@pytest.mark.parametrize("script", ["fit-surface-calibration.py", "probe-face-contact.py", "locate-contact.py"])
+def test_python_scripts_help(script):
+    r = run([sys.executable, str(SCRIPTS / script), "--help"])
+    assert r.returncode == 0, r.stderr
+    assert "usage" in (r.stdout + r.stderr).lower() or "Fit the surface layer" in r.stdout
+
+
+@pytest.mark.parametrize("args, words", [
+    (["probe-face-contact.py", "--seed", "-1"], "argument --seed: -1 must be at least 0"),
+    (["probe-face-contact.py", "--points", "abc"], "argument --points: 'abc' is not an integer"),
+    (["locate-contact.py", "--robot-mesh", "a", "--env-mesh", "b", "--nearest", "-3"], "argument --nearest: -3 must be at least 1"),
+    (["locate-contact.py", "--robot-mesh", "a", "--env-mesh", "b", "--band", "0"], "argument --band: 0 must be above 0.0"),
+    (["fit-surface-calibration.py"], "usage: fit-surface-calibration.py RUN_DIR..."),
+    (["fit-surface-calibration.py", "--bogus"], "usage: fit-surface-calibration.py RUN_DIR..."),
+])
+def test_python_scripts_refuse_bad_arguments(args, words):
+    r = run([sys.executable, str(SCRIPTS / args[0])] + args[1:])
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    assert words in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("script", ["demo-picture.sh", "measure-large-cloud.sh"])
+def test_shell_scripts_help_and_bad_arguments(script):
+    helped = run(["bash", str(SCRIPTS / script), "--help"])
+    assert helped.returncode == 0 and helped.stdout.startswith("usage:"), helped.stderr
+    refused = run(["bash", str(SCRIPTS / script), "--bogus"])
+    assert refused.returncode == 2 and refused.stderr.startswith("usage:"), refused.stderr
+
+
+def test_demo_picture_writes_a_relative_out_where_it_is_called(tmp_path):
+    tool = os.environ.get("PCL_PROBCOLLISION_PCD_COLLISION")
+    assert tool, "PCL_PROBCOLLISION_PCD_COLLISION (set by ctest) names the built pcd_collision"
+    r = run(["bash", str(SCRIPTS / "demo-picture.sh"), "--out=pose2.png", f"--tool={tool}"], cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "pose2.png").stat().st_size > 1000
+    assert not (ROOT / "pose2.png").exists()
