@@ -130,6 +130,10 @@ def locate(args):
         fail(f"--band: {args.band} must be finite and > 0")
     if args.samples < 1:
         fail(f"--samples: {args.samples} must be >= 1")
+    if args.nearest < 1:  # -3 was taken (a probe, 2026-12-03)
+        fail(f"--nearest: {args.nearest} must be >= 1")
+    if args.seed < 0:
+        fail(f"--seed: {args.seed} must be >= 0")
     if (args.pose is None) == (args.poses is None):
         fail("give the pose as --pose tx,ty,tz,roll,pitch,yaw or as --poses FILE --query N")
     if args.poses is not None and args.query is None:
@@ -209,20 +213,6 @@ def print_text(report):
                   f"{normal}")
 
 
-def at_least(kind, low, above=False):
-    """An argparse type: a number of `kind` at least `low` (above it with above=True); argparse
-    names the option and exits 2 otherwise (--nearest -3 was taken before)."""
-    def parse(text):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"'{text}' is not {'an integer' if kind is int else 'a number'}") from None
-        if not (value > low if above else value >= low) or value != value:
-            raise argparse.ArgumentTypeError(f"{text} must be {'above' if above else 'at least'} {low}")
-        return value
-    return parse
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robot-mesh", required=True, help="the moving object's mesh (input A)")
@@ -232,11 +222,10 @@ def main():
     parser.add_argument("--query", type=int, help="the query whose pose --poses holds")
     parser.add_argument("--env-cloud", help="the fixed object's cloud (PCD/PLY): its samples nearest the contact")
     parser.add_argument("--robot-cloud", help="the moving object's cloud, unposed")
-    parser.add_argument("--band", type=at_least(float, 0.0, above=True), default=2.0,
-                        help="contact within this distance (data units; 2)")
-    parser.add_argument("--samples", type=at_least(int, 1), default=400000, help="surface samples of the moving mesh (400000)")
-    parser.add_argument("--nearest", type=at_least(int, 1), default=8, help="cloud samples listed (8)")
-    parser.add_argument("--seed", type=at_least(int, 0), default=1, help="seed of the surface samples (1)")
+    parser.add_argument("--band", type=float, default=2.0, help="contact within this distance (data units; 2)")
+    parser.add_argument("--samples", type=int, default=400000, help="surface samples of the moving mesh (400000)")
+    parser.add_argument("--nearest", type=int, default=8, help="cloud samples listed (8)")
+    parser.add_argument("--seed", type=int, default=1, help="seed of the surface samples (1)")
     parser.add_argument("--json", action="store_true", help="one JSON object on stdout instead of text")
     args = parser.parse_args()
     report = locate(args)
