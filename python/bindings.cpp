@@ -727,9 +727,10 @@ posesFromXyzRpy (const py::object& obj)
   return out;
 }
 
-/** (M, 4, 4) rigid transforms -> their inverses, as Eigen::Isometry3d::inverse() computes them. */
-py::array_t<double>
-invertPoses (const py::object& obj)
+/** An (M, 4, 4) array of poses: TypeError for what is no numeric array, ValueError naming the shape
+  * of one that is not (M, 4, 4). */
+py::array_t<double, py::array::forcecast>
+poseArray (const py::object& obj)
 {
   auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
   if (!a)
@@ -739,6 +740,14 @@ invertPoses (const py::object& obj)
   }
   if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
     throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
+  return a;
+}
+
+/** (M, 4, 4) rigid transforms -> their inverses, as Eigen::Isometry3d::inverse() computes them. */
+py::array_t<double>
+invertPoses (const py::object& obj)
+{
+  const auto a = poseArray (obj);
   const auto p = a.unchecked<3> ();
   py::array_t<double> out ({a.shape (0), static_cast<py::ssize_t> (4), static_cast<py::ssize_t> (4)});
   auto o = out.mutable_unchecked<3> ();
@@ -1635,14 +1644,7 @@ PYBIND11_MODULE (_core, m)
          "invert_poses() of these to answer as pcd_collision does.");
   m.def ("check_poses",
          [] (const py::object& obj) {
-           auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
-           if (!a)
-           {
-             PyErr_Clear ();
-             throw py::type_error ("poses: expected a numeric array of shape (M, 4, 4)");
-           }
-           if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
-             throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
+           const auto a = poseArray (obj);
            const auto p = a.unchecked<3> ();
            for (py::ssize_t k = 0; k < p.shape (0); ++k)
              poseAt (p, k, true);
