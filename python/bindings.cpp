@@ -527,13 +527,20 @@ enumName (E value)
   return py::cast (value).attr ("name").template cast<std::string> ();
 }
 
-const char*
+/** The factory call that builds n, for the reprs: isotropic with its sigma (which it gives at any
+  * point), so that a repr builds the same model back. */
+std::string
 noiseFactory (const SensorNoiseModel& n)
 {
   switch (n.type ())
   {
     case SensorNoiseModel::Type::None: return "none()";
-    case SensorNoiseModel::Type::Isotropic: return "isotropic(...)";
+    case SensorNoiseModel::Type::Isotropic:
+    {
+      double axial = 0.0, lateral = 0.0;
+      n.sigmas (Eigen::Vector3d::Zero (), Eigen::Vector3d::Zero (), SensorPose (), axial, lateral);
+      return "isotropic(" + num (axial) + ")";
+    }
     case SensorNoiseModel::Type::Anisotropic: return "anisotropic(...)";
     case SensorNoiseModel::Type::KinectV1: return "kinect()";
     case SensorNoiseModel::Type::Stereo: return "stereo()";

@@ -1033,7 +1033,8 @@ def test_cloud_model_params_takes_every_member_as_a_keyword():
     # n_max=5 failed validation with n_min left at 8 where pcd_collision's -nmax 5 works (a probe,
     # 2026-12-03).
     p = pc.CloudModelParams(threads=1, noise_resolution=2.0, noise_resolution_gate="spacing",
-                            keep_full_resolution=False, noise_stop=1.5, split="octree", n_max=5)
+                            keep_full_resolution=False, noise_stop=1.5, split="octree", n_max=5,
+                            noise=pc.SensorNoiseModel.isotropic(0.0031))
     assert (p.threads, p.noise_resolution, p.noise_resolution_gate, p.keep_full_resolution, p.noise_stop, p.split) == \
         (1, 2.0, "spacing", False, 1.5, "octree")
     assert (p.n_max, p.n_min) == (5, 5)
@@ -1046,6 +1047,8 @@ def test_cloud_model_params_takes_every_member_as_a_keyword():
     q = eval(repr(p), {"CloudModelParams": pc.CloudModelParams, "SensorNoiseModel": pc.SensorNoiseModel,
                        "NormalOrientation": pc.NormalOrientation})
     assert repr(q) == repr(p)
+    assert "noise=SensorNoiseModel.isotropic(0.0031)" in repr(p)  # it read isotropic(...)
+    assert repr(pc.SensorNoiseModel.isotropic(0.25)) == "SensorNoiseModel.isotropic(0.25)"
     with pytest.raises(ValueError, match="split: expected 'pca' or 'octree', got 'kd'"):
         pc.CloudModelParams(split="kd")
     with pytest.raises(ValueError, match="noise_resolution_gate"):
