@@ -423,6 +423,12 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
   for (const CloudModel* m : {&a, &b})
     if (!m->warning ().empty ())
       result.message += (result.message.empty () ? "" : "; ") + m->warning ();
+  // The surface layer asked for where a model has none: the separators answered (answered_by),
+  // and the message says why, as a model's warning does.
+  if (request.surface && !surface)
+    result.message += std::string (result.message.empty () ? "" : "; ") + "request.surface: model " +
+                      (a.surface ().empty () ? "a" : "b") +
+                      " was built without a surface model (CloudModelParams::surface), so the separators answered";
   return true;
 }
 } // namespace

@@ -182,6 +182,17 @@ TEST (ProbabilisticCollision, ASurfaceRequestBuildsTheSurfaceModelsOnce)
   ASSERT_TRUE (collide (*buildCloudModel (*a, params), *buildCloudModel (*b, params), pose.inverse (), request, direct));
   EXPECT_EQ (surface.probability, direct.probability);
   EXPECT_EQ (surface.signed_distance, direct.signed_distance);
+  EXPECT_EQ (direct.message, "");
+  // Asked of a model built without its surface, the separators answer, and the message says so
+  // (it said nothing: only answered_by told).
+  CloudModelParams plain_params = params;
+  plain_params.surface = false;
+  CollisionResult fallback;
+  ASSERT_TRUE (collide (*buildCloudModel (*a, params), *buildCloudModel (*b, plain_params), pose.inverse (), request, fallback));
+  EXPECT_EQ (fallback.answered_by, AnsweredBy::Separators);
+  EXPECT_EQ (fallback.probability, plain.probability);
+  EXPECT_EQ (fallback.message,
+             "request.surface: model b was built without a surface model (CloudModelParams::surface), so the separators answered");
 
   request.surface = false;
   pc.setRequest (request);

@@ -73,7 +73,8 @@ struct CollisionRequest
     * each object's points against the other's oriented surface (a local signed distance near
     * contact, a winding-number inside test when out of reach) and fill signed_distance. Needs
     * both models built with CloudModelParams::surface (ProbabilisticCollision builds them so when
-    * its request asks); otherwise the separators answer, and CollisionResult::answered_by says so.
+    * its request asks); otherwise the separators answer, CollisionResult::answered_by says so and
+    * CollisionResult::message says why.
     * Default off: on the evaluation's noisy piano-in-room clouds, whose normals are oriented by
     * propagation, it is not yet as accurate as the separators (docs/RESULTS.md, issue #16). */
   bool surface = false;
