@@ -7,7 +7,8 @@
 //
 // Usage: gripper_filter [SCAN.pcd] [OUTPUT.pcd] [DEPTH]
 //   SCAN    default ../shared/data/scans/table_scene_mug_stereo_textured.pcd
-//   OUTPUT  default gripper_contacts.pcd (written atomically: temporary file, then rename)
+//   OUTPUT  default gripper_contacts.pcd (written atomically: a new temporary file beside it, then
+//           a rename)
 //   DEPTH   how far the fingertips go below the table surface, metres (default 0.01)
 //
 // The gripper is the one of data/gripper.obj (palm 12 x 3 x 2 cm, two 1 x 2 x 6 cm fingers 10 cm
@@ -32,6 +33,10 @@
 #include <filesystem>
 #include <string>
 #include <system_error>
+#include <vector>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 using PointT = pcl::PointXYZRGB;
 using Cloud = pcl::PointCloud<PointT>;
@@ -106,16 +111,28 @@ outputProblem (const std::string& out, const std::string& scan)
   return "";
 }
 
+/** \brief Writes the cloud to a temporary file beside `path`, then renames it over `path`. The
+  * temporary file gets a fresh name (mkstemp: `.NAME.tmp-XXXXXX`), never an existing file's: a
+  * fixed `path + ".tmp"` overwrote, and then renamed away, a scan called OUTPUT.tmp. */
 bool
 saveAtomically (const std::string& path, const Cloud& cloud)
 {
-  const std::string tmp = path + ".tmp";
-  if (pcl::io::savePCDFileBinary (tmp, cloud) != 0)
-  {
-    std::remove (tmp.c_str ());
+  namespace fs = std::filesystem;
+  const fs::path target (path);
+  const fs::path dir = target.has_parent_path () ? target.parent_path () : fs::path (".");
+  const std::string pattern = (dir / ("." + target.filename ().string () + ".tmp-XXXXXX")).string ();
+  std::vector<char> name (pattern.begin (), pattern.end ());
+  name.push_back ('\0');
+  const int fd = ::mkstemp (name.data ());
+  if (fd < 0)
     return false;
-  }
-  if (std::rename (tmp.c_str (), path.c_str ()) != 0)
+  // mkstemp creates the file 0600; the output gets the usual 0666 & ~umask.
+  const mode_t mask = ::umask (0);
+  ::umask (mask);
+  ::fchmod (fd, 0666 & ~mask);
+  ::close (fd);
+  const std::string tmp (name.data ());
+  if (pcl::io::savePCDFileBinary (tmp, cloud) != 0 || std::rename (tmp.c_str (), path.c_str ()) != 0)
   {
     std::remove (tmp.c_str ());
     return false;

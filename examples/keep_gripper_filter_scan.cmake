@@ -1,0 +1,35 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# The example writes OUTPUT through a temporary file beside it: a scan whose name is the one a
+# fixed temporary name would take (OUTPUT.tmp, the name used before 2026-12-04) survives the run
+# byte-identical, OUTPUT is written, and no temporary file is left behind. The scan is a copy made
+# here (of data/table_mug.pcd, which the example answers in under a second).
+# cmake -DEXE=... -DSCAN=... -DWORK=DIR -P keep_gripper_filter_scan.cmake
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+set(out "${WORK}/contacts.pcd")
+set(scan "${out}.tmp")
+file(COPY_FILE "${SCAN}" "${scan}")
+file(SHA256 "${scan}" before)
+execute_process(COMMAND "${EXE}" "${scan}" "${out}" RESULT_VARIABLE rc OUTPUT_VARIABLE stdout ERROR_VARIABLE stderr)
+message(STATUS "${stdout}${stderr}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "gripper_filter exited with ${rc}")
+endif()
+if(NOT EXISTS "${scan}")
+  message(FATAL_ERROR "the scan ${scan} is gone: the output's temporary file took its name")
+endif()
+file(SHA256 "${scan}" after)
+if(NOT before STREQUAL after)
+  message(FATAL_ERROR "the scan ${scan} was overwritten")
+endif()
+if(NOT EXISTS "${out}")
+  message(FATAL_ERROR "gripper_filter wrote no ${out}")
+endif()
+file(STRINGS "${out}" points REGEX "^POINTS [0-9]+$" LIMIT_COUNT 1)
+if(NOT points MATCHES "^POINTS [1-9]")
+  message(FATAL_ERROR "${out} has no points ('${points}')")
+endif()
+file(GLOB left "${WORK}/.contacts.pcd.tmp-*")
+if(left)
+  message(FATAL_ERROR "temporary file(s) left behind: ${left}")
+endif()
