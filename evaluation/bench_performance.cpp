@@ -27,6 +27,7 @@
 // BENCH_PERFORMANCE_NOISE sets the noise in % of the piano's diagonal (default 0.5; issue #17's
 // targets at 2 and 4 %), the octomap's resolution following it (2 sigma).
 #include "baselines.h"
+#include "eval_options.h"
 #include "ground_truth.h"
 #include "metrics.h"
 #include "workloads.h"
@@ -81,12 +82,9 @@ noisePercent ()
   const char* env = std::getenv ("BENCH_PERFORMANCE_NOISE");
   if (!env || !*env)
     return 0.5;
-  char* end = nullptr;
-  const double pct = std::strtod (env, &end);
-  if (*end != '\0' || !std::isfinite (pct) || !(pct > 0.0))
-    throw std::invalid_argument (std::string ("BENCH_PERFORMANCE_NOISE: expected a noise > 0 in % of the diagonal, got '") +
-                                 env + "'");
-  return pct;
+  // Read as the evaluation reads its options (eval_options.h): " 0.5" and hex floats, which strtod
+  // took, are refused too.
+  return pcl_probcollision_eval::options::number ("BENCH_PERFORMANCE_NOISE (% of the diagonal)", env, 0.0, true);
 }
 
 /** \brief The two meshes and the noise level (all a build benchmark needs). */

@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # The driver: every method on every workload, CSV out (scripts/evaluate.sh renders the charts).
 add_executable(evaluate_collision evaluate_collision.cpp workloads.cpp scenes.cpp fit_scenes.cpp)
-# pcd_collision_cli: the command-line tool's number parsing (one reader of a number on a command line).
+# pcd_collision_cli: the command-line tool's number parsing (one reader of a number on a command line),
+# under eval_options.h, the evaluation tools' option readers (evaluate_collision, dump_primitive,
+# bench_performance).
 target_link_libraries(evaluate_collision PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io pcd_collision_cli
   pcl_probcollision pcl_io FLANN::FLANN)
 target_compile_options(evaluate_collision PRIVATE -Wall -Wextra)
@@ -17,7 +19,7 @@ find_package(benchmark QUIET)
 if(benchmark_FOUND)
   add_executable(bench_performance bench_performance.cpp workloads.cpp)
   target_link_libraries(bench_performance PRIVATE eval_ground_truth eval_metrics pcl_probcollision_io
-    pcl_probcollision benchmark::benchmark)
+    pcd_collision_cli pcl_probcollision benchmark::benchmark)
   target_compile_options(bench_performance PRIVATE -Wall -Wextra)
   target_compile_definitions(bench_performance PRIVATE
     PCL_PROBCOLLISION_SHARED_DATA="${PCL_PROBCOLLISION_SHARED_DATA}")
@@ -36,10 +38,17 @@ if(BUILD_TESTING)
   add_test(NAME eval.EvaluateCollisionChecksItsOptions
     COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:evaluate_collision> -DDATA=${PCL_PROBCOLLISION_SHARED_DATA}
       -DWORK=${CMAKE_CURRENT_BINARY_DIR}/check_options -P ${CMAKE_CURRENT_SOURCE_DIR}/check_options.cmake)
+  # Every case is refused at once or fails reading an empty --data: a value taken by mistake
+  # would start a full run instead, which the timeout ends.
+  set_tests_properties(eval.EvaluateCollisionChecksItsOptions PROPERTIES TIMEOUT 120)
   add_test(NAME eval.DumpPrimitiveRefusesABadSeed
     COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test --seed 5x sphere_sphere/0s)
   set_tests_properties(eval.DumpPrimitiveRefusesABadSeed PROPERTIES PASS_REGULAR_EXPRESSION
-    "--seed '5x' is not a whole number")
+    "option --seed: '5x' is not a whole number")
+  # Exit statuses and messages: --help 0 with the usage (it was 2), a bad value 2 naming it.
+  add_test(NAME eval.DumpPrimitiveChecksItsOptions
+    COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:dump_primitive> -DWORK=${CMAKE_CURRENT_BINARY_DIR}/check_dump_options
+      -P ${CMAKE_CURRENT_SOURCE_DIR}/check_dump_options.cmake)
   add_test(NAME eval.DumpPrimitiveRefusesAnUnknownName
     COMMAND dump_primitive --out ${CMAKE_CURRENT_BINARY_DIR}/dump_primitive_test no_such_scenario)
   set_tests_properties(eval.DumpPrimitiveRefusesAnUnknownName PROPERTIES PASS_REGULAR_EXPRESSION

@@ -9,24 +9,25 @@
 // Every query whose name ("<scenario>/<gap in sigma>s", e.g. sphere_box_dense/-4s) starts with
 // PREFIX is written to DIR/<scenario>_<gap>_robot.pcd and _env.pcd; a line per query gives its
 // point counts, exact signed distance and the pcd_collision command that answers it.
+#include "eval_options.h"
 #include "primitives.h"
-
-#include <cli_options.h>
 
 #include <pcl/io/pcd_io.h>
 
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 
 namespace
 {
+const char* const kUsage = "usage: dump_primitive --out DIR [--seed N] [--scale S] [--quick] PREFIX";
+
 int
-usage (const char* message)
+usage (const std::string& message)
 {
-  std::fprintf (stderr, "dump_primitive: %s\nusage: dump_primitive --out DIR [--seed N] [--scale S] [--quick] PREFIX\n",
-                message);
+  std::fprintf (stderr, "dump_primitive: %s\n%s\n", message.c_str (), kUsage);
   return 2;
 }
 } // namespace
@@ -34,34 +35,47 @@ usage (const char* message)
 int
 main (int argc, char** argv)
 {
+  namespace opt = pcl_probcollision_eval::options;
   std::string out, prefix;
   unsigned long long seed = 1;
   double scale = 1.0;
   bool quick = false;
-  for (int i = 1; i < argc; ++i)
+  // The values are read by the evaluation's option readers (eval_options.h), as evaluate_collision
+  // reads its own; a refusal exits 2 naming the option and the value, --help prints the usage
+  // and exits 0 (it was "unknown or incomplete argument '--help'", exit 2, before 2026-12-04).
+  try
   {
-    const std::string a = argv[i];
-    const bool has_value = i + 1 < argc;
-    if (a == "--out" && has_value)
-      out = argv[++i];
-    else if (a == "--seed" && has_value)
+    for (int i = 1; i < argc; ++i)
     {
-      std::uint64_t v = 0;
-      if (!pcd_collision::parseUint64 (argv[++i], v))
-        return usage (("--seed '" + std::string (argv[i]) + "' is not a whole number").c_str ());
-      seed = v;
+      const std::string a = argv[i];
+      const std::string name = "option " + a;
+      auto value = [&] () -> std::string {
+        if (i + 1 >= argc)
+          throw std::invalid_argument (name + " needs a value");
+        return argv[++i];
+      };
+      if (a == "--help" || a == "-h")
+      {
+        std::printf ("%s\n", kUsage);
+        return 0;
+      }
+      if (a == "--out")
+        out = value ();
+      else if (a == "--seed")
+        seed = opt::wholeNumber (name, value ());
+      else if (a == "--scale")
+        scale = opt::number (name, value (), 0.0, true);
+      else if (a == "--quick")
+        quick = true;
+      else if (!a.empty () && a[0] != '-' && prefix.empty ())
+        prefix = a;
+      else
+        throw std::invalid_argument ("unknown argument '" + a + "'");
     }
-    else if (a == "--scale" && has_value)
-    {
-      if (!pcd_collision::parseDouble (argv[++i], scale) || !(scale > 0.0))
-        return usage (("--scale '" + std::string (argv[i]) + "' is not a number above 0").c_str ());
-    }
-    else if (a == "--quick")
-      quick = true;
-    else if (!a.empty () && a[0] != '-' && prefix.empty ())
-      prefix = a;
-    else
-      return usage (("unknown or incomplete argument '" + a + "'").c_str ());
+  }
+  catch (const std::invalid_argument& e)
+  {
+    return usage (e.what ());
   }
   if (out.empty () || prefix.empty ())
     return usage ("--out and PREFIX are required");

@@ -28,8 +28,10 @@
 //                      [--stop C,C,...] [--cap N,N,...] [--only SETTING,...] [--drop F,...] [--workloads W,...]
 //
 // Counts are whole numbers, --noise values above 0, --merge/--gate/--cloud-merge/--stop/--cap
-// values at least 0, --drop below 100, --only names of settings the run has, and DIR lies outside
-// --data; anything else exits 2 naming the option, before any work. --help prints the usage.
+// values at least 0, --drop below 100, --only names of settings the run has, a list has no empty
+// item, and DIR lies outside --data (evaluation/eval_options.h reads the values); anything else
+// exits 2 naming the option, before any work. --help prints the usage and exits 0. A failure while
+// running exits 1, a finished run whose W3 answers differ from SCENES.md 3.
 // --workloads W2 (or W1, W3, or a list) runs only those workloads: a study of one of them.
 // --surface-calibrated passes the surface layer's P through its calibration maps
 // (CollisionRequest::surface_calibrated, off by default). --fit-scene runs W1's pipeline on a
@@ -47,9 +49,8 @@
 #include "mesh_sampling.h"
 #include "metrics.h"
 #include "primitives.h"
+#include "eval_options.h"
 #include "workloads.h"
-
-#include <cli_options.h>
 
 #include <pcl_probcollision/collision_request.h>
 
@@ -1440,56 +1441,11 @@ writeOutputs (const Options& o, const Results& results)
   printTargets (targets);
 }
 
-/** \brief The items of a comma-separated option value. */
-std::vector<std::string>
-list (const std::string& value)
-{
-  std::vector<std::string> items;
-  std::stringstream in (value);
-  std::string item;
-  while (std::getline (in, item, ','))
-    items.push_back (item);
-  return items;
-}
-
 const char* const kUsage =
   "usage: evaluate_collision --out DIR --data DIR [--quick] [--seed N] [--poses N] [--sigma-poses N]"
   " [--rescans N] [--rescan-poses N] [--ours-only] [--surface-calibrated] [--fit-scene] [--dump] [--noise P,P,...]"
   " [--merge C,C,...] [--gate C,C,...] [--cloud-merge C,C,...] [--stop C,C,...] [--cap N,N,...]"
   " [--only SETTING,...] [--drop F,...] [--workloads W,...]";
-
-/** \brief An option's whole-number value (decimal digits only: "5x", "2.5" and "-1" are refused,
-  * not truncated or wrapped), read as the command-line tool reads them (tools/cli_options.h). */
-std::uint64_t
-count (const std::string& option, const std::string& text, std::uint64_t max = std::numeric_limits<std::uint64_t>::max ())
-{
-  std::uint64_t v = 0;
-  if (!pcd_collision::parseUint64 (text, v) || v > max)
-    throw std::invalid_argument ("option " + option + ": '" + text + "' is not a whole number from 0 to " + std::to_string (max));
-  return v;
-}
-
-/** \brief An option's comma-separated finite numbers, each at least `min` (strictly above it when
-  * `above`), naming the option and the value that is not. */
-std::vector<double>
-numbers (const std::string& option, const std::string& text, double min, bool above)
-{
-  std::vector<double> out;
-  for (const std::string& item : list (text))
-  {
-    double v = 0.0;
-    if (!pcd_collision::parseDouble (item, v))
-      throw std::invalid_argument ("option " + option + ": '" + item + "' is not a finite number");
-    if (above ? !(v > min) : !(v >= min))
-    {
-      std::ostringstream what;
-      what << "option " << option << ": " << item << " must be " << (above ? "above " : "at least ") << min;
-      throw std::invalid_argument (what.str ());
-    }
-    out.push_back (v);
-  }
-  return out;
-}
 
 /** \brief The values > 0 (a 0 in --merge, --gate, --cloud-merge, --stop or --cap leaves those settings out). */
 std::vector<double>
@@ -1522,13 +1478,15 @@ checkOutputDirectory (const Options& o)
 Options
 parse (int argc, char** argv)
 {
+  namespace opt = pcl_probcollision_eval::options;
   Options o;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
+    const std::string name = "option " + a;  // what a refusal names
     auto value = [&] () -> std::string {
       if (i + 1 >= argc)
-        throw std::invalid_argument ("option " + a + " needs a value");
+        throw std::invalid_argument (name + " needs a value");
       return argv[++i];
     };
     if (a == "--help" || a == "-h")
@@ -1540,15 +1498,15 @@ parse (int argc, char** argv)
     else if (a == "--quick")
       o.quick = true;
     else if (a == "--seed")
-      o.seed = count (a, value ());
+      o.seed = opt::wholeNumber (name, value ());
     else if (a == "--poses")
-      o.poses = count (a, value ());
+      o.poses = opt::wholeNumber (name, value ());
     else if (a == "--sigma-poses")
-      o.sigma_poses = count (a, value ());
+      o.sigma_poses = opt::wholeNumber (name, value ());
     else if (a == "--rescans")
-      o.rescans = static_cast<int> (count (a, value (), 1000));
+      o.rescans = static_cast<int> (opt::wholeNumber (name, value (), 1000));
     else if (a == "--rescan-poses")
-      o.rescan_poses = count (a, value ());
+      o.rescan_poses = opt::wholeNumber (name, value ());
     else if (a == "--ours-only")
       o.ours_only = true;
     else if (a == "--surface-calibrated")
@@ -1558,36 +1516,36 @@ parse (int argc, char** argv)
     else if (a == "--dump")
       o.dump = true;
     else if (a == "--noise")
-      o.noise = numbers (a, value (), 0.0, true);
+      o.noise = opt::numbers (name, value (), 0.0, true);
     else if (a == "--merge")
-      o.merge = positive (numbers (a, value (), 0.0, false));
+      o.merge = positive (opt::numbers (name, value (), 0.0, false));
     else if (a == "--gate")
-      o.gate = positive (numbers (a, value (), 0.0, false));
+      o.gate = positive (opt::numbers (name, value (), 0.0, false));
     else if (a == "--cloud-merge")
-      o.cloud_merge = positive (numbers (a, value (), 0.0, false));
+      o.cloud_merge = positive (opt::numbers (name, value (), 0.0, false));
     else if (a == "--stop")
-      o.stop = positive (numbers (a, value (), 0.0, false));
+      o.stop = positive (opt::numbers (name, value (), 0.0, false));
     else if (a == "--cap")
-      o.cap = positive (numbers (a, value (), 0.0, false));
+      o.cap = positive (opt::numbers (name, value (), 0.0, false));
     else if (a == "--drop")
     {
-      o.drop = numbers (a, value (), 0.0, false);
+      o.drop = opt::numbers (name, value (), 0.0, false);
       for (const double f : o.drop)
         if (!(f < 100.0))
         {
           std::ostringstream what;
-          what << "option --drop: " << f << " % leaves no sample (below 100)";
+          what << name << ": " << f << " % leaves no sample (below 100)";
           throw std::invalid_argument (what.str ());
         }
     }
     else if (a == "--only")
-      o.only = list (value ());
+      o.only = opt::items (name, value ());
     else if (a == "--workloads")
     {
-      o.workloads = list (value ());
+      o.workloads = opt::items (name, value ());
       for (const std::string& w : o.workloads)
         if (w != "W1" && w != "W2" && w != "W3")
-          throw std::invalid_argument ("--workloads: unknown workload '" + w + "' (W1, W2 or W3)");
+          throw std::invalid_argument (name + ": unknown workload '" + w + "' (W1, W2 or W3)");
     }
     else
       throw std::invalid_argument ("unknown option " + a + " (" + kUsage + ")");
@@ -1615,7 +1573,7 @@ parse (int argc, char** argv)
         std::string names;
         for (const std::string& k : known)
           names += (names.empty () ? "" : ", ") + k;
-        throw std::invalid_argument ("--only: unknown setting '" + name + "' (this run's: " + names + ")");
+        throw std::invalid_argument ("option --only: unknown setting '" + name + "' (this run's: " + names + ")");
       }
   }
   return o;
@@ -1625,14 +1583,25 @@ parse (int argc, char** argv)
 int
 main (int argc, char** argv)
 {
+  // A command line it cannot run is a usage error (2); a failure while running, e.g. an input it
+  // cannot read, is 1 (it was 2 as well before 2026-12-04); 3: the run finished and W3 missed.
+  Options o;
   try
   {
-    const Options o = parse (argc, argv);
-    if (o.help)
-    {
-      std::cout << kUsage << "\n(docs/RESULTS.md says what each option does)" << std::endl;
-      return 0;
-    }
+    o = parse (argc, argv);
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "evaluate_collision: " << e.what () << std::endl;
+    return 2;
+  }
+  if (o.help)
+  {
+    std::cout << kUsage << "\n(docs/RESULTS.md says what each option does)" << std::endl;
+    return 0;
+  }
+  try
+  {
     std::filesystem::create_directories (o.out_dir);  // before hours of work, not after
     const auto start = Clock::now ();
     Results results;
@@ -1657,6 +1626,6 @@ main (int argc, char** argv)
   catch (const std::exception& e)
   {
     std::cerr << "evaluate_collision: " << e.what () << std::endl;
-    return 2;
+    return 1;
   }
 }
