@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -259,12 +260,22 @@ checkPlyHeader (const std::string& path, std::string& error, PlyCounts* counts)
       // by their order: other orders or a missing one write past it (found by fuzzing).
       if (element == "vertex" && list)
         return fail (number, "a list property in the vertex element ('" + name + "') is not read");
-      // PCL's reader takes a face's vertex indices as int or uint only: others (uchar, short,
-      // ...) left every face out without a word, and the mesh read "no triangles".
-      if (element == "face" && list && (name == "vertex_indices" || name == "vertex_index") &&
-          w[3] != "int" && w[3] != "uint" && w[3] != "int32" && w[3] != "uint32")
-        return fail (number, "the face list '" + name + "' has " + w[3] +
-                               " indices; PCL's PLY reader reads int or uint indices only");
+      // PCL's reader takes a face's vertex indices as int or uint only, and their count as uchar,
+      // int or uint: other indices (uchar, short, ...) and ushort counts left every face out
+      // without a word (the mesh read "no triangles"), char and short counts failed as
+      // "malformed or truncated".
+      if (element == "face" && list && (name == "vertex_indices" || name == "vertex_index"))
+      {
+        const auto one_of = [] (const std::string& type, std::initializer_list<const char*> types) {
+          return std::find (types.begin (), types.end (), type) != types.end ();
+        };
+        if (!one_of (w[3], {"int", "uint", "int32", "uint32"}))
+          return fail (number, "the face list '" + name + "' has " + w[3] +
+                                 " indices; PCL's PLY reader reads int or uint indices only");
+        if (!one_of (w[2], {"uchar", "uint8", "int", "int32", "uint", "uint32"}))
+          return fail (number, "the face list '" + name + "' has " + w[2] +
+                                 " counts; PCL's PLY reader reads uchar, int or uint counts only");
+      }
       if (element == "vertex")
         for (const std::string prefix : {"", "diffuse_"})
           for (const char* c : {"red", "green", "blue", "alpha"})
