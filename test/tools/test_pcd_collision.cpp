@@ -1219,6 +1219,67 @@ TEST_F (PcdCollisionTool, PlyFaceListTypesPclDoesNotReadAreRefusedInAsciiAndBina
   }
 }
 
+// A PLY whose header lines end in CRLF (a probe of 2026-12-03 reported it refused as "truncated or
+// corrupt"; not reproduced): PCL's reader and the header and value checks take it, ascii and
+// binary, cloud and mesh, and the answer is the one of the same file with LF line ends.
+TEST_F (PcdCollisionTool, PlyWithCrlfHeaderLinesReadsAsWithLf)
+{
+  const auto ply = [] (const std::string& format, bool mesh, const std::string& eol) {
+    std::vector<std::string> header = {"ply", "format " + format + " 1.0", "comment exported", "element vertex 100",
+                                       "property float x", "property float y", "property float z"};
+    if (mesh)
+      header.insert (header.end (), {"element face 2", "property list uchar int vertex_indices"});
+    header.push_back ("end_header");
+    std::string text;
+    for (const std::string& line : header)
+      text += line + eol;
+    std::ostringstream ascii;
+    for (int i = 0; i < 100; ++i)
+    {
+      const float p[3] = {-0.05f + 0.01f * static_cast<float> (i % 10), -0.05f + 0.01f * static_cast<float> (i / 10), 0.004f};
+      if (format == "ascii")
+        ascii << p[0] << ' ' << p[1] << ' ' << p[2] << eol;
+      else
+        text.append (reinterpret_cast<const char*> (p), sizeof p);
+    }
+    if (mesh && format == "ascii")
+      ascii << "3 0 9 90" << eol << "4 9 99 90 0" << eol;
+    text += ascii.str ();
+    if (mesh && format != "ascii")
+      for (const std::vector<int>& face : {std::vector<int>{0, 9, 90}, std::vector<int>{9, 99, 90, 0}})
+      {
+        text.push_back (static_cast<char> (face.size ()));
+        for (const int i : face)
+          text.append (reinterpret_cast<const char*> (&i), sizeof i);
+      }
+    return text;
+  };
+  for (const std::string format : {"ascii", "binary_little_endian"})
+    for (const bool mesh : {false, true})
+    {
+      std::vector<Value> answers;
+      for (const std::string eol : {"\n", "\r\n"})
+      {
+        const std::string name = std::string (mesh ? "mesh_" : "cloud_") + format + (eol == "\n" ? "_lf" : "_crlf") + ".ply";
+        writeFile (dir_ / name, ply (format, mesh, eol));
+        const auto v = runJson ({(dir_ / name).string (), kScene.string (), "-pose", "0,0,0,0,0,0"});
+        ASSERT_EQ (v.size (), 1u) << name;
+        EXPECT_EQ (v[0]["inputs"]["a"]["kind"].text, mesh ? "mesh" : "cloud") << name;
+        if (mesh)
+          EXPECT_EQ (v[0]["inputs"]["a"]["triangles"].number, 3.0) << name;
+        else
+          EXPECT_EQ (v[0]["inputs"]["a"]["finite"].number, 100.0) << name;
+        answers.push_back (v[0]);
+      }
+      const std::string what = std::string (mesh ? "mesh, " : "cloud, ") + format;
+      EXPECT_EQ (answers[0]["verdict"].text, answers[1]["verdict"].text) << what;
+      EXPECT_EQ (answers[0]["probability"].number, answers[1]["probability"].number) << what;
+      EXPECT_EQ (answers[0]["points_a"].number, answers[1]["points_a"].number) << what;
+      EXPECT_EQ (answers[0]["leaf_pairs"].number, answers[1]["leaf_pairs"].number) << what;
+      EXPECT_GT (answers[0]["leaf_pairs"].number, 0.0) << what << ": the answer should rest on a fit";
+    }
+}
+
 // Options that changed nothing were accepted (a probe, 2026-12-03): -mesh_density with two clouds
 // (it sets a mesh's sample spacing) and -noise_resolution_gate without -noise_resolution. Both are
 // usage errors now, naming the option and why, found before any input is loaded; a .ply without
