@@ -426,10 +426,24 @@ checkPlyValues (const std::string& path, const PlyCounts& layout, std::string& e
 bool
 isFacelessPly (const std::string& path)
 {
-  PlyCounts counts;
+  bool faceless = false;
   std::string unused;
   // An unreadable header is left to the mesh loader, which reports it (the same check, the same words).
-  return isPly (path) && checkPlyHeader (path, unused, &counts) && counts.vertices > 0 && counts.faces == 0;
+  return plyKind (path, faceless, unused) && faceless;
+}
+
+bool
+plyKind (const std::string& path, bool& faceless, std::string& error)
+{
+  faceless = false;
+  if (!isPly (path))
+    return true;
+  error = unreadableFile (path);
+  PlyCounts counts;
+  if (!error.empty () || !checkPlyHeader (path, error, &counts))
+    return false;
+  faceless = counts.vertices > 0 && counts.faces == 0;
+  return true;
 }
 
 namespace

@@ -99,5 +99,13 @@ bool checkPlyValues (const std::string& path, const PlyCounts& layout, std::stri
   * loadCloud reads. A PLY with faces is a mesh; an unreadable one is left to the mesh loader,
   * which reports it. Reads the header only. */
 bool isFacelessPly (const std::string& path);
+
+/** \brief isFacelessPly for a caller that must know the kind before loading: true with faceless
+  * set when the file is not a .ply (faceless false: its extension says its kind) or its header
+  * was read, false with the loaders' reason naming the file (unreadableFile, checkPlyHeader) when
+  * a .ply cannot be read or its header is malformed, whose kind nothing tells. pcd_collision
+  * asks it before judging options by the inputs' kinds: a missing or malformed .ply was called
+  * "a mesh" by its extension. */
+bool plyKind (const std::string& path, bool& faceless, std::string& error);
 } // namespace io
 } // namespace pcl_probcollision

@@ -42,7 +42,6 @@ namespace
 namespace fs = std::filesystem;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 // The file formats around the library (io/).
-using pcl_probcollision::io::isFacelessPly;
 using pcl_probcollision::io::loadCloud;
 using pcl_probcollision::io::loadCloudWithNormals;
 using pcl_probcollision::io::loadTriangleMesh;
@@ -508,10 +507,19 @@ run (int argc, char** argv)
   b.path = o.input_b;
   b.kind = inputKindOf (b.path);
   // A .ply whose header declares no face is a cloud: the kinds are known before the (slow)
-  // loading, and so is an option that needs a mesh among the inputs.
+  // loading, and so is an option that needs a mesh among the inputs. A .ply whose header cannot
+  // be read has no kind to judge options by: it is reported as its loader would (exit 1), not
+  // called a mesh by its name.
   for (Input* in : {&a, &b})
-    if (in->kind == InputKind::Mesh && isFacelessPly (in->path))
-      in->kind = InputKind::Cloud;
+    if (in->kind == InputKind::Mesh)
+    {
+      bool faceless = false;
+      std::string error;
+      if (!pcl_probcollision::io::plyKind (in->path, faceless, error))
+        throw Failure{kRuntimeFailure, error};
+      if (faceless)
+        in->kind = InputKind::Cloud;
+    }
   if (const std::string why = inputKindsUsageError (o, a.kind == InputKind::Mesh, b.kind == InputKind::Mesh); !why.empty ())
     throw Failure{kUsageError, why};
   const bool with_normals = o.surface && !o.ignore_normals;

@@ -1313,6 +1313,17 @@ TEST_F (PcdCollisionTool, OptionsThatWouldChangeNothingAreUsageErrors)
   EXPECT_NE (sheet_sigma.out.find ("\"sigma_a\":0.002"), std::string::npos) << sheet_sigma.out;
   expectFailure ({kGripper.string (), kScene.string (), "-sensor_a", "kinect"}, 2,
                  "option -sensor_a: <a> '" + kGripper.string () + "' is a mesh, sampled exactly with no sensor noise");
+  // A .ply whose header cannot be read has no kind: it is reported as the loader reports it (exit
+  // 1), not called "a mesh" by its extension (a probe, 2026-12-04: a missing sheet.ply with
+  // -sigma_a read "option -sigma_a: <a> 'missing.ply' is a mesh").
+  const std::string missing = (dir_ / "missing.ply").string ();
+  expectFailure ({missing, kScene.string (), "-sigma_a", "0.002"}, 1, "cannot read '" + missing + "': No such file or directory");
+  expectFailure ({kScene.string (), missing, "-sensor_b", "kinect"}, 1, "cannot read '" + missing + "': No such file or directory");
+  const std::string malformed = (dir_ / "malformed.ply").string ();
+  writeFile (malformed, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                        "bogus line\nend_header\n0 0 0\n0.01 0 0\n0 0.01 0\n");
+  expectFailure ({malformed, kScene.string (), "-sigma_a", "0.002"}, 1,
+                 "'" + malformed + "' is not a readable PLY file (header line 7: unknown keyword 'bogus')", {malformed});
 }
 
 // Two meshes are sampled exactly: a part narrower than the spacing through a thin wall can pass
