@@ -1005,8 +1005,9 @@ PYBIND11_MODULE (_core, m)
               p.orientation = orientation;
               p.closed_objects = closed_objects;
               p.hierarchy.n_max = n_max;
-              // As pcd_collision's -nmax: n_min follows a smaller n_max unless given.
-              p.hierarchy.n_min = n_min ? *n_min : std::min (p.hierarchy.n_min, n_max);
+              // As pcd_collision's -nmax (BVHParams::nMinFor, the one rule): n_min follows a smaller
+              // n_max unless given.
+              p.hierarchy.n_min = n_min ? *n_min : BVHParams::nMinFor (n_max);
               p.hierarchy.sigma_max = sigma_max;
               p.hierarchy.epsilon = epsilon;
               p.hierarchy.k_sigma = k_sigma;
@@ -1084,9 +1085,13 @@ PYBIND11_MODULE (_core, m)
                      "one per hardware thread. The model is the same for any count. ValueError outside that range,\n"
                      "as pcd_collision refuses -threads.")
       .def_property ("n_max", [] (const CloudModelParams& p) { return p.hierarchy.n_max; },
-                     [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; })
+                     [] (CloudModelParams& p, int v) { p.hierarchy.n_max = v; },
+                     "A hierarchy node with more points is split (>= 1; default 20). Setting it leaves n_min as it is:\n"
+                     "below n_min, set n_min too (validate() and build_model say so); the constructor's n_max sets\n"
+                     "n_min to min(8, n_max) unless given, as pcd_collision's -nmax.")
       .def_property ("n_min", [] (const CloudModelParams& p) { return p.hierarchy.n_min; },
-                     [] (CloudModelParams& p, int v) { p.hierarchy.n_min = v; })
+                     [] (CloudModelParams& p, int v) { p.hierarchy.n_min = v; },
+                     "A hierarchy node of at most n_min points is never split (1 <= n_min <= n_max; default 8).")
       .def_property ("sigma_max", [] (const CloudModelParams& p) { return p.hierarchy.sigma_max; },
                      [] (CloudModelParams& p, double v) { p.hierarchy.sigma_max = v; })
       .def_property ("epsilon", [] (const CloudModelParams& p) { return p.hierarchy.epsilon; },

@@ -29,7 +29,10 @@ BVHParams::validate () const
   if (n_min < 1 || n_min > n_max)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::BVHParams::validate] n_min "
-                             << n_min << " outside [1, n_max = " << n_max << "]");
+                             << n_min << " outside [1, n_max = " << n_max << "]"
+                             << (n_min > n_max && n_max >= 1 ? ": set n_min too when lowering n_max (pcd_collision's -nmax N "
+                                                               "sets it to min(8, N))"
+                                                             : ""));
   if (!(sigma_max >= 0.0) || !std::isfinite (sigma_max))
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::BVHParams::validate] sigma_max "

@@ -123,6 +123,25 @@ TEST (BVHParams, DefaultsMatchMethod)
   EXPECT_TRUE (p != q);
 }
 
+// n_min for an n_max given alone: min(8, n_max), the one rule of pcd_collision's -nmax and
+// Python's CloudModelParams(n_max=N) (each kept its own copy of it).
+TEST (BVHParams, NMinForAnNMaxGivenAlone)
+{
+  EXPECT_EQ (BVHParams::nMinFor (5), 5);
+  EXPECT_EQ (BVHParams::nMinFor (1), 1);
+  EXPECT_EQ (BVHParams::nMinFor (8), 8);
+  EXPECT_EQ (BVHParams::nMinFor (40), 8);
+  const BVHParams defaults;
+  EXPECT_EQ (BVHParams::nMinFor (defaults.n_max), defaults.n_min);
+  for (const int n_max : {1, 3, 7, 8, 9, 20, 1000})
+  {
+    BVHParams p;
+    p.n_max = n_max;
+    p.n_min = BVHParams::nMinFor (n_max);
+    EXPECT_NO_THROW (p.validate ()) << "n_max " << n_max;
+  }
+}
+
 TEST (BVHParams, ValidateRejectsEachParameterByName)
 {
   auto message = [] (const BVHParams& p) -> std::string {
@@ -145,6 +164,12 @@ TEST (BVHParams, ValidateRejectsEachParameterByName)
   p = BVHParams ();
   p.n_min = 0;
   EXPECT_NE (message (p).find ("n_min 0"), std::string::npos);
+  // An n_max lowered below the default n_min alone (Python's params.n_max = 5): the message says
+  // what to do, not only that n_min 8 is out of range.
+  p = BVHParams ();
+  p.n_max = 5;
+  EXPECT_NE (message (p).find ("n_min 8 outside [1, n_max = 5]: set n_min too when lowering n_max"), std::string::npos)
+      << message (p);
   p = BVHParams ();
   p.sigma_max = -0.1;
   EXPECT_NE (message (p).find ("sigma_max -0.1"), std::string::npos);

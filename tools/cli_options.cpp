@@ -318,7 +318,7 @@ modelParamsFor (const Options& o, bool input)
                                                 : pcl_probcollision::BVHParams::SplitStyle::Pca;
   m.hierarchy.n_max = o.n_max;
   m.hierarchy.noise_stop = o.noise_stop;
-  m.hierarchy.n_min = std::min (Defaults::n_min, o.n_max);
+  m.hierarchy.n_min = pcl_probcollision::BVHParams::nMinFor (o.n_max);  // the library's rule
   m.hierarchy.sigma_max = o.sigma_max;
   m.hierarchy.epsilon = o.epsilon;
   m.threads = o.threads;

@@ -31,9 +31,16 @@ struct BVHParams
   SplitStyle split_style = SplitStyle::Pca;
   /** \brief A node with more points than n_max is split (>= 1). */
   int n_max = 20;
+  /** \brief n_min's default. */
+  static constexpr int kDefaultNMin = 8;
   /** \brief A node with at most n_min points is never split, whatever its variation
-    * (1 <= n_min <= n_max). */
-  int n_min = 8;
+    * (1 <= n_min <= n_max). Default 8; lowering n_max below it needs n_min lowered too
+    * (nMinFor()). */
+  int n_min = kDefaultNMin;
+  /** \brief n_min for an n_max set without one: min(8, n_max), so that an n_max below the
+    * default n_min stays valid. The one rule of pcd_collision's -nmax N and of Python's
+    * CloudModelParams(n_max=N) without n_min. */
+  static int nMinFor (int n_max) { return n_max < kDefaultNMin ? n_max : kDefaultNMin; }
   /** \brief A node whose variation lambda_1 / (lambda_1 + lambda_2 + lambda_3) exceeds this is
     * split (dimensionless, >= 0; values >= 1/3 disable the variation rule). */
   double sigma_max = 0.05;

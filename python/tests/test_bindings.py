@@ -1046,6 +1046,16 @@ def test_cloud_model_params_takes_every_member_as_a_keyword():
     assert pc.CloudModelParams().n_min == 8 and pc.CloudModelParams(n_max=40).n_min == 8
     flags = pc._core.pcd_collision_params(["-nmax=5"])[0]
     assert (flags.n_max, flags.n_min) == (5, 5)
+    # The attribute leaves n_min as it is; the refusal says to set it too (it said only that
+    # n_min 8 was out of range).
+    q = pc.CloudModelParams()
+    q.n_max = 5
+    with pytest.raises(ValueError, match=r"n_min 8 outside \[1, n_max = 5\]: set n_min too when lowering n_max"):
+        q.validate()
+    with pytest.raises(ValueError, match="set n_min too"):
+        pc.build_model(GOOD, params=q)
+    q.n_min = 5
+    q.validate()
     # The repr holds every member and builds the same parameters back.
     q = eval(repr(p), {"CloudModelParams": pc.CloudModelParams, "SensorNoiseModel": pc.SensorNoiseModel,
                        "NormalOrientation": pc.NormalOrientation})
