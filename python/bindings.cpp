@@ -441,6 +441,22 @@ setSplit (CloudModelParams& p, const std::string& v)
   p.hierarchy.split_style = v == "octree" ? BVHParams::SplitStyle::Octree : BVHParams::SplitStyle::Pca;
 }
 
+/** CloudModelParams.leakage_bound: how the hierarchy combines a box's slab probabilities
+  * (BVHParams::leakage_bound), 'min_slab' or 'union_bound'. */
+std::string
+leakageName (const CloudModelParams& p)
+{
+  return p.hierarchy.leakage_bound == BVHParams::LeakageBound::UnionBound ? "union_bound" : "min_slab";
+}
+
+void
+setLeakage (CloudModelParams& p, const std::string& v)
+{
+  if (v != "min_slab" && v != "union_bound")
+    throw py::value_error ("leakage_bound: expected 'min_slab' or 'union_bound', got '" + v + "'");
+  p.hierarchy.leakage_bound = v == "union_bound" ? BVHParams::LeakageBound::UnionBound : BVHParams::LeakageBound::MinSlab;
+}
+
 /** The k-th pose of an (M, 4, 4) array: ValueError naming it when it is not finite or its last row
   * is not 0 0 0 1, and with `rigid` when collide()'s rigid check (detail::poseError) fails. */
 Eigen::Isometry3d
@@ -988,7 +1004,8 @@ PYBIND11_MODULE (_core, m)
   py::class_<CloudModelParams> (m, "CloudModelParams",
       "How a CloudModel is built from a point cloud (the per-cloud settings).\n\n"
       "k: neighbours of the covariance estimation (>= 1); noise: SensorNoiseModel added to the covariances;\n"
-      "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma: the hierarchy;\n"
+      "surface_projection: locally denoised positions; n_max, n_min, sigma_max, epsilon, k_sigma, split, noise_stop,\n"
+      "n_noise_max, leakage_bound: the hierarchy (BVHParams);\n"
       "surface: also build the oriented surface model (METHOD.md 10a) that CollisionRequest.surface queries\n"
       "(experimental, issue #16; costs a normal fit and an orientation pass per point); orientation: how its\n"
       "normals are oriented (NormalOrientation, default Auto); closed_objects: the cloud samples closed solids,\n"
@@ -996,7 +1013,8 @@ PYBIND11_MODULE (_core, m)
       .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, std::optional<int> n_min,
                           double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation,
                           bool closed_objects, int threads, double noise_resolution, const std::string& noise_resolution_gate,
-                          bool keep_full_resolution, double noise_stop, const std::string& split) {
+                          bool keep_full_resolution, double noise_stop, const std::string& split, int n_noise_max,
+                          const std::string& leakage_bound) {
               CloudModelParams p;
               p.k = k;
               p.noise = noise;
@@ -1018,6 +1036,8 @@ PYBIND11_MODULE (_core, m)
               p.keep_full_resolution = keep_full_resolution;
               p.hierarchy.noise_stop = noise_stop;
               setSplit (p, split);
+              p.hierarchy.n_noise_max = n_noise_max;
+              setLeakage (p, leakage_bound);
               return p;
             }),
             py::kw_only (), py::arg ("k") = dp.k, py::arg_v ("noise", dp.noise, "SensorNoiseModel.none()"),
@@ -1029,7 +1049,8 @@ PYBIND11_MODULE (_core, m)
             py::arg ("noise_resolution") = dp.noise_resolution,
             py::arg ("noise_resolution_gate") = std::string (CloudModelParams::resolutionGateName (dp.noise_resolution_gate)),
             py::arg ("keep_full_resolution") = dp.keep_full_resolution, py::arg ("noise_stop") = dp.hierarchy.noise_stop,
-            py::arg ("split") = splitName (dp),
+            py::arg ("split") = splitName (dp), py::arg ("n_noise_max") = dp.hierarchy.n_noise_max,
+            py::arg ("leakage_bound") = leakageName (dp),
             "Every argument defaults to the C++ CloudModelParams default, n_min to min(8, n_max) as pcd_collision's\n"
             "-nmax sets it. Each is also an attribute.")
       .def_readwrite ("k", &CloudModelParams::k)
@@ -1100,10 +1121,18 @@ PYBIND11_MODULE (_core, m)
                      [] (CloudModelParams& p, double v) { p.hierarchy.k_sigma = v; })
       .def_property ("noise_stop", [] (const CloudModelParams& p) { return p.hierarchy.noise_stop; },
                      [] (CloudModelParams& p, double v) { p.hierarchy.noise_stop = v; },
-                     "Do not split a hierarchy node of at most n_noise_max (160) points whose extent is within\n"
+                     "Do not split a hierarchy node of at most n_noise_max points whose extent is within\n"
                      "noise_stop noise standard deviations (BVHParams::noise_stop); default 0: off.")
       .def_property ("split", &splitName, &setSplit,
                      "Hierarchy split style, 'pca' (default) or 'octree' (pcd_collision's -split).")
+      .def_property ("n_noise_max", [] (const CloudModelParams& p) { return p.hierarchy.n_noise_max; },
+                     [] (CloudModelParams& p, int v) { p.hierarchy.n_noise_max = v; },
+                     "Largest hierarchy node noise_stop may keep whole (>= 1; default 160): bounds a leaf's points\n"
+                     "(BVHParams::n_noise_max).")
+      .def_property ("leakage_bound", &leakageName, &setLeakage,
+                     "How a box's three slab probabilities combine into a point's outside probability\n"
+                     "(BVHParams::leakage_bound): 'min_slab' (default, METHOD.md 8.4, a lower bound) or 'union_bound'\n"
+                     "(an upper bound).")
       .def ("validate", &CloudModelParams::validate, "Raises ValueError naming the first member out of range.")
       .def ("__repr__", [] (const CloudModelParams& p) {
         return "CloudModelParams(k=" + std::to_string (p.k) + ", noise=SensorNoiseModel." + noiseFactory (p.noise) +
@@ -1116,7 +1145,8 @@ PYBIND11_MODULE (_core, m)
                ", noise_resolution=" + num (p.noise_resolution) + ", noise_resolution_gate='" +
                CloudModelParams::resolutionGateName (p.noise_resolution_gate) + "', keep_full_resolution=" +
                (p.keep_full_resolution ? "True" : "False") + ", noise_stop=" + num (p.hierarchy.noise_stop) +
-               ", split='" + splitName (p) + "')";
+               ", split='" + splitName (p) + "', n_noise_max=" + std::to_string (p.hierarchy.n_noise_max) +
+               ", leakage_bound='" + leakageName (p) + "')";
       });
 
   // --- CollisionRequest ---------------------------------------------------------------------------

@@ -70,6 +70,8 @@ class CloudModelParams:
     noise_resolution_gated: bool
     noise_resolution_whole_cloud: bool
     noise_stop: float
+    n_noise_max: int
+    leakage_bound: str  # 'min_slab' (default) or 'union_bound'
     keep_full_resolution: bool
     threads: int  # in [0, MAX_THREADS] (0: one per hardware thread); ValueError outside, as pcd_collision -threads
     def __init__(self, *, k: int = ..., noise: SensorNoiseModel = ..., surface_projection: bool = ...,
@@ -77,7 +79,8 @@ class CloudModelParams:
                  k_sigma: float = ..., surface: bool = False,
                  orientation: NormalOrientation = NormalOrientation.Auto, closed_objects: bool = False,
                  threads: int = 0, noise_resolution: float = 0.0, noise_resolution_gate: str = "cloud",
-                 keep_full_resolution: bool = True, noise_stop: float = 0.0, split: str = "pca") -> None: ...
+                 keep_full_resolution: bool = True, noise_stop: float = 0.0, split: str = "pca",
+                 n_noise_max: int = 160, leakage_bound: str = "min_slab") -> None: ...
         # n_min None: min(8, n_max), as pcd_collision's -nmax sets it.
     def validate(self) -> None: ...
 
