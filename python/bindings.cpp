@@ -1313,29 +1313,43 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("probabilities_b", [] (const CollisionResult& r) { return floats (r.probabilities_b); })
       .def_property_readonly ("ok", &CollisionResult::ok)
       .def ("__repr__", [] (const CollisionResult& r) {
+        // Every member but the per-point arrays: a NaN distance or timing (not computed) and a
+        // flag that is False are left out, the vectors shown where they mean something.
+        const auto flag = [] (bool v) { return std::string (v ? "True" : "False"); };
+        const auto vector = [] (const Eigen::Vector3d& v) {
+          return "[" + num (v.x ()) + ", " + num (v.y ()) + ", " + num (v.z ()) + "]";
+        };
         std::string s = std::string ("CollisionResult(status=") + enumName (r.status) + ", verdict=Verdict." +
-                        enumName (r.verdict) + ", probability=" + num (r.probability);
-        if (r.answered_by == AnsweredBy::SurfaceLayer || r.answered_by == AnsweredBy::Pooled)  // shown only for the surface
-          s += ", answered_by=AnsweredBy." + enumName (r.answered_by);
+                        enumName (r.verdict) + ", probability=" + num (r.probability) +
+                        ", answered_by=AnsweredBy." + enumName (r.answered_by);
         if (!std::isnan (r.signed_distance))
           s += ", signed_distance=" + num (r.signed_distance);
         if (!std::isnan (r.signed_distance_std))
           s += ", signed_distance_std=" + num (r.signed_distance_std);
-        if (r.sample_distance)  // shown only when set
-          s += ", sample_distance=True";
-        if (r.unobserved)  // shown only when set, like the signed distance only when computed
+        if (r.sample_distance)  // the nearest samples the distance is between
+          s += ", sample_distance=True, nearest_point_a=" + vector (r.nearest_point_a) +
+               ", nearest_point_b=" + vector (r.nearest_point_b);
+        if (r.unobserved)
           s += ", unobserved=True";
-        if (r.budget_exhausted)  // shown only when set
+        if (r.budget_exhausted)
           s += ", budget_exhausted=True";
-        if (r.full_resolution)  // shown only when set
+        if (r.full_resolution)
           s += ", full_resolution=True";
-        s = s + ", lower_bound=" + (r.lower_bound ? "True" : "False") +
-            ", no_leaf_tested=" + (r.no_leaf_tested ? "True" : "False") +
-            ", witness_side=" + std::to_string (r.witness_side) +
-            ", witness_index=" + std::to_string (r.witness_index) +
-            ", points_a=" + std::to_string (r.points_a) + ", points_b=" + std::to_string (r.points_b) +
-            ", leaf_pairs_tested=" + std::to_string (r.leaf_pairs_tested) +
-            ", bv_tests=" + std::to_string (r.bv_tests);
+        s += ", lower_bound=" + flag (r.lower_bound) + ", no_leaf_tested=" + flag (r.no_leaf_tested) +
+             ", witness_side=" + std::to_string (r.witness_side) + ", witness_index=" + std::to_string (r.witness_index);
+        if (r.witness_side != 0)  // a witness: where it is, and its normal
+          s += ", witness_point=" + vector (r.witness_point) + ", witness_normal=" + vector (r.witness_normal);
+        s += ", points_a=" + std::to_string (r.points_a) + ", points_b=" + std::to_string (r.points_b) +
+             ", points_skipped_nonfinite=" + std::to_string (r.points_skipped_nonfinite) +
+             ", leaf_pairs_tested=" + std::to_string (r.leaf_pairs_tested) +
+             ", kernel_leaf_pairs=" + std::to_string (r.kernel_leaf_pairs) +
+             ", degenerate_leaf_pairs=" + std::to_string (r.degenerate_leaf_pairs) +
+             ", classifier_iterations=" + std::to_string (r.classifier_iterations) +
+             ", bv_tests=" + std::to_string (r.bv_tests);
+        if (!std::isnan (r.build_ms))  // timings: request.enable_timings
+          s += ", build_ms=" + num (r.build_ms);
+        if (!std::isnan (r.query_ms))
+          s += ", query_ms=" + num (r.query_ms);
         if (!r.message.empty ())
           s += ", message=" + std::string (py::repr (py::str (r.message)));
         return s + ")";

@@ -315,6 +315,45 @@ def test_result_repr_and_verdict_enum(table, gripper_patch):
     assert np.isnan(pc.CollisionResult().probability) and pc.CollisionResult().verdict == pc.Verdict.Unknown
 
 
+def test_result_repr_shows_every_member(table, gripper_patch):
+    # The repr left out answered_by (unless the surface layer answered), the nearest points of a
+    # sample distance, the witness point and normal, points_skipped_nonfinite, the fit counts and
+    # the timings (a probe, 2026-12-03). Each member is now shown where it means something: the
+    # per-point arrays, the derived ok and the Status enum aside, every attribute is named by a
+    # near result with timings, a far one with a sample distance, one stopped by its budget or
+    # one with a message; a flag only when set.
+    T = translation(0.1, 0.1, 0.004)
+    near = pc.collide(table, gripper_patch, T, pc.CollisionRequest(enable_timings=True))
+    far = pc.collide(table, gripper_patch, translation(0.1, 0.1, 0.5), pc.CollisionRequest(distance=True))
+    capped = pc.collide(table, gripper_patch, T, pc.CollisionRequest(max_leaf_fits=1, exhaustive=True))
+    told = pc.collide(table, gripper_patch, T, pc.CollisionRequest(surface=True))  # no surface model: a message
+    assert near.witness_side != 0 and far.sample_distance and far.no_leaf_tested
+    assert capped.budget_exhausted and told.message
+    results = (near, far, capped, told)
+    members = {n for n in dir(pc.CollisionResult) if not n.startswith("_")} - {
+        "probabilities_a", "probabilities_b", "ok", "Status"}
+    flags = {"full_resolution", "unobserved"}  # not set by these queries (tested with their layers)
+    shown = {m for m in members if any(f"{m}=" in repr(r) for r in results)}
+    assert shown == members - flags, sorted(members - flags - shown)
+    for r in results:
+        for f in flags | {"budget_exhausted", "sample_distance"}:
+            assert (f"{f}=True" in repr(r)) == getattr(r, f), (f, repr(r))
+        assert f"message={r.message!r}" in repr(r) if r.message else "message=" not in repr(r)
+
+    def vector(v):
+        return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+    text = repr(near)
+    assert "answered_by=AnsweredBy.Separators, lower_bound=" in text  # shown for the separators too
+    assert f"witness_point={vector(near.witness_point)}, witness_normal={vector(near.witness_normal)}" in text
+    assert f"query_ms={near.query_ms!r}" in text and f"kernel_leaf_pairs={near.kernel_leaf_pairs}," in text
+    assert "nearest_point_a" not in text and "sample_distance" not in text
+    text = repr(far)
+    assert (f"sample_distance=True, nearest_point_a={vector(far.nearest_point_a)}, "
+            f"nearest_point_b={vector(far.nearest_point_b)}") in text
+    assert "witness_point" not in text and "query_ms" not in text  # no witness, no timings asked
+
+
 # --- the surface layer (issue #16): signed distances -----------------------------------------------
 
 SURFACE = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True)
@@ -442,7 +481,7 @@ def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):
         assert surface.answered_by == pc.AnsweredBy.SurfaceLayer
         assert pooled.answered_by == pc.AnsweredBy.Pooled
         assert ladder.answered_by == expected.answered_by, (z, rung)
-        assert ("answered_by=AnsweredBy." in repr(ladder)) == (rung != "separators")
+        assert f"answered_by=AnsweredBy.{ladder.answered_by.name}," in repr(ladder)
         # A distance asked for: where the separators' sure collision stands, the surface layer's
         # distance (as it gives it alone) with their probability.
         if rung == "separators" and not separators.no_leaf_tested:
