@@ -1160,6 +1160,8 @@ PYBIND11_MODULE (_core, m)
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
+      "surface_pooled, surface_ladder, surface_calibrated: each needs surface (ValueError without it; pcd_collision's\n"
+      "-surface_pooled and -surface_ladder imply -surface);\n"
       "surface_pooled: with surface, the mean of the surface layer's P and the separators' (experimental);\n"
       "surface_ladder: with surface, the separators first and the surface layer only where they leave the answer\n"
       "open (experimental; excludes surface_pooled);\n"
@@ -1216,14 +1218,16 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
-                      "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).")
+                      "With surface: P is the mean of the surface layer's and the separators' (experimental, default False).\n"
+                      "Without surface, collide() and validate() raise ValueError naming it.")
       .def_readwrite ("surface_ladder", &CollisionRequest::surface_ladder,
                       "With surface: the separators first; the surface layer where they reached a leaf pair and found\n"
                       "no sure collision, alone in the contact band, pooled with them where they read free\n"
-                      "(experimental, default False; excludes surface_pooled).")
+                      "(experimental, default False; excludes surface_pooled). Without surface, ValueError.")
       .def_readwrite ("surface_calibrated", &CollisionRequest::surface_calibrated,
                       "With surface: P in [0.1, 0.9] through the calibration map fitted on the evaluation's "
-                      "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.")
+                      "procedural scenes (rankings and default verdicts kept). Default False: the model's raw P.\n"
+                      "Without surface, ValueError.")
       .def_readwrite ("distance", &CollisionRequest::distance,
                       "Beyond the query's reach (no_leaf_tested), signed_distance is the nearest samples' distance,\n"
                       "its std their covariances' along the line between them with 0.29 of each one's spacing\n"

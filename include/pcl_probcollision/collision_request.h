@@ -83,7 +83,9 @@ struct CollisionRequest
     * things: the surface layer whether a point lies behind the other's surface, the separators
     * whether two sheets cross (thin parts, where noise leaves no inside). The signed distance
     * stays the surface layer's. Experimental, off by default; the rule was chosen on evaluation
-    * runs with seeds other than the reported one (docs/SURFACE.md). */
+    * runs with seeds other than the reported one (docs/SURFACE.md). validate() refuses it
+    * without surface (it would change nothing: the separators would answer a request naming the
+    * surface layer); pcd_collision's -surface_pooled sets both. */
   bool surface_pooled = false;
   /** \brief With surface on: a ladder, the separators first and the surface layer only where they
     * leave the answer open. The separators' answer stands where they reached no leaf pair (the
@@ -97,7 +99,8 @@ struct CollisionRequest
     * sparse samples a part can pass unseen by the separators). Most free poses then cost the
     * separators alone. The rule was chosen on evaluation runs with seeds other than the reported
     * one (docs/SURFACE.md, "The ladder"); experimental, off by default. Excludes surface_pooled.
-    * Like surface_pooled and surface_calibrated, refused by validate() without surface. */
+    * Like surface_pooled and surface_calibrated, refused by validate() without surface
+    * (pcd_collision's -surface_ladder sets both). */
   bool surface_ladder = false;
   /** \brief With surface on: P (the surface layer's, or the pool's) goes through a calibration
     * map inside the default contact band [0.1, 0.9]: strictly increasing, onto the band, the
@@ -107,7 +110,8 @@ struct CollisionRequest
     * reported piano-and-room scenes the raw P over-states them, and the maps make it worse
     * (docs/SURFACE.md, "Calibration"). No map fitted apart from those scenes helps them, so the
     * default is the model's raw P, P = Phi(-signed_distance / signed_distance_std). Per-point
-    * values, signed_distance and its std are never mapped. */
+    * values, signed_distance and its std are never mapped. Refused by validate() without surface,
+    * as surface_pooled (pcd_collision's -surface_calibrated needs -surface or a flag implying it). */
   bool surface_calibrated = false;
   /** \brief A distance at any separation, as FCL's distance request gives: beyond the reach of
     * the surface layer where it runs (alone, pooled or as the ladder's rung: no leaf pair within
@@ -129,7 +133,9 @@ struct CollisionRequest
   ClassifierParams classifier;
 
   /** \brief Throws pcl::BadArgumentException naming the first member out of range (the
-    * classifier's included). */
+    * classifier's included), or surface_pooled, surface_ladder or surface_calibrated set
+    * without surface, or surface_pooled with surface_ladder. collide() and collideBatch() run it
+    * first (an InvalidInput result), ProbabilisticCollision::setRequest() too (it throws). */
   void validate () const;
   /** \brief The part of validate() that verdictFor() needs: free_below and collision_above. */
   void validateThresholds () const;
