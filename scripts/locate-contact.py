@@ -23,8 +23,9 @@ the same inputs print the same numbers. Needs numpy and Open3D (Debian's python3
         --env-mesh ../shared/data/meshes/piano_room_env.obj \\
         --poses out/scans/W1_0.25_poses.txt --query 115 --env-cloud out/scans/W1_0.25_env.pcd
 
-Exit status 0 on success (touching or not), 1 on bad input (the message names the file or
-option).
+Exit status 0 on success (touching or not), 2 on a usage error (an option missing, or a value
+out of range or malformed: the message names the option), 1 on a bad input file (the message
+names it).
 """
 import argparse
 import json
@@ -38,16 +39,18 @@ def fail(message):
     sys.exit(1)
 
 
-def parse_pose(text, where):
+def parse_pose(text, where, refuse=fail):
+    """Six finite numbers; refuse(message) otherwise (fail for a file's line, the parser's error
+    for --pose)."""
     parts = text.replace(",", " ").split()
     if len(parts) != 6:
-        fail(f"{where}: expected 6 numbers tx,ty,tz,roll,pitch,yaw, got {len(parts)}")
+        refuse(f"{where}: expected 6 numbers tx,ty,tz,roll,pitch,yaw, got {len(parts)}")
     try:
         values = [float(v) for v in parts]
     except ValueError:
-        fail(f"{where}: '{text.strip()}' is not six numbers")
+        refuse(f"{where}: '{text.strip()}' is not six numbers")
     if not all(math.isfinite(v) for v in values):
-        fail(f"{where}: every number must be finite")
+        refuse(f"{where}: every number must be finite")
     return values
 
 
@@ -120,25 +123,32 @@ def nearest_samples(np, points, normals, centre, count):
     return rows
 
 
-def locate(args):
+def check_usage(args, refuse):
+    """The option values, before any file is read: refuse(message) (the parser's error, exit 2,
+    as argparse's own for a value that is not a number) for one out of range. Returns the --pose
+    given, or None."""
+    if args.band <= 0 or not math.isfinite(args.band):
+        refuse(f"--band: {args.band} must be finite and > 0")
+    if args.samples < 1:
+        refuse(f"--samples: {args.samples} must be >= 1")
+    if args.nearest < 1:  # -3 was taken (a probe, 2026-12-03)
+        refuse(f"--nearest: {args.nearest} must be >= 1")
+    if args.seed < 0:
+        refuse(f"--seed: {args.seed} must be >= 0")
+    if (args.pose is None) == (args.poses is None):
+        refuse("give the pose as --pose tx,ty,tz,roll,pitch,yaw or as --poses FILE --query N")
+    if args.poses is not None and args.query is None:
+        refuse("--poses needs --query N")
+    return parse_pose(args.pose, "--pose", refuse) if args.pose is not None else None
+
+
+def locate(args, pose=None):
     try:
         import numpy as np
         import open3d as o3d
     except ImportError as e:
         fail(f"needs numpy and Open3D (Debian: python3-numpy, python3-open3d): {e}")
-    if args.band <= 0 or not math.isfinite(args.band):
-        fail(f"--band: {args.band} must be finite and > 0")
-    if args.samples < 1:
-        fail(f"--samples: {args.samples} must be >= 1")
-    if args.nearest < 1:  # -3 was taken (a probe, 2026-12-03)
-        fail(f"--nearest: {args.nearest} must be >= 1")
-    if args.seed < 0:
-        fail(f"--seed: {args.seed} must be >= 0")
-    if (args.pose is None) == (args.poses is None):
-        fail("give the pose as --pose tx,ty,tz,roll,pitch,yaw or as --poses FILE --query N")
-    if args.poses is not None and args.query is None:
-        fail("--poses needs --query N")
-    pose = parse_pose(args.pose, "--pose") if args.pose is not None else pose_from_file(args.poses, args.query)
+    pose = pose if pose is not None else pose_from_file(args.poses, args.query)
     R = rotation(*pose[3:])
     t = np.array(pose[:3])
 
@@ -228,7 +238,7 @@ def main():
     parser.add_argument("--seed", type=int, default=1, help="seed of the surface samples (1)")
     parser.add_argument("--json", action="store_true", help="one JSON object on stdout instead of text")
     args = parser.parse_args()
-    report = locate(args)
+    report = locate(args, check_usage(args, parser.error))
     if args.json:
         print(json.dumps(report))
     else:

@@ -85,13 +85,15 @@ def test_a_pose_from_a_dumped_poses_file(scene, tmp_path):
     assert report["pose"] == [100, 5, 205, 0, 0, 0] and report["contact"] is not None
 
 
-@pytest.mark.parametrize("args, named", [
-    (["--env-mesh", "missing.obj"], "--env-mesh"),
-    (["--pose", "1,2,3"], "--pose"),
-    (["--band", "0"], "--band"),
-    (["--poses", "p.txt"], "--poses needs --query"),
+@pytest.mark.parametrize("args, named, status", [
+    (["--env-mesh", "missing.obj"], "--env-mesh", 1),  # a bad file: 1
+    (["--pose", "1,2,3"], "--pose", 2),  # a bad option value: a usage error, 2 (it exited 1)
+    (["--band", "0"], "--band", 2),
+    (["--band", "abc"], "--band", 2),  # argparse's own: 2 before too
+    (["--nearest", "-3"], "--nearest: -3 must be >= 1", 2),
+    (["--poses", "p.txt"], "--poses needs --query", 2),
 ])
-def test_bad_input_is_refused_by_name(scene, args, named):
+def test_bad_input_is_refused_by_name(scene, args, named, status):
     env, robot, _ = scene
     base = {"--robot-mesh": robot, "--env-mesh": env, "--pose": "0,0,0,0,0,0"}
     for key, value in zip(args[::2], args[1::2]):
@@ -99,5 +101,6 @@ def test_bad_input_is_refused_by_name(scene, args, named):
     if "--poses" in base:
         del base["--pose"]
     out = run(*[x for kv in base.items() for x in kv])
-    assert out.returncode == 1
+    assert out.returncode == status, out.stderr
     assert named in out.stderr
+    assert "Traceback" not in out.stderr

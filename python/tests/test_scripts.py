@@ -37,12 +37,14 @@ def test_python_scripts_refuse_bad_arguments(args, words):
 
 
 def test_locate_contact_refuses_a_count_below_one():
-    # A bad value of its inputs exits 1 naming it (test_locate_contact.py); --nearest -3 was taken.
-    for flag, value in (("--nearest", "-3"), ("--seed", "-1")):
+    # An option's bad value is a usage error: exit 2 naming it, as argparse's own refusal of a
+    # value that is no number (--nearest -3 was taken; then it exited 1, --nearest abc 2).
+    for flag, value in (("--nearest", "-3"), ("--seed", "-1"), ("--nearest", "abc")):
         r = run([sys.executable, str(SCRIPTS / "locate-contact.py"), "--robot-mesh", "a.obj", "--env-mesh", "b.obj",
                  "--pose", "0,0,0,0,0,0", flag, value])
-        assert r.returncode == 1, r.stderr
-        assert f"{flag}: {value} must be >= " in r.stderr, r.stderr
+        assert r.returncode == 2, r.stderr
+        assert f"argument {flag}: invalid int value: '{value}'" in r.stderr if value == "abc" else \
+            f"error: {flag}: {value} must be >= " in r.stderr, r.stderr
         assert "Traceback" not in r.stderr
 
 
