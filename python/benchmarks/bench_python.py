@@ -8,7 +8,10 @@
 Workload (as benchmarks/bench_collide.cpp and W1): FCL's piano and room meshes
 (../shared/data/meshes) sampled to about 10,000 points each, Gaussian noise of 0.5 % of the
 piano's bounding-box diagonal on every sample, declared as isotropic noise; default parameters;
-uniformly random piano poses in the room's bounding box. Prints figures, asserts nothing."""
+uniformly random piano poses in the room's bounding box. Prints figures, asserts nothing.
+
+Exit status 0 after the figures, 2 on a usage error (a bad option or value), 1 when something it
+needs is missing (the module, the bench binary, the meshes)."""
 import argparse
 import json
 import math
@@ -21,10 +24,38 @@ import time
 
 import numpy as np
 
-import pcl_probcollision as pc
-from pcl_probcollision import dask as pcd
-
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+pc = pcd = None  # pcl_probcollision and its dask layer, imported by main() once the options are read
+
+
+def import_module(build):
+    """pcl_probcollision from PYTHONPATH, else from BUILD/python; exit 1 naming both when neither
+    has it (it ended in an import traceback, even for --help)."""
+    global pc, pcd
+    try:
+        import pcl_probcollision
+    except ImportError:
+        sys.path.insert(0, str(pathlib.Path(build) / "python"))
+        try:
+            import pcl_probcollision
+        except ImportError as e:
+            sys.exit(f"bench_python.py: cannot import pcl_probcollision from PYTHONPATH or {build}/python ({e}); "
+                     f"build it (cmake --build {build}) or set PYTHONPATH=BUILD/python")
+    from pcl_probcollision import dask as dask_layer
+    pc, pcd = pcl_probcollision, dask_layer
+
+
+def at_least(low):
+    """An argparse type: an integer >= low (argparse's error, exit 2, otherwise)."""
+    def read(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not an integer") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{value} must be at least {low}")
+        return value
+    return read
 
 
 def mesh_area(V, F):
@@ -72,15 +103,19 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default=str(ROOT / "build"))
     ap.add_argument("--shared", default=os.environ.get("PCL_PROBCOLLISION_SHARED_DATA", str(ROOT.parent / "shared" / "data")))
-    ap.add_argument("--poses", type=int, default=2000)
-    ap.add_argument("--dask-poses", type=int, default=20000)
-    ap.add_argument("--chunk-size", type=int, default=None)
+    ap.add_argument("--poses", type=at_least(1), default=2000)
+    ap.add_argument("--dask-poses", type=at_least(1), default=20000)
+    ap.add_argument("--chunk-size", type=at_least(1), default=None)
     args = ap.parse_args()
     exe = pathlib.Path(args.build) / "python" / "pcl_probcollision_bench_batch"
     if not os.access(exe, os.X_OK):
         sys.exit(f"bench_python.py: {exe}: no such executable (cmake --build {args.build} --target "
                  f"pcl_probcollision_bench_batch)")
     meshes = pathlib.Path(args.shared) / "meshes"
+    for name in ("piano_room_rob.obj", "piano_room_env.obj"):
+        if not (meshes / name).is_file():
+            sys.exit(f"bench_python.py: {meshes / name}: no such file (--shared names the shared data directory)")
+    import_module(args.build)
 
     V, F = pc.read_mesh(meshes / "piano_room_rob.obj")
     sigma = 0.005 * pc.mesh_diagonal(V, F)

@@ -63,3 +63,34 @@ def test_demo_picture_writes_a_relative_out_where_it_is_called(tmp_path):
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "pose2.png").stat().st_size > 1000
     assert not (ROOT / "pose2.png").exists()
+
+
+def test_bench_python_help_and_refusals(tmp_path):
+    # bench_python.py imported pcl_probcollision before reading its options, so --help without
+    # PYTHONPATH ended in an import traceback; --poses 0 and a --shared without the meshes went on
+    # to tracebacks of their own. Now --help exits 0, a bad value 2 and a missing mesh 1, by name.
+    bench = ROOT / "python" / "benchmarks" / "bench_python.py"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+
+    def bench_run(*args):
+        return subprocess.run([sys.executable, str(bench), *map(str, args)], capture_output=True, text=True,
+                              cwd=tmp_path, env=env, timeout=120)
+
+    helped = bench_run("--help")
+    assert helped.returncode == 0 and helped.stdout.startswith("usage: bench_python.py"), helped.stderr
+    for args, words in ((["--poses", "0"], "argument --poses: 0 must be at least 1"),
+                        (["--dask-poses", "-5"], "argument --dask-poses: -5 must be at least 1"),
+                        (["--chunk-size", "abc"], "argument --chunk-size: 'abc' is not an integer")):
+        refused = bench_run(*args)
+        assert refused.returncode == 2 and words in refused.stderr, refused.stderr
+    build = tmp_path / "build"
+    (build / "python").mkdir(parents=True)
+    exe = build / "python" / "pcl_probcollision_bench_batch"
+    exe.write_text("#!/bin/sh\nexit 0\n")
+    exe.chmod(0o755)
+    missing = bench_run("--build", build, "--shared", tmp_path)
+    assert missing.returncode == 1, missing.stderr
+    assert f"{tmp_path / 'meshes' / 'piano_room_rob.obj'}: no such file" in missing.stderr
+    assert "Traceback" not in missing.stderr
+    for r in (helped, refused):
+        assert "Traceback" not in r.stderr
