@@ -28,6 +28,9 @@ from these runs (the seed draws the scene as well as its samples):
 Rows of any other workload are refused. The runs must give the raw P
 (CollisionRequest::surface_calibrated off, the default; not --surface-calibrated): nothing in
 queries.csv says which one a run wrote. Standard library only.
+
+Exit status 0 after the fit, 2 on a usage error, 1 on a run it cannot use (a missing or malformed
+queries.csv, another workload, too few answers); each message names the file.
 """
 import csv
 import sys
@@ -36,6 +39,40 @@ LOW, HIGH = 0.1, 0.9       # CollisionRequest's default free_below and collision
 GRID = [0.5 + 0.05 * k for k in range(71)]
 SETTINGS = (("surface", "kSurfaceLayerGamma"), ("pooled", "kPooledGamma"))
 FIT_WORKLOAD = "F1"        # evaluate_collision --fit-scene: F1 and F1-sparse
+COLUMNS = ("workload", "method", "setting", "noise_pct", "near_sigma", "score", "exact_collision")
+
+
+def fail(message):
+    sys.exit(f"fit-surface-calibration.py: {message}")
+
+
+def read_rows(path):
+    """queries.csv's rows, each with its file and line ("_where"): a missing column or a short row
+    is named with them (a missing column ended in a KeyError traceback)."""
+    try:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+            if missing:
+                fail(f"{path}: not an evaluate_collision queries.csv (no column {', '.join(missing)})")
+            rows = []
+            for row in reader:
+                if None in row.values() or None in row:
+                    fail(f"{path}:{reader.line_num}: {len(reader.fieldnames)} columns expected")
+                row["_where"] = f"{path}:{reader.line_num}"
+                rows.append(row)
+            return rows
+    except OSError as e:
+        fail(f"cannot read {path}: {e.strerror}")
+
+
+def answer(row):
+    """(score, exact_collision) of a row the fit uses, or a failure naming its file and line (a
+    value that is not a number ended in a ValueError traceback)."""
+    try:
+        return float(row["score"]), int(row["exact_collision"])
+    except ValueError:
+        fail(f"{row['_where']}: score {row['score']!r} or exact_collision {row['exact_collision']!r} is not a number")
 
 
 def mapped(p, gamma):
@@ -57,18 +94,13 @@ def main(dirs):
         sys.exit(2)
     rows = []
     for d in dirs:
-        path = d.rstrip("/") + "/queries.csv"
-        try:
-            with open(path, newline="") as f:
-                rows.extend(csv.DictReader(f))
-        except OSError as e:
-            sys.exit(f"fit-surface-calibration.py: cannot read {path}: {e.strerror}")
+        rows.extend(read_rows(d.rstrip("/") + "/queries.csv"))
     reported = sorted({r["workload"] for r in rows if not r["workload"].startswith(FIT_WORKLOAD)})
     if reported:
         sys.exit(f"fit-surface-calibration.py: the runs hold workload(s) {', '.join(reported)}; fit only on "
                  f"evaluate_collision --fit-scene runs ({FIT_WORKLOAD}), never on what the evaluation reports")
     for setting, name in SETTINGS:
-        points = [(float(r["score"]), int(r["exact_collision"])) for r in rows
+        points = [answer(r) for r in rows
                   if r["method"] == "ours" and r["setting"] == setting
                   and r["noise_pct"] == "0.5" and r["near_sigma"] == "1"]
         if len(points) < 100:

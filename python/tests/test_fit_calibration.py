@@ -65,3 +65,29 @@ def test_refuses_runs_of_a_reported_workload(tmp_path):
     write_run(tmp_path / "w1", gamma=2.0, count=4000, seed=3, workloads=("W1", "F1"))
     out = run(tmp_path / "w1")
     assert out.returncode != 0 and "W1" in out.stderr and "--fit-scene" in out.stderr
+
+
+def test_refuses_a_malformed_queries_csv_by_file_and_line(tmp_path):
+    # A queries.csv without the columns the fit reads ended in a KeyError traceback, a score that
+    # is no number in a ValueError one: both now exit 1 naming the file (and the line).
+    headless = tmp_path / "headless"
+    headless.mkdir()
+    (headless / "queries.csv").write_text("a,b\n1,2\n")
+    out = run(headless)
+    assert out.returncode == 1, out.stderr
+    assert f"{headless}/queries.csv: not an evaluate_collision queries.csv (no column workload" in out.stderr
+    write_run(tmp_path / "bad", gamma=1.0, count=200, seed=2)
+    path = tmp_path / "bad" / "queries.csv"
+    lines = path.read_text().splitlines()
+    row = next(i for i, line in enumerate(lines) if ",ours,surface," in line)
+    lines[row] = lines[row].rsplit(",", 2)[0] + ",abc," + lines[row].rsplit(",", 1)[1]
+    path.write_text("\n".join(lines) + "\n")
+    out = run(tmp_path / "bad")
+    assert out.returncode == 1, out.stderr
+    assert f"{path}:{row + 1}: score 'abc'" in out.stderr, out.stderr
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "empty" / "queries.csv").write_text("")
+    out = run(tmp_path / "empty")
+    assert out.returncode == 1 and "not an evaluate_collision queries.csv" in out.stderr, out.stderr
+    for out in (run(headless), run(tmp_path / "bad")):
+        assert "Traceback" not in out.stderr
