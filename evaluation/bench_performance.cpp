@@ -42,6 +42,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -484,4 +486,35 @@ BM_Batch (benchmark::State& state)
 BENCHMARK (BM_Batch)->Arg (1)->Arg (2)->Unit (benchmark::kMillisecond)->Iterations (1)->UseRealTime ();
 } // namespace
 
-BENCHMARK_MAIN ();
+// The environment's settings are read before any benchmark runs, so that a bad value is one line
+// and exit 2 (before 2026-12-05 it was an uncaught exception out of a benchmark: "terminate called").
+int
+main (int argc, char** argv)
+{
+  try
+  {
+    noisePercent ();
+    benchSetting ();
+    if (!std::filesystem::is_directory (dataDir () + "/meshes"))
+      throw std::invalid_argument ("PCL_PROBCOLLISION_SHARED_DATA: no directory '" + dataDir () + "/meshes'");
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "bench_performance: " << e.what () << std::endl;
+    return 2;
+  }
+  benchmark::Initialize (&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments (argc, argv))
+    return 1;
+  try
+  {
+    benchmark::RunSpecifiedBenchmarks ();
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "bench_performance: " << e.what () << std::endl;
+    return 1;
+  }
+  benchmark::Shutdown ();
+  return 0;
+}

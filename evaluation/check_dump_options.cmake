@@ -23,6 +23,8 @@ expect(2 err "option --scale: '1O' is not a finite number" ${base} --scale 1O sp
 expect(2 err "option --scale: 0 must be above 0" ${base} --scale 0 sphere_sphere/0s)
 expect(2 err "option --scale needs a value" ${base} sphere_sphere/0s --scale)
 expect(2 err "--out and PREFIX are required" --seed 1 sphere_sphere/0s)
+# A prefix no query has: exit 1, and no directory made (it was made before the search).
+expect(1 err "no W2 query name starts with 'no_such_scenario'" ${base} no_such_scenario)
 if(EXISTS "${WORK}/out")
   message(FATAL_ERROR "a refused run made ${WORK}/out")
 endif()

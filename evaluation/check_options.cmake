@@ -43,8 +43,11 @@ expect(2 "--out '.*' lies in --data" --out "${DATA}/scenes" --data "${DATA}/")
 file(MAKE_DIRECTORY "${WORK}/own_data/scenes")
 file(CREATE_LINK "${WORK}/own_data/scenes" "${WORK}/link" SYMBOLIC)
 expect(2 "--out '.*/link/results' lies in --data" --out "${WORK}/link/results" --data "${WORK}/own_data")
+# A --data that is no directory, before --out is made (it was made, then the read failed).
+expect(2 "--data '.*/missing' is not a directory" --out "${WORK}/out" --data "${WORK}/missing")
 if(EXISTS "${WORK}/out")
   message(FATAL_ERROR "a refused run made ${WORK}/out")
 endif()
 # A failure while running is not a usage error: exit 1 (it was 2).
+file(MAKE_DIRECTORY "${WORK}/no_data")
 expect(1 "cannot read ${WORK}/no_data/scenes/queries.csv" --out "${WORK}/out" --data "${WORK}/no_data" --workloads W3)

@@ -23,6 +23,17 @@ if(benchmark_FOUND)
   target_compile_options(bench_performance PRIVATE -Wall -Wextra)
   target_compile_definitions(bench_performance PRIVATE
     PCL_PROBCOLLISION_SHARED_DATA="${PCL_PROBCOLLISION_SHARED_DATA}")
+  if(BUILD_TESTING)
+    # A bad setting is one line naming it, before any benchmark runs (it was "terminate called").
+    add_test(NAME eval.BenchPerformanceRefusesABadNoise
+      COMMAND ${CMAKE_COMMAND} -E env BENCH_PERFORMANCE_NOISE=1O $<TARGET_FILE:bench_performance>)
+    set_tests_properties(eval.BenchPerformanceRefusesABadNoise PROPERTIES PASS_REGULAR_EXPRESSION
+      "^bench_performance: BENCH_PERFORMANCE_NOISE [^\n]*'1O' is not a finite number\n$")
+    add_test(NAME eval.BenchPerformanceRefusesAnUnknownSetting
+      COMMAND ${CMAKE_COMMAND} -E env BENCH_PERFORMANCE_SETTING=bogus $<TARGET_FILE:bench_performance>)
+    set_tests_properties(eval.BenchPerformanceRefusesAnUnknownSetting PROPERTIES PASS_REGULAR_EXPRESSION
+      "^bench_performance: BENCH_PERFORMANCE_SETTING: unknown setting 'bogus'\n$")
+  endif()
 endif()
 
 # One W2 query's clouds as PCD files, to run it alone through pcd_collision (docs/PERFORMANCE.md).

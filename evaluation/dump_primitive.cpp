@@ -81,7 +81,6 @@ main (int argc, char** argv)
     return usage ("--out and PREFIX are required");
   try
   {
-    std::filesystem::create_directories (out);
     int written = 0;
     for (const auto& q : pcl_probcollision_eval::makePrimitiveQueries (scale, seed, quick))
     {
@@ -90,6 +89,8 @@ main (int argc, char** argv)
       std::string base = q.name;
       for (char& c : base)
         c = c == '/' ? '_' : c;
+      if (written == 0)
+        std::filesystem::create_directories (out);  // only once a query matches
       const std::string robot = out + "/" + base + "_robot.pcd", env = out + "/" + base + "_env.pcd";
       if (pcl::io::savePCDFileBinary (robot, *q.b) != 0 || pcl::io::savePCDFileBinary (env, *q.a) != 0)
       {

@@ -1554,6 +1554,8 @@ parse (int argc, char** argv)
     return o;
   if (o.out_dir.empty () || o.data_dir.empty ())
     throw std::invalid_argument (std::string ("--out and --data are required (") + kUsage + ")");
+  if (!std::filesystem::is_directory (o.data_dir))
+    throw std::invalid_argument ("--data '" + o.data_dir + "' is not a directory");
   checkOutputDirectory (o);
   // --only names settings the run knows (the full sweep's, and --drop's).
   if (!o.only.empty ())

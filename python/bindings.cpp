@@ -543,6 +543,20 @@ enumName (E value)
   return py::cast (value).attr ("name").template cast<std::string> ();
 }
 
+/** ClassifierParams(...) with every member, for its repr and CollisionRequest's. */
+std::string
+classifierRepr (const ClassifierParams& c)
+{
+  const auto flag = [] (bool b) { return std::string (b ? "True" : "False"); };
+  return "ClassifierParams(kernel=KernelMode." + enumName (c.kernel) + ", training=TrainingMode." +
+         enumName (c.training) + ", confidence=" + num (c.confidence) + ", gamma_cap=" + num (c.gamma_cap) +
+         ", C=" + num (c.C) + ", rbf_gamma=" + num (c.rbf_gamma) + ", rff_features=" + std::to_string (c.rff_features) +
+         ", rff_features_large=" + std::to_string (c.rff_features_large) + ", rff_seed=" + std::to_string (c.rff_seed) +
+         ", ladder_depth_sigmas=" + num (c.ladder_depth_sigmas) + ", ladder_fraction=" + num (c.ladder_fraction) +
+         ", exact_points_in_maximum=" + flag (c.exact_points_in_maximum) +
+         ", max_iterations=" + std::to_string (c.max_iterations) + ", loss=Loss." + enumName (c.loss) + ")";
+}
+
 /** The factory call that builds n, for the reprs: isotropic with its sigma (which it gives at any
   * point), so that a repr builds the same model back. */
 std::string
@@ -1149,6 +1163,76 @@ PYBIND11_MODULE (_core, m)
                ", leakage_bound='" + leakageName (p) + "')";
       });
 
+  // --- ClassifierParams ---------------------------------------------------------------------------
+  py::enum_<KernelMode> (m, "KernelMode", "Which separating surface a leaf pair fits (METHOD.md 5.7); ClassifierParams.kernel.")
+      .value ("Linear", KernelMode::Linear)
+      .value ("RFF", KernelMode::RFF)
+      .value ("Ladder", KernelMode::Ladder);
+  py::enum_<TrainingMode> (m, "TrainingMode", "How the covariances enter training (METHOD.md 5.2); ClassifierParams.training.")
+      .value ("Standard", TrainingMode::Standard)
+      .value ("Robust", TrainingMode::Robust);
+  py::enum_<Loss> (m, "Loss", "The loss on the margin violation (METHOD.md 5.3); ClassifierParams.loss.")
+      .value ("SquaredHinge", Loss::SquaredHinge)
+      .value ("Huber", Loss::Huber);
+  const ClassifierParams dcl;
+  py::class_<ClassifierParams> (m, "ClassifierParams",
+      "The leaf-pair classifier of the separators (METHOD.md 5.7); CollisionRequest.classifier. Lengths are in\n"
+      "the unit-cube frame of the problem, so they do not depend on units.\n\n"
+      "kernel: Linear (a plane), RFF (random Fourier features) or Ladder (default: the plane first, the kernel\n"
+      "rungs where it misclassifies); training: Robust (default, the chance-constrained SVM) or Standard\n"
+      "(covariances for the probabilities only); confidence: kappa in (0.5, 1); gamma_cap: eta in (0, 1);\n"
+      "C > 0: the soft-margin weight (default 1000, not the paper's 10: docs/RESULTS.md, 'C10'); rbf_gamma > 0;\n"
+      "rff_features >= 8 and rff_features_large >= rff_features: the kernel rungs' D; rff_seed;\n"
+      "ladder_depth_sigmas > 0 and ladder_fraction in [0, 1): when the ladder escalates;\n"
+      "exact_points_in_maximum: whether noise-free points take part in the maximum; max_iterations >= 1;\n"
+      "loss: SquaredHinge (default) or Huber.")
+      .def (py::init ([] (KernelMode kernel, TrainingMode training, double confidence, double gamma_cap, double C,
+                          double rbf_gamma, int rff_features, int rff_features_large, std::uint64_t rff_seed,
+                          double ladder_depth_sigmas, double ladder_fraction, bool exact_points_in_maximum,
+                          int max_iterations, Loss loss) {
+              ClassifierParams c;
+              c.kernel = kernel;
+              c.training = training;
+              c.confidence = confidence;
+              c.gamma_cap = gamma_cap;
+              c.C = C;
+              c.rbf_gamma = rbf_gamma;
+              c.rff_features = rff_features;
+              c.rff_features_large = rff_features_large;
+              c.rff_seed = rff_seed;
+              c.ladder_depth_sigmas = ladder_depth_sigmas;
+              c.ladder_fraction = ladder_fraction;
+              c.exact_points_in_maximum = exact_points_in_maximum;
+              c.max_iterations = max_iterations;
+              c.loss = loss;
+              return c;
+            }),
+            py::kw_only (), py::arg ("kernel") = dcl.kernel, py::arg ("training") = dcl.training,
+            py::arg ("confidence") = dcl.confidence, py::arg ("gamma_cap") = dcl.gamma_cap, py::arg ("C") = dcl.C,
+            py::arg ("rbf_gamma") = dcl.rbf_gamma, py::arg ("rff_features") = dcl.rff_features,
+            py::arg ("rff_features_large") = dcl.rff_features_large, py::arg ("rff_seed") = dcl.rff_seed,
+            py::arg ("ladder_depth_sigmas") = dcl.ladder_depth_sigmas, py::arg ("ladder_fraction") = dcl.ladder_fraction,
+            py::arg ("exact_points_in_maximum") = dcl.exact_points_in_maximum,
+            py::arg ("max_iterations") = dcl.max_iterations, py::arg ("loss") = dcl.loss,
+            "Every argument defaults to the C++ ClassifierParams default; validate() (or the query) checks the ranges.")
+      .def_readwrite ("kernel", &ClassifierParams::kernel)
+      .def_readwrite ("training", &ClassifierParams::training)
+      .def_readwrite ("confidence", &ClassifierParams::confidence)
+      .def_readwrite ("gamma_cap", &ClassifierParams::gamma_cap)
+      .def_readwrite ("C", &ClassifierParams::C)
+      .def_readwrite ("rbf_gamma", &ClassifierParams::rbf_gamma)
+      .def_readwrite ("rff_features", &ClassifierParams::rff_features)
+      .def_readwrite ("rff_features_large", &ClassifierParams::rff_features_large)
+      .def_readwrite ("rff_seed", &ClassifierParams::rff_seed)
+      .def_readwrite ("ladder_depth_sigmas", &ClassifierParams::ladder_depth_sigmas)
+      .def_readwrite ("ladder_fraction", &ClassifierParams::ladder_fraction)
+      .def_readwrite ("exact_points_in_maximum", &ClassifierParams::exact_points_in_maximum)
+      .def_readwrite ("max_iterations", &ClassifierParams::max_iterations)
+      .def_readwrite ("loss", &ClassifierParams::loss)
+      .def ("validate", &ClassifierParams::validate, "Raises ValueError naming the first parameter out of range.")
+      .def ("__eq__", [] (const ClassifierParams& a, const ClassifierParams& b) { return a == b; })
+      .def ("__repr__", [] (const ClassifierParams& c) { return classifierRepr (c); });
+
   // --- CollisionRequest ---------------------------------------------------------------------------
   const CollisionRequest dr;
   py::class_<CollisionRequest> (m, "CollisionRequest",
@@ -1170,11 +1254,13 @@ PYBIND11_MODULE (_core, m)
       "distance: beyond the query's reach, signed_distance is the distance between the nearest samples\n"
       "(CollisionResult.sample_distance, nearest_point_a/_b), as FCL's distance request; near contact\n"
       "the surface layer's signed_distance is then an estimate, never the first deciding point's bound\n"
-      "(with surface_ladder also where the separators find a sure collision; their P stands).")
+      "(with surface_ladder also where the separators find a sure collision; their P stands);\n"
+      "classifier: the separators' leaf-pair classifier (ClassifierParams; default: the C++ defaults).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
                           double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
-                          bool surface_pooled, bool surface_ladder, bool surface_calibrated, bool distance) {
+                          bool surface_pooled, bool surface_ladder, bool surface_calibrated, bool distance,
+                          const ClassifierParams& classifier) {
               CollisionRequest r;
               r.free_below = free_below;
               r.collision_above = collision_above;
@@ -1192,6 +1278,7 @@ PYBIND11_MODULE (_core, m)
               r.surface_ladder = surface_ladder;
               r.surface_calibrated = surface_calibrated;
               r.distance = distance;
+              r.classifier = classifier;
               return r;
             }),
             py::kw_only (), py::arg ("free_below") = dr.free_below, py::arg ("collision_above") = dr.collision_above,
@@ -1202,6 +1289,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
             py::arg ("surface_ladder") = dr.surface_ladder,
             py::arg ("surface_calibrated") = dr.surface_calibrated, py::arg ("distance") = dr.distance,
+            py::arg ("classifier") = dr.classifier,
             "Every argument defaults to the C++ CollisionRequest default.")
       .def_readwrite ("free_below", &CollisionRequest::free_below)
       .def_readwrite ("collision_above", &CollisionRequest::collision_above)
@@ -1234,6 +1322,8 @@ PYBIND11_MODULE (_core, m)
                       "(result.sample_distance). Near contact the surface layer's signed_distance is then an estimate,\n"
                       "never the first deciding point's bound (it visits every pair, as exhaustive); where the ladder's\n"
                       "separators find a sure collision, the surface layer runs for the distance alone. Default False.")
+      .def_readwrite ("classifier", &CollisionRequest::classifier,
+                      "The separators' leaf-pair classifier (ClassifierParams; a reference: request.classifier.C = 10 sets it).")
       .def ("validate", &CollisionRequest::validate, "Raises ValueError naming the first member out of range.")
       .def ("__eq__", [] (const CollisionRequest& a, const CollisionRequest& b) { return a == b; })
       .def ("__repr__", [] (const CollisionRequest& r) {
@@ -1248,7 +1338,7 @@ PYBIND11_MODULE (_core, m)
                ", surface_pooled=" + (r.surface_pooled ? "True" : "False") +
                ", surface_ladder=" + (r.surface_ladder ? "True" : "False") +
                ", surface_calibrated=" + (r.surface_calibrated ? "True" : "False") +
-               ", distance=" + (r.distance ? "True" : "False") + ")";
+               ", distance=" + (r.distance ? "True" : "False") + ", classifier=" + classifierRepr (r.classifier) + ")";
       });
 
   // --- CollisionResult ----------------------------------------------------------------------------

@@ -228,6 +228,30 @@ TEST (SurfaceModel, GivenNormalsAreKeptEvenInsideOut)
   EXPECT_NEAR (s.windingNumber (model->hierarchy (), Eigen::Vector3d (0.3, 0.0, 0.0)), 0.0, 0.05);
 }
 
+// NaN or zero marks "no normal"; an infinite component is a broken normal, refused by point
+// (it read as "none" before 2026-12-05), and only where the surface model reads normals.
+TEST (SurfaceModel, AnInfiniteNormalIsRefusedByPoint)
+{
+  auto cloud = sphere (200, 0.1, Eigen::Vector3d::Zero ());
+  cloud.points[17].normal_y = std::numeric_limits<float>::infinity ();
+  try
+  {
+    buildCloudModel (cloud, withSurface (), nullptr, nullptr, "gripper");
+    FAIL () << "an infinite normal was accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("gripper point 17 has a normal with an infinite component"), std::string::npos)
+        << e.what ();
+  }
+  cloud.points[17].normal_y = std::numeric_limits<float>::quiet_NaN ();
+  EXPECT_EQ (buildCloudModel (cloud, withSurface ())->surface ().orientation (), NormalOrientation::PointNormals);
+  cloud.points[17].normal_y = -std::numeric_limits<float>::infinity ();
+  CloudModelParams no_surface = withSurface ();
+  no_surface.surface = false;
+  EXPECT_NO_THROW (buildCloudModel (cloud, no_surface));
+}
+
 TEST (SurfaceModel, ViewpointOrientsASheetTowardTheSensor)
 {
   for (const float side : {1.0f, -1.0f})

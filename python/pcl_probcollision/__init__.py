@@ -13,12 +13,16 @@ Pose batches over Dask workers: pcl_probcollision.dask (needs python3-distribute
 """
 from ._core import (  # noqa: F401
     AnsweredBy,
+    ClassifierParams,
     CloudModel,
     CloudModelParams,
     CollisionRequest,
     CollisionResult,
+    KernelMode,
+    Loss,
     NormalOrientation,
     SensorNoiseModel,
+    TrainingMode,
     TraversalMode,
     Verdict,
     build_model,
@@ -40,12 +44,16 @@ from ._core import (  # noqa: F401
 
 __all__ = [
     "AnsweredBy",
+    "ClassifierParams",
     "CloudModel",
     "CloudModelParams",
     "CollisionRequest",
     "CollisionResult",
+    "KernelMode",
+    "Loss",
     "NormalOrientation",
     "SensorNoiseModel",
+    "TrainingMode",
     "TraversalMode",
     "Verdict",
     "build_model",

@@ -84,6 +84,42 @@ class CloudModelParams:
         # n_min None: min(8, n_max), as pcd_collision's -nmax sets it.
     def validate(self) -> None: ...
 
+class KernelMode(enum.IntEnum):
+    Linear: int
+    RFF: int
+    Ladder: int
+
+class TrainingMode(enum.IntEnum):
+    Standard: int
+    Robust: int
+
+class Loss(enum.IntEnum):
+    SquaredHinge: int
+    Huber: int
+
+class ClassifierParams:
+    """The separators' leaf-pair classifier (METHOD.md 5.7); CollisionRequest.classifier."""
+    kernel: KernelMode
+    training: TrainingMode
+    confidence: float
+    gamma_cap: float
+    C: float
+    rbf_gamma: float
+    rff_features: int
+    rff_features_large: int
+    rff_seed: int
+    ladder_depth_sigmas: float
+    ladder_fraction: float
+    exact_points_in_maximum: bool
+    max_iterations: int
+    loss: Loss
+    def __init__(self, *, kernel: KernelMode = ..., training: TrainingMode = ..., confidence: float = ...,
+                 gamma_cap: float = ..., C: float = ..., rbf_gamma: float = ..., rff_features: int = ...,
+                 rff_features_large: int = ..., rff_seed: int = ..., ladder_depth_sigmas: float = ...,
+                 ladder_fraction: float = ..., exact_points_in_maximum: bool = ..., max_iterations: int = ...,
+                 loss: Loss = ...) -> None: ...
+    def validate(self) -> None: ...
+
 class CollisionRequest:
     free_below: float
     collision_above: float
@@ -101,12 +137,14 @@ class CollisionRequest:
     surface_ladder: bool
     surface_calibrated: bool
     distance: bool
+    classifier: ClassifierParams
     def __init__(self, *, free_below: float = ..., collision_above: float = ..., exhaustive: bool = ...,
                  per_point: bool = ..., enable_timings: bool = ..., traversal: TraversalMode = ...,
                  rho_min: float = ..., seed: int = ..., expanded_k_sigma: float = ...,
                  defer_kernel_fits: bool = ..., max_leaf_fits: int = ..., surface: bool = False,
                  surface_pooled: bool = False, surface_ladder: bool = False,
-                 surface_calibrated: bool = False, distance: bool = False) -> None: ...
+                 surface_calibrated: bool = False, distance: bool = False,
+                 classifier: ClassifierParams = ...) -> None: ...
     def validate(self) -> None: ...
 
 class CollisionResult:

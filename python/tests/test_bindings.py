@@ -613,6 +613,10 @@ def test_surface_normals_and_orientation_options(sheets):
         pc.build_model(a, normals=np.zeros((len(a), 2)))
     with pytest.raises(ValueError, match="unit length"):
         pc.build_model(a, normals=np.tile([0.0, 0.0, 2.0], (len(a), 1)))
+    broken = np.tile([0.0, 0.0, 1.0], (len(a), 1))
+    broken[4, 1] = np.inf
+    with pytest.raises(ValueError, match="point 4 has a normal with an infinite component"):
+        pc.build_model(a, params=SURFACE, normals=broken)
     with pytest.raises(TypeError, match="normals"):
         pc.build_model(a, normals=np.zeros((len(a), 3), dtype=np.int32))
 
@@ -1175,11 +1179,12 @@ def test_params_and_request_take_every_attribute_as_a_keyword_and_show_it():
     derived = {"noise_resolution_gated", "noise_resolution_whole_cloud"}
     scope = {"CloudModelParams": pc.CloudModelParams, "CollisionRequest": pc.CollisionRequest,
              "SensorNoiseModel": pc.SensorNoiseModel, "NormalOrientation": pc.NormalOrientation,
-             "TraversalMode": pc.TraversalMode}
-    for cls in (pc.CloudModelParams, pc.CollisionRequest):
+             "TraversalMode": pc.TraversalMode, "ClassifierParams": pc.ClassifierParams,
+             "KernelMode": pc.KernelMode, "TrainingMode": pc.TrainingMode, "Loss": pc.Loss}
+    for cls in (pc.CloudModelParams, pc.CollisionRequest, pc.ClassifierParams):
         default = cls()
         names = [n for n in dir(cls) if not n.startswith("_") and n not in derived and not callable(getattr(default, n))]
-        assert len(names) >= 16, names
+        assert len(names) >= 14, names
         for n in names:
             made = cls(**{n: getattr(default, n)})  # TypeError for a member that is no keyword
             assert f"{n}=" in repr(made), (cls.__name__, n, repr(made))
@@ -1225,3 +1230,31 @@ def test_a_viewpoint_that_is_not_finite_is_refused():
         pc.build_model(GOOD, viewpoint=[np.inf, 0, 0, 1, 0, 0, 0])
     with pytest.raises(ValueError, match="viewpoint: value 5 is not finite"):
         pc.build_model(GOOD, viewpoint=[0, 0, 0, 1, np.nan, 0, 0])
+
+
+def test_the_classifier_is_a_keyword_of_the_request_and_reaches_the_query(table, gripper_patch):
+    # CollisionRequest.classifier (kernel, training, C, kappa, ...) was not bound: a Python request
+    # always fitted with the C++ defaults (2026-12-04 pass). It is now a ClassifierParams, checked
+    # by validate() and by the query, and held by reference (request.classifier.C = 10 sets it).
+    default = pc.ClassifierParams()
+    assert (default.kernel, default.training, default.loss) == \
+        (pc.KernelMode.Ladder, pc.TrainingMode.Robust, pc.Loss.SquaredHinge)
+    assert (default.confidence, default.C, default.rff_features) == (0.9, 1000.0, 256)
+    r = pc.CollisionRequest()
+    r.classifier.C = 10.0
+    assert r.classifier.C == 10.0 and r.classifier != default
+    with pytest.raises(ValueError, match="confidence"):
+        pc.CollisionRequest(classifier=pc.ClassifierParams(confidence=0.4)).validate()
+    with pytest.raises(ValueError, match="confidence"):
+        pc.collide(table, gripper_patch, translation(0.1, 0.1, 0.004),
+                   pc.CollisionRequest(classifier=pc.ClassifierParams(confidence=0.4)))
+    # The paper's plain SVM (Standard training) against the chance-constrained one, near contact:
+    # a different fit, so a different P (exhaustive and per point, every pair's fit counts).
+    T = translation(0.1, 0.1, 0.004)
+    robust = pc.collide(table, gripper_patch, T, pc.CollisionRequest(exhaustive=True, per_point=True))
+    plain = pc.collide(table, gripper_patch, T, pc.CollisionRequest(
+        exhaustive=True, per_point=True, classifier=pc.ClassifierParams(training=pc.TrainingMode.Standard)))
+    assert robust.ok and plain.ok
+    assert not np.array_equal(robust.probabilities_b, plain.probabilities_b)
+    again = pc.collide(table, gripper_patch, T, pc.CollisionRequest(exhaustive=True, per_point=True))
+    np.testing.assert_array_equal(robust.probabilities_b, again.probabilities_b)

@@ -71,6 +71,15 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       throw pcl::BadArgumentException (err.str ());
     }
     max_abs = std::max (max_abs, m);
+    // NaN or zero marks a point without a normal (PCL's convention); an infinite component is a
+    // broken normal, which read as "none" would silently drop what the caller gave.
+    if constexpr (pcl::traits::has_normal_v<PointT>)
+      if (params.surface && (std::isinf (p.normal_x) || std::isinf (p.normal_y) || std::isinf (p.normal_z)))
+      {
+        err << name << " point " << at (j) << " has a normal with an infinite component (" << p.normal_x << ", "
+            << p.normal_y << ", " << p.normal_z << "); give NaN or 0 for none";
+        throw pcl::BadArgumentException (err.str ());
+      }
   }
   // Refused here, before the estimation, whose PCL base class would also print "input_ is
   // empty!" on stderr for an empty cloud.
