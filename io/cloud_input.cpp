@@ -721,6 +721,15 @@ loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>
     if (has_normals)
       for (int i = 0; i < 3; ++i)
         n[i] = static_cast<float> (file.value (j, file.normal[i]));
+    // An infinite component is a broken normal, not a missing one (as buildCloudModel rules).
+    if (std::isinf (n[0]) || std::isinf (n[1]) || std::isinf (n[2]))
+    {
+      std::ostringstream s;
+      s << "'" << path << "': point " << j << " has a normal with an infinite component (" << n[0] << ", " << n[1]
+        << ", " << n[2] << "); NaN or 0 marks a point without one";
+      error = s.str ();
+      return false;
+    }
     // No usable direction (non-finite or zero): NaN, which the surface model orients from the
     // point's neighbours.
     if (!n.allFinite () || n.isZero ())

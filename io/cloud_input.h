@@ -45,8 +45,9 @@ bool loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, 
 /** \brief loadCloud (the same reader, checks and messages) with the file's normals: when the file
   * has all of normal_x normal_y normal_z (any numeric type, converted; a PLY's nx ny nz as PCL's
   * PLY reader names them), has_normals is true and each point gets its stored normal as it is (not
-  * normalized); a non-finite or zero one becomes NaN, a point without a normal, which the surface
-  * model orients from its neighbours (buildCloudModel<PointNormal>). Without normal fields
+  * normalized); a NaN or zero one becomes NaN, a point without a normal, which the surface
+  * model orients from its neighbours (buildCloudModel<PointNormal>); one with an infinite
+  * component is refused, naming the file and the point. Without normal fields
   * has_normals is false and every normal is NaN. False with a reason naming the file and the
   * missing field when only some of the three are there (e.g. normal_x alone). Curvature is 0. */
 bool loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>& cloud, bool& has_normals,

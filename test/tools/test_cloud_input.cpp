@@ -11,7 +11,9 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 using pcl_probcollision::io::loadCloud;
@@ -75,6 +77,35 @@ TEST_F (CloudInput, PcdNormalsAreLoadedWithTheirValues)
   ASSERT_EQ (xyz.size (), 4u);
   for (std::size_t i = 0; i < 4; ++i)
     EXPECT_EQ (xyz[i].getVector3fMap (), cloud[i].getVector3fMap ()) << i;
+}
+
+// An infinite normal component is a broken normal, not a missing one: refused naming the file
+// and the point (it became NaN, "no normal", without a word), in ascii and binary files alike.
+TEST_F (CloudInput, AnInfiniteNormalIsRefusedNamingThePoint)
+{
+  const std::string header = "VERSION 0.7\nFIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n"
+                             "TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\n";
+  writeFile (dir_ / "a.pcd", header + kHeaderTail + "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 -inf 1\n3 0 0 0 0 1\n");
+  std::string data;
+  for (int i = 0; i < 4; ++i)
+  {
+    const float p[6] = {1.0f * i, 0.0f, 0.0f, i == 1 ? std::numeric_limits<float>::infinity () : 0.0f, 0.0f, 1.0f};
+    data.append (reinterpret_cast<const char*> (p), sizeof (p));
+  }
+  writeFile (dir_ / "b.pcd", header + "WIDTH 4\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA binary\n" + data);
+  for (const auto& [name, point] : {std::pair<const char*, int> {"a.pcd", 2}, {"b.pcd", 1}})
+  {
+    pcl::PointCloud<pcl::PointNormal> cloud;
+    bool has_normals = false;
+    std::string error;
+    EXPECT_FALSE (loadCloudWithNormals (path (name), cloud, has_normals, error)) << name;
+    EXPECT_NE (error.find (path (name) + "': point " + std::to_string (point) + " has a normal with an infinite component"),
+               std::string::npos)
+        << error;
+    // Without normals (no -surface) the file's normals are not read, and it loads.
+    pcl::PointCloud<pcl::PointXYZ> xyz;
+    EXPECT_TRUE (loadCloud (path (name), xyz, error)) << error;
+  }
 }
 
 // Integer normal fields are converted like x y z of any type; a binary file reads the same.
