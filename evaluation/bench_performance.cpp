@@ -487,7 +487,7 @@ BENCHMARK (BM_Batch)->Arg (1)->Arg (2)->Unit (benchmark::kMillisecond)->Iteratio
 } // namespace
 
 // The environment's settings are read before any benchmark runs, so that a bad value is one line
-// and exit 2 (before 2026-12-05 it was an uncaught exception out of a benchmark: "terminate called").
+// and exit 2 (until 2026-12-04 it was an uncaught exception out of a benchmark: "terminate called").
 int
 main (int argc, char** argv)
 {

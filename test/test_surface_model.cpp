@@ -229,7 +229,7 @@ TEST (SurfaceModel, GivenNormalsAreKeptEvenInsideOut)
 }
 
 // NaN or zero marks "no normal"; an infinite component is a broken normal, refused by point
-// (it read as "none" before 2026-12-05), and only where the surface model reads normals.
+// (it read as "none" until 2026-12-04), and only where the surface model reads normals.
 TEST (SurfaceModel, AnInfiniteNormalIsRefusedByPoint)
 {
   auto cloud = sphere (200, 0.1, Eigen::Vector3d::Zero ());
