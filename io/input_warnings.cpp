@@ -149,6 +149,19 @@ modelWarning (const InputFacts& in, const std::string& model_warning)
 }
 
 std::string
+openMeshWarning (const std::string& path, bool closed, const std::string& orientation_option)
+{
+  if (closed)
+    return {};
+  return formatted ("mesh '%s' is not closed (an edge does not border exactly two triangles wound oppositely): the "
+                    "surface layer takes its faces to enclose an inside all the same, so inside an open container (a "
+                    "bin, a shelf) the space its walls surround reads inside. For such a container give %s propagate, "
+                    "which makes its surface two-sided; a solid whose mesh merely has cracks or T-junctions is "
+                    "better left as it is",
+                    path.c_str (), orientation_option.c_str ());
+}
+
+std::string
 betweenSamplesWarning (bool both_meshes, bool free, std::size_t leaf_pairs_tested, const std::string& where,
                        double spacing)
 {

@@ -81,6 +81,13 @@ std::string roundingWarning (const InputFacts& in);
   * when roundingWarning (in) already said it of the file. */
 std::string modelWarning (const InputFacts& in, const std::string& model_warning);
 
+/** \brief The warning for a mesh whose faces the surface layer takes as enclosing an inside
+  * (-surface, oriented by its faces) although the mesh is not closed (isClosedMesh false): inside
+  * an open container the space its walls half-enclose reads inside (a box resting in an open bin
+  * read collision, 0.45 m deep). orientation_option names the option that makes its surface
+  * two-sided instead (-orientation_a or -orientation_b). Empty for a closed mesh. */
+std::string openMeshWarning (const std::string& path, bool closed, const std::string& orientation_option);
+
 /** \brief The warning for a "free" answer (where: "pose 3", "the pose") when both inputs are
   * meshes sampled spacing apart and their samples came within reach (leaf pairs were tested): a
   * part thinner than the spacing crossing a thin wall passes between samples. Empty otherwise.

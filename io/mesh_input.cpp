@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "mesh_input.h"
+#include "mesh_sampling.h"
 #include "cloud_input.h"
 #include "quiet_pcl_console.h"
 
@@ -469,6 +470,14 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
   {
     error = "'" + path + "' has no triangles (" + std::to_string (mesh.vertices.size ()) +
             " vertices; a mesh input needs faces)";
+    return false;
+  }
+  // Triangles whose vertices are collinear or repeated bound nothing: sampled, such a mesh was its
+  // vertices alone, read as a cloud without noise.
+  if (!(meshArea (mesh) > 0.0))
+  {
+    error = "'" + path + "' has no triangle with an area (" + std::to_string (mesh.triangles.size ()) +
+            " triangles, every one with collinear or repeated vertices; a mesh input needs faces)";
     return false;
   }
   return true;

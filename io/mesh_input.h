@@ -21,7 +21,7 @@ struct TriangleMesh
 
 /** \brief Loads a .ply, .obj, .stl or .vtk mesh (extension case-insensitive). False with a
   * reason in error (naming the file) when the file cannot be read, is malformed or truncated, has
-  * no vertex or no triangle, or refers to a missing vertex. Vertex coordinates of any numeric type
+  * no vertex, no triangle or no triangle with an area, or refers to a missing vertex. Vertex coordinates of any numeric type
   * are converted. Triangles with a non-finite vertex are dropped.
   *
   * The readers print nothing: the first call silences VTK's warnings and output window for the

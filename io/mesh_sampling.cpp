@@ -9,11 +9,15 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <cstdio>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace pcl_probcollision::io
 {
@@ -33,6 +37,34 @@ triangleArea (const TriangleMesh& mesh, const std::array<int, 3>& t)
   return 0.5 * (vertex (mesh, t[1]) - a).cross (vertex (mesh, t[2]) - a).norm ();
 }
 } // namespace
+
+bool
+isClosedMesh (const TriangleMesh& mesh)
+{
+  // Vertices welded by position: exporters split them where faces meet at a crease.
+  std::map<std::array<double, 3>, int> welded;
+  std::vector<int> id (mesh.vertices.size ());
+  for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
+    id[i] = welded.emplace (mesh.vertices[i], static_cast<int> (welded.size ())).first->second;
+  // Each directed edge once, and its reverse once.
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : mesh.triangles)
+  {
+    if (!(triangleArea (mesh, t) > 0.0))
+      continue;
+    for (int k = 0; k < 3; ++k)
+      ++edges[{id[static_cast<std::size_t> (t[k])], id[static_cast<std::size_t> (t[(k + 1) % 3])]}];
+  }
+  if (edges.empty ())
+    return false;
+  for (const auto& [edge, count] : edges)
+  {
+    const auto reverse = edges.find ({edge.second, edge.first});
+    if (count != 1 || reverse == edges.end () || reverse->second != 1)
+      return false;
+  }
+  return true;
+}
 
 double
 meshArea (const TriangleMesh& mesh)

@@ -38,6 +38,14 @@ pcl::PointCloud<pcl::PointNormal> sampleMeshWithNormals (const TriangleMesh& mes
 /** \brief Total triangle area. */
 double meshArea (const TriangleMesh& mesh);
 
+/** \brief Whether the mesh bounds a solid: with vertices at one position taken as one (a box
+  * exported with split vertices per face is closed) and triangles without area left out, every
+  * edge borders two triangles that run it in opposite directions. A bin or a box missing a face
+  * (an edge bordering one triangle), a fin (three), or faces wound inconsistently are not closed;
+  * their faces do not say where an inside is (CloudModelParams::open_surface). A closed mesh
+  * wound inward (a cavity) is closed. */
+bool isClosedMesh (const TriangleMesh& mesh);
+
 /** \brief Two meshes' sample spacing: 1/100 of the smaller bounding-box diagonal, so that the
   * smaller object (the robot, the part) is resolved whatever the scene around it; widened to
   * the spacing at which both meshes together expect kMeshPairSamples samples when it would

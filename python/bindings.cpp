@@ -1731,6 +1731,15 @@ PYBIND11_MODULE (_core, m)
          py::arg ("vertices_a"), py::arg ("triangles_a"), py::arg ("vertices_b"), py::arg ("triangles_b"),
          "pcd_collision's sample spacing when both inputs are meshes: 1/100 of the smaller bounding-box diagonal,\n"
          "or wider so that both together expect 500,000 samples.");
+  m.def ("is_closed_mesh",
+         [] (const py::object& vertices, const py::object& triangles) {
+           return pcl_probcollision::io::isClosedMesh (meshOf (vertices, triangles));
+         },
+         py::arg ("vertices"), py::arg ("triangles"),
+         "Whether the mesh bounds a solid, as pcd_collision judges it: with vertices at one position taken as one,\n"
+         "every edge of a triangle with an area borders two triangles wound oppositely. Given as normals, an open\n"
+         "mesh's face normals still enclose an inside (a box resting in a bin reads inside the bin); build an open\n"
+         "container's samples without normals (orientation=NormalOrientation.Propagate: two-sided) instead.");
   m.def ("mesh_diagonal",
          [] (const py::object& vertices, const py::object& triangles) {
            return pcl_probcollision::io::meshDiagonal (meshOf (vertices, triangles));

@@ -33,6 +33,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 namespace pcd_collision
@@ -533,6 +534,13 @@ run (int argc, char** argv)
     warn (pcl_probcollision::io::noiseWarning (in->facts));
   for (const Input* in : {&a, &b})
     warn (pcl_probcollision::io::roundingWarning (in->facts));
+  // A mesh oriented by its faces (-surface, -orientation auto or point_normals) has an inside.
+  for (const auto& [in, orientation, option] :
+       {std::tuple<const Input*, pcl_probcollision::NormalOrientation, const char*> {&a, o.orientation_a, "-orientation_a"},
+        {&b, o.orientation_b, "-orientation_b"}})
+    if (o.surface && in->kind == InputKind::Mesh && orientation != pcl_probcollision::NormalOrientation::Propagate &&
+        orientation != pcl_probcollision::NormalOrientation::Viewpoint)
+      warn (pcl_probcollision::io::openMeshWarning (in->path, pcl_probcollision::io::isClosedMesh (in->mesh), option));
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at

@@ -141,3 +141,13 @@ TEST (InputWarnings, ACloudsFactsCountAndSpanItsFinitePointsOnly)
   EXPECT_EQ (finiteCount (xyz), 2u);
   EXPECT_DOUBLE_EQ (finiteDiagonal (xyz), 5.0);
 }
+
+// An open mesh oriented by its faces still encloses an inside to the surface layer: warned of,
+// naming the file and the option that makes it two-sided; a closed one is not.
+TEST (InputWarnings, AnOpenMeshIsWarnedOfNamingTheWayOut)
+{
+  EXPECT_TRUE (openMeshWarning ("box.obj", true, "-orientation_a").empty ());
+  const std::string w = openMeshWarning ("bin.obj", false, "-orientation_b");
+  EXPECT_NE (w.find ("mesh 'bin.obj' is not closed"), std::string::npos) << w;
+  EXPECT_NE (w.find ("give -orientation_b propagate"), std::string::npos) << w;
+}

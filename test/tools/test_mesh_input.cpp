@@ -2,6 +2,7 @@
 // Mesh loading of io/ on its own, as the evaluation and the benchmarks call it (no CLI around).
 
 #include "mesh_input.h"
+#include "mesh_sampling.h"
 #include "test_files.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,7 @@
 #include <initializer_list>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 namespace fs = std::filesystem;
 using pcl_probcollision::io::TriangleMesh;
@@ -206,4 +208,39 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
       EXPECT_EQ (mesh.vertices[2], (std::array<double, 3>{0.0, 1.0, 0.0}));
     }
   }
+}
+
+// A mesh is closed when every edge borders two triangles wound oppositely, with vertices at one
+// position taken as one: a cube exported with split vertices per face is closed, an open box (a
+// bin) or a cube with one triangle flipped is not, and an inside-out cube (a cavity) is.
+TEST_F (MeshInput, ClosedMeshesAreTheOnesThatBoundASolid)
+{
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+  // Outward quads; the first is the top (z = 1).
+  const std::string top = "f 5 6 7 8\n", rest = "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  test_files::writeFile (dir_ / "cube.obj", v + top + rest);
+  test_files::writeFile (dir_ / "bin.obj", v + rest);
+  test_files::writeFile (dir_ / "flipped_face.obj", v + "f 8 7 6 5\n" + rest);
+  test_files::writeFile (dir_ / "inside_out.obj", v + "f 8 7 6 5\nf 2 3 4 1\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n");
+  // The top as its own quad on four vertices of its own, as exporters split them at creases.
+  test_files::writeFile (dir_ / "split.obj", v + "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 9 10 11 12\n" + rest);
+  for (const auto& [name, closed] : {std::pair<const char*, bool> {"cube.obj", true}, {"bin.obj", false},
+                                     {"flipped_face.obj", false}, {"inside_out.obj", true}, {"split.obj", true}})
+  {
+    TriangleMesh mesh;
+    std::string error;
+    ASSERT_TRUE (pcl_probcollision::io::loadTriangleMesh ((dir_ / name).string (), mesh, error)) << error;
+    EXPECT_EQ (pcl_probcollision::io::isClosedMesh (mesh), closed) << name;
+  }
+}
+
+// Triangles on collinear or repeated vertices only: refused as a mesh without faces (it was
+// sampled as its vertices alone).
+TEST_F (MeshInput, AMeshWhoseTrianglesHaveNoAreaIsRefused)
+{
+  test_files::writeFile (dir_ / "line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 1 1 2\n");
+  TriangleMesh mesh;
+  std::string error;
+  EXPECT_FALSE (pcl_probcollision::io::loadTriangleMesh ((dir_ / "line.obj").string (), mesh, error));
+  EXPECT_NE (error.find ("line.obj' has no triangle with an area (2 triangles"), std::string::npos) << error;
 }
