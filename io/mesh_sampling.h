@@ -42,8 +42,8 @@ double meshArea (const TriangleMesh& mesh);
   * exported with split vertices per face is closed) and triangles without area left out, every
   * edge borders two triangles that run it in opposite directions. A bin or a box missing a face
   * (an edge bordering one triangle), a fin (three), or faces wound inconsistently are not closed;
-  * their faces do not say where an inside is (CloudModelParams::open_surface). A closed mesh
-  * wound inward (a cavity) is closed. */
+  * their faces do not say where an inside is, and pcd_collision -surface warns of them
+  * (openMeshWarning). A closed mesh wound inward (a cavity) is closed. */
 bool isClosedMesh (const TriangleMesh& mesh);
 
 /** \brief Two meshes' sample spacing: 1/100 of the smaller bounding-box diagonal, so that the
