@@ -120,7 +120,8 @@ collideLocal (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen:
   * order. */
 bool
 collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b,
-                const CollisionRequest& request, CollisionResult& result, bool containment_only = false)
+                const CollisionRequest& request, CollisionResult& result, bool containment_only = false,
+                detail::SurfaceAnswer* answer = nullptr)
 {
   result.points_a = a.size ();
   result.points_b = b.size ();
@@ -142,6 +143,8 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
     fail (result, CollisionResult::Status::InvalidInput, errorMessage (e));
     return false;
   }
+  if (answer)
+    *answer = s;
   result.status = CollisionResult::Status::Ok;
   result.probability = s.probability;
   result.signed_distance = s.signed_distance;
@@ -189,11 +192,16 @@ addSeparators (CollisionResult& into, const CollisionResult& separators)
 /** \brief The surface layer's answer (into) pooled with the separators' on the same pair
   * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
   * reached it (else the one that did); the surface layer's distance and witness (the
-  * separators' when the surface layer reached nothing); the work of both counted. */
-void
-pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request)
+  * separators' when the surface layer reached nothing); the work of both counted. One object
+  * wholly inside the other (`contained`, found by the winding number out of every leaf's reach)
+  * is what the separators cannot see: their P = 0 then says nothing, and the surface layer's P = 1
+  * stands alone (it read contact 0.5): returns false then. */
+bool
+pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request, bool contained)
 {
-  into.probability = 0.5 * (into.probability + separators.probability);
+  const bool pooled = !(contained && separators.no_leaf_tested);
+  if (pooled)
+    into.probability = 0.5 * (into.probability + separators.probability);
   into.lower_bound = into.lower_bound || separators.lower_bound;
   addSeparators (into, separators);
   auto mean = [] (std::vector<float>& values, const std::vector<float>& other) {
@@ -203,6 +211,7 @@ pool (CollisionResult& into, const CollisionResult& separators, const CollisionR
   mean (into.probabilities_a, separators.probabilities_a);
   mean (into.probabilities_b, separators.probabilities_b);
   into.verdict = verdictFor (into.probability, request);
+  return pooled;
 }
 /** \brief CollisionRequest::distance beyond reach: the nearest samples' distance and its std,
   * the points in the query frame. */
@@ -214,13 +223,16 @@ sampleDistance (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
     return;
   const Eigen::Vector3d d = n.point_a - n.point_b;
   const double length = d.norm ();
-  double variance = 0.0;
+  const PackedCovariance& cov_a = a.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_a)];
+  const PackedCovariance& cov_b = b.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_b)];
+  double variance;
   if (length > 0.0)
   {
     const Eigen::Vector3d u = d / length;
-    variance = a.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_a)].quadratic (u) +
-               b.hierarchy ().covariances ()[static_cast<std::size_t> (n.index_b)].quadratic (T_local.linear ().transpose () * u);
+    variance = cov_a.quadratic (u) + cov_b.quadratic (T_local.linear ().transpose () * u);
   }
+  else  // coincident samples: no direction, so the mean over directions (a third of the traces)
+    variance = (double (cov_a.xx) + cov_a.yy + cov_a.zz + cov_b.xx + cov_b.yy + cov_b.zz) / 3.0;
   // Where each surface passes between its samples: the discretisation term of the surface layer,
   // 0.29 of the local spacing a side. Without it, +-2 std covered the exact (mesh) distance in
   // 78 % of bench_performance's poses beyond reach (the samples' distance reads long by a median
@@ -321,8 +333,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         result = std::move (separators);
         from_surface = pooled = false;
       }
-      else if (pooled)
-        pool (result, separators, request);
+      else if (pooled)  // the separators reached a leaf pair here
+        pool (result, separators, request, false);
       else
         addSeparators (result, separators);
     }
@@ -364,12 +376,18 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
   }
   else
   {
-    if (surface ? !collideSurface (a, b, T_local, request, result)
+    detail::SurfaceAnswer answer;
+    if (surface ? !collideSurface (a, b, T_local, request, result, false, &answer)
                 : !collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, result, classifier))
       return false;
     surface_ran = surface;
     surface_reached = surface && !result.no_leaf_tested;
-    if (pooled)
+    // Reaching no point, the surface layer may still have met leaves whose samples carry no
+    // normal (a cloud of coincident, collinear or a few points has no surface): it cannot judge
+    // them, and its P = 0 would read "free" (coincident clouds of 1-100 points did). The
+    // separators answer then, as in the ladder.
+    const bool defer = surface && !surface_reached && answer.unjudged;
+    if (pooled || defer)
     {
       CollisionResult separators;
       if (!collideLocal (a.hierarchy (), b.hierarchy (), T_local, request, separators, classifier))
@@ -377,7 +395,14 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         result = separators;
         return false;
       }
-      pool (result, separators, request);
+      if (defer)
+      {
+        separators.bv_tests += result.bv_tests;
+        result = std::move (separators);
+        from_surface = pooled = false;
+      }
+      else
+        pooled = pool (result, separators, request, answer.contained);
     }
   }
   result.answered_by = !from_surface ? AnsweredBy::Separators : pooled ? AnsweredBy::Pooled : AnsweredBy::SurfaceLayer;

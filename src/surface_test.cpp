@@ -1098,7 +1098,10 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         scratch.pool.add ((scratch.cache[sj].position - center).norm (), j);
       }
     if (scratch.pool.empty ())
+    {
+      answer.unjudged = true;
       continue;
+    }
     scratch.outside.clear ();
     for (const int i : q_bvh.indices (q_bvh.node (q_leaf)))
     {

@@ -47,6 +47,10 @@ struct SurfaceAnswer
   /** \brief Stopped at the first point with P_in > collision_above (decision mode): P and the
     * distance are then bounds (the deepest point may lie elsewhere). */
   bool stopped_early = false;
+  /** \brief A query leaf within reach met only samples without a normal (a cloud of coincident,
+    * collinear or too few points has no surface there): its points were not judged, so a P of
+    * 0 with reached false does not mean "far". */
+  bool unjudged = false;
   std::size_t leaf_pairs = 0;    ///< leaf pairs within reach (their boxes; collide() counts them where a point was reached)
   std::size_t points_tested = 0; ///< point-against-surface evaluations, both sides
   std::size_t bv_tests = 0;      ///< node pairs tested by its traversal

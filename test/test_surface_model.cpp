@@ -822,6 +822,19 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   EXPECT_FALSE (inside.unobserved);          // inside a closed surface, not behind a sheet
   EXPECT_EQ (outside.verdict, Verdict::Free);
   EXPECT_TRUE (outside.no_leaf_tested);
+  // Pooled: the separators reach no leaf pair here, and their P = 0 says nothing. It was
+  // averaged with the containment's P = 1 into contact 0.5 (a probe, 2026-12-04); the surface
+  // layer's answer stands alone now.
+  CollisionRequest pooled = surfaceRequest (), separators = surfaceRequest ();
+  pooled.surface_pooled = true;
+  separators.surface = false;
+  CollisionResult by_separators, by_pool;
+  ASSERT_TRUE (collide (*ball, *big, shift (0.2, 0.1, 0.0), separators, by_separators));
+  ASSERT_TRUE (by_separators.no_leaf_tested) << "the case needs separators that reach nothing";
+  ASSERT_TRUE (collide (*ball, *big, shift (0.2, 0.1, 0.0), pooled, by_pool));
+  EXPECT_EQ (by_pool.verdict, Verdict::InCollision);
+  EXPECT_EQ (by_pool.probability, inside.probability);
+  EXPECT_EQ (by_pool.answered_by, AnsweredBy::SurfaceLayer);
 }
 
 namespace
@@ -1188,8 +1201,9 @@ TEST (SurfaceLayer, LadderAnswersAsTheRungItReaches)
 }
 
 // Found probing as a new user (2026-12-03): two coincident clouds of two points each. The
-// separators read contact (P = 0.5); the surface layer reaches no point of either and reads
-// P = 0, and the ladder used to hand that "free" on. It now keeps the separators' answer.
+// separators read contact (P = 0.5); the surface layer reaches no point of either and read
+// P = 0, and the ladder used to hand that "free" on. It now keeps the separators' answer (as the
+// surface layer alone does since 2026-12-04: CloudsWithoutASurfaceAreAnsweredByTheSeparators).
 TEST (SurfaceLayer, LadderKeepsTheSeparatorsWhereTheSurfaceLayerReachesNothing)
 {
   pcl::PointCloud<pcl::PointXYZ> two;
@@ -1202,7 +1216,7 @@ TEST (SurfaceLayer, LadderKeepsTheSeparatorsWhereTheSurfaceLayerReachesNothing)
   ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.surface, rs));
   ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.separators, rc));
   ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.ladder, rl));
-  ASSERT_TRUE (rs.no_leaf_tested) << "the case needs a surface layer that reaches nothing";
+  ASSERT_EQ (rs.answered_by, AnsweredBy::Separators) << "the case needs a surface layer that reaches nothing";
   ASSERT_FALSE (rc.no_leaf_tested);
   EXPECT_EQ (rc.verdict, Verdict::InContact);
   EXPECT_EQ (rl.answered_by, AnsweredBy::Separators);
@@ -1210,33 +1224,46 @@ TEST (SurfaceLayer, LadderKeepsTheSeparatorsWhereTheSurfaceLayerReachesNothing)
   EXPECT_DOUBLE_EQ (rl.probability, rc.probability);
 }
 
-// A surface-layer answer whose leaf boxes met within reach but none of whose points came within
-// reach of the other surface counted the pairs: `leaf pairs 1` beside `witness: none (no leaf
-// pair tested)`, JSON `no_leaf_tested: true` with `leaf_pairs: 1` (a probe, 2026-12-03). Those
-// pairs tested nothing: with no_leaf_tested the count is 0, their work in bv_tests alone, as the
-// ladder counts a surface layer that reached nothing.
-TEST (SurfaceLayer, AnAnswerThatReachedNoPointCountsNoLeafPair)
+// Clouds with no surface: coincident copies of one point, or two points (no sample has a normal).
+// The surface layer meets their leaves but can judge no point against samples without a normal,
+// and it read "free" (P = 0, "no leaf pair tested") where the separators read contact (a probe,
+// 2026-12-04: coincident clouds of 1-100 identical points). It now hands the query to the
+// separators, alone and pooled, as the ladder does; their leaf pair is counted.
+TEST (SurfaceLayer, CloudsWithoutASurfaceAreAnsweredByTheSeparators)
 {
-  pcl::PointCloud<pcl::PointXYZ> two;  // two coincident clouds of two points: no point has a normal
-  two.push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
-  two.push_back (pcl::PointXYZ (0.01f, 0.0f, 0.0f));
-  const auto model = buildCloudModel (two, noisy (0.001));
-  for (const bool exhaustive : {false, true})
+  std::vector<pcl::PointCloud<pcl::PointXYZ>> clouds;
+  for (const int n : {1, 5, 100})
+    clouds.emplace_back (static_cast<std::uint32_t> (n), 1, pcl::PointXYZ (0.3f, -0.2f, 1.0f));
+  clouds.emplace_back ();
+  clouds.back ().push_back (pcl::PointXYZ (0.0f, 0.0f, 0.0f));
+  clouds.back ().push_back (pcl::PointXYZ (0.01f, 0.0f, 0.0f));
+  for (const auto& cloud : clouds)
   {
-    const Answerers q (exhaustive);
-    CollisionResult rs, rp;
-    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.surface, rs));
-    EXPECT_TRUE (rs.no_leaf_tested);
-    EXPECT_EQ (rs.leaf_pairs_tested, 0u);
-    EXPECT_GT (rs.bv_tests, 0u);  // the boxes met
-    EXPECT_EQ (rs.witness_side, 0);
-    EXPECT_EQ (rs.probability, 0.0);
-    // Pooled with the separators, which tested their pair: theirs is the only count.
-    CollisionResult rc;
-    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.separators, rc));
-    ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.pooled, rp));
-    EXPECT_FALSE (rp.no_leaf_tested);
-    EXPECT_EQ (rp.leaf_pairs_tested, rc.leaf_pairs_tested);
+    SCOPED_TRACE (std::to_string (cloud.size ()) + " points");
+    const auto model = buildCloudModel (cloud, noisy (0.001));
+    ASSERT_FALSE (model->surface ().empty ());
+    for (const bool exhaustive : {false, true})
+    {
+      const Answerers q (exhaustive);
+      CollisionResult rs, rp, rc;
+      ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.separators, rc));
+      ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.surface, rs));
+      ASSERT_TRUE (collide (*model, *model, Eigen::Isometry3d::Identity (), q.pooled, rp));
+      ASSERT_FALSE (rc.no_leaf_tested);
+      EXPECT_NE (rc.verdict, Verdict::Free);
+      for (const CollisionResult* r : {&rs, &rp})
+      {
+        EXPECT_EQ (r->answered_by, AnsweredBy::Separators);
+        EXPECT_EQ (r->verdict, rc.verdict);
+        EXPECT_DOUBLE_EQ (r->probability, rc.probability);
+        EXPECT_FALSE (r->no_leaf_tested);
+        EXPECT_EQ (r->leaf_pairs_tested, rc.leaf_pairs_tested);
+        EXPECT_GT (r->bv_tests, rc.bv_tests);  // the surface layer's node tests counted too
+        ASSERT_EQ (r->probabilities_a.size (), cloud.size ());
+        for (std::size_t i = 0; i < cloud.size (); ++i)
+          EXPECT_EQ (r->probabilities_a[i], rc.probabilities_a[i]) << "point " << i;
+      }
+    }
   }
 }
 

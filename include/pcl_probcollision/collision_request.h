@@ -79,7 +79,9 @@ struct CollisionRequest
     * propagation, it is not yet as accurate as the separators (docs/RESULTS.md, issue #16). */
   bool surface = false;
   /** \brief With surface on: also run the separators and answer the mean of the two
-    * probabilities (a linear opinion pool), per point and for the pair. The two see different
+    * probabilities (a linear opinion pool), per point and for the pair; where the surface layer
+    * finds one object wholly inside the other and the separators reach no leaf pair (their P = 0
+    * says nothing there), its answer stands alone (answered_by SurfaceLayer). The two see different
     * things: the surface layer whether a point lies behind the other's surface, the separators
     * whether two sheets cross (thin parts, where noise leaves no inside). The signed distance
     * stays the surface layer's. Experimental, off by default; the rule was chosen on evaluation

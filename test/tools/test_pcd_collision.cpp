@@ -277,25 +277,29 @@ TEST_F (PcdCollisionTool, JsonFieldsAndTypes)
   EXPECT_EQ (j["parameters"]["sigma_a"].type, T::Null);  // a mesh gets no noise
 }
 
-// The surface layer on two coincident clouds of two points (no point has a normal, so none comes
-// within reach of the other surface, though their leaf boxes meet): the summary said `leaf pairs 1`
-// beside `witness: none (no leaf pair tested)`, the JSON `no_leaf_tested` true with `leaf_pairs`
-// 1 (a probe, 2026-12-03). No leaf pair was tested: both now say 0.
-TEST_F (PcdCollisionTool, ASurfaceAnswerThatReachedNoPointReportsNoLeafPair)
+// The surface layer on two coincident clouds of two points (no point has a normal): it read
+// `free P = 0` with `witness: none (no leaf pair tested)` where the separators read contact (a
+// probe, 2026-12-04; coincident clouds of 1-100 identical points did the same). The separators
+// answer it now, and -distance gives the coincident nearest samples' 0 with both clouds' spread
+// (it read `d = +0.0000 +- 0.0000`).
+TEST_F (PcdCollisionTool, CloudsWithoutASurfaceAreAnsweredByTheSeparators)
 {
   const std::string two = (dir_ / "two.pcd").string ();
   writeFile (two, "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
                   "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 0\n0.01 0 0\n");
-  const auto v = runJson ({two, two, "-sigma", "0.001", "-surface"});
+  const auto separators = runJson ({two, two, "-sigma", "0.001"});
+  const auto v = runJson ({two, two, "-sigma", "0.001", "-surface", "-distance"});
   ASSERT_EQ (v.size (), 1u);
-  EXPECT_TRUE (v[0]["no_leaf_tested"].boolean);
-  EXPECT_EQ (v[0]["leaf_pairs"].number, 0.0);
-  EXPECT_GT (v[0]["bv_tests"].number, 0.0);  // the boxes met
-  EXPECT_EQ (v[0]["witness"].type, Value::Type::Null);
-  const ToolRun r = run ({two, two, "-sigma", "0.001", "-surface"});
-  ASSERT_EQ (r.status, 0) << r.err;
-  EXPECT_NE (r.out.find ("; leaf pairs 0;"), std::string::npos) << r.out;
-  EXPECT_NE (r.out.find ("witness: none (no leaf pair tested)"), std::string::npos) << r.out;
+  ASSERT_EQ (separators.size (), 1u);
+  EXPECT_EQ (v[0]["answered_by"].text, "separators");
+  EXPECT_EQ (v[0]["verdict"].text, "contact");
+  EXPECT_EQ (v[0]["probability"].number, separators[0]["probability"].number);
+  EXPECT_FALSE (v[0]["no_leaf_tested"].boolean);
+  EXPECT_EQ (v[0]["leaf_pairs"].number, separators[0]["leaf_pairs"].number);
+  EXPECT_EQ (v[0]["signed_distance"].number, 0.0);
+  // At least both sensors' spread (each sample's covariance adds its neighbour's spacing).
+  EXPECT_GE (v[0]["signed_distance_std"].number, 0.99 * std::sqrt (2.0) * 0.001);
+  EXPECT_TRUE (std::isfinite (v[0]["signed_distance_std"].number));
 }
 
 // One object wholly inside the other (a 4 cm cube in the middle of a closed 40 cm box, both
