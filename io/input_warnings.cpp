@@ -162,6 +162,19 @@ openMeshWarning (const std::string& path, bool closed, const std::string& orient
 }
 
 std::string
+insideOutMeshWarning (const std::string& path, bool closed, double signed_volume, const std::string& orientation_option,
+                      const std::string& closed_option)
+{
+  if (!closed || !(signed_volume < 0.0))
+    return {};
+  return formatted ("mesh '%s' is closed but its faces wind inward (it encloses %g cubic units negatively): the surface "
+                    "layer takes the space around it as its inside, so a part within it reads free. Right for a "
+                    "cavity (a closed room); for a solid exported inside out, reverse its faces or give %s propagate "
+                    "%s, which orient it outward",
+                    path.c_str (), -signed_volume, orientation_option.c_str (), closed_option.c_str ());
+}
+
+std::string
 betweenSamplesWarning (bool both_meshes, bool free, std::size_t leaf_pairs_tested, const std::string& where,
                        double spacing)
 {

@@ -88,6 +88,14 @@ std::string modelWarning (const InputFacts& in, const std::string& model_warning
   * two-sided instead (-orientation_a or -orientation_b). Empty for a closed mesh. */
 std::string openMeshWarning (const std::string& path, bool closed, const std::string& orientation_option);
 
+/** \brief The warning for a closed mesh whose faces wind inward (meshSignedVolume < 0), oriented
+  * by its faces (-surface): the surface layer takes the space around it as its inside, so a part
+  * within it reads free (right for a cavity, a closed room; wrong for a solid exported inside
+  * out). orientation_option and closed_option name the options that orient it outward instead.
+  * Empty for a mesh that is not closed (openMeshWarning's case) or whose volume is positive. */
+std::string insideOutMeshWarning (const std::string& path, bool closed, double signed_volume,
+                                  const std::string& orientation_option, const std::string& closed_option);
+
 /** \brief The warning for a "free" answer (where: "pose 3", "the pose") when both inputs are
   * meshes sampled spacing apart and their samples came within reach (leaf pairs were tested): a
   * part thinner than the spacing crossing a thin wall passes between samples. Empty otherwise.

@@ -67,6 +67,22 @@ isClosedMesh (const TriangleMesh& mesh)
 }
 
 double
+meshSignedVolume (const TriangleMesh& mesh)
+{
+  if (mesh.vertices.empty ())
+    return 0.0;
+  // About the centroid, so that a mesh far from its origin keeps its digits.
+  Eigen::Vector3d c = Eigen::Vector3d::Zero ();
+  for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
+    c += vertex (mesh, static_cast<int> (i));
+  c /= static_cast<double> (mesh.vertices.size ());
+  double six_volume = 0.0;
+  for (const auto& t : mesh.triangles)
+    six_volume += (vertex (mesh, t[0]) - c).dot ((vertex (mesh, t[1]) - c).cross (vertex (mesh, t[2]) - c));
+  return six_volume / 6.0;
+}
+
+double
 meshArea (const TriangleMesh& mesh)
 {
   double area = 0.0;

@@ -46,6 +46,12 @@ double meshArea (const TriangleMesh& mesh);
   * (openMeshWarning). A closed mesh wound inward (a cavity) is closed. */
 bool isClosedMesh (const TriangleMesh& mesh);
 
+/** \brief The volume the faces enclose by their winding (the divergence theorem, about the
+  * vertices' centroid): positive for a closed mesh wound outward, negative for one wound inward
+  * (a cavity, or a solid exported inside out; insideOutMeshWarning). Meaningful for a closed
+  * mesh only. */
+double meshSignedVolume (const TriangleMesh& mesh);
+
 /** \brief Two meshes' sample spacing: 1/100 of the smaller bounding-box diagonal, so that the
   * smaller object (the robot, the part) is resolved whatever the scene around it; widened to
   * the spacing at which both meshes together expect kMeshPairSamples samples when it would

@@ -540,7 +540,12 @@ run (int argc, char** argv)
         {&b, o.orientation_b, "-orientation_b"}})
     if (o.surface && in->kind == InputKind::Mesh && orientation != pcl_probcollision::NormalOrientation::Propagate &&
         orientation != pcl_probcollision::NormalOrientation::Viewpoint)
-      warn (pcl_probcollision::io::openMeshWarning (in->path, pcl_probcollision::io::isClosedMesh (in->mesh), option));
+    {
+      const bool closed = pcl_probcollision::io::isClosedMesh (in->mesh);
+      warn (pcl_probcollision::io::openMeshWarning (in->path, closed, option));
+      warn (pcl_probcollision::io::insideOutMeshWarning (in->path, closed, pcl_probcollision::io::meshSignedVolume (in->mesh),
+                                                         option, in == &a ? "-closed_a" : "-closed_b"));
+    }
 
   // A cloud's model does not depend on the other input. When the other is a mesh, whose
   // sampling first measures this cloud's spacing with a k-d tree of its own (serial: 0.8 s at

@@ -514,6 +514,40 @@ TEST_F (CliReliability, MeshesWithAHoleUnderTheSurfaceLayer)
   }
 }
 
+// A closed mesh wound inward (a solid exported inside out, or a cavity) under the surface layer:
+// a small cube wholly within it read free without a word (a probe, 2026-12-04). It still reads
+// free, as for a cavity, but the tool warns and names the options that orient it outward, with
+// which the cube reads collision; a mesh wound outward gets no such warning.
+TEST_F (CliReliability, AnInsideOutMeshIsWarnedOfNamingTheWayOut)
+{
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+  writeFile (dir_ / "inside_out.obj", v + "f 8 7 6 5\nf 2 3 4 1\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n");
+  writeFile (dir_ / "outward.obj", v + "f 5 6 7 8\nf 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  Cloud cube;  // a 0.2 m grid cube about the mesh's centre
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j)
+      for (int k = 0; k <= 10; ++k)
+        if (i % 10 == 0 || j % 10 == 0 || k % 10 == 0)
+          cube.push_back (pcl::PointXYZ (0.4f + 0.02f * i, 0.4f + 0.02f * j, 0.4f + 0.02f * k));
+  const std::string c = save ("cube.pcd", cube);
+  const std::string inside_out = (dir_ / "inside_out.obj").string ();
+  const Run as_is = run ({c, inside_out, "-surface", "-sigma", "0.002", "-mesh_density", "0.02"});
+  ASSERT_EQ (as_is.status, 0) << as_is.err;
+  ASSERT_EQ (as_is.json.size (), 1u) << as_is.out;
+  EXPECT_EQ (as_is.json[0]["verdict"].text, "free");
+  EXPECT_NE (as_is.err.find ("warning: mesh '" + inside_out + "' is closed but its faces wind inward"), std::string::npos)
+      << as_is.err;
+  EXPECT_NE (as_is.err.find ("give -orientation_b propagate -closed_b"), std::string::npos) << as_is.err;
+  const Value outward = expectAnswer ({c, inside_out, "-surface", "-sigma", "0.002", "-mesh_density", "0.02",
+                                       "-orientation_b", "propagate", "-closed_b"});
+  EXPECT_EQ (outward["verdict"].text, "collision");
+  const Run solid = run ({c, (dir_ / "outward.obj").string (), "-surface", "-sigma", "0.002", "-mesh_density", "0.02"});
+  ASSERT_EQ (solid.status, 0) << solid.err;
+  EXPECT_EQ (solid.err.find ("wind inward"), std::string::npos) << solid.err;
+  ASSERT_EQ (solid.json.size (), 1u) << solid.out;
+  EXPECT_EQ (solid.json[0]["verdict"].text, "collision");
+}
+
 // SIGINT during a long batch: the tool dies of SIGINT, prints whole lines only, leaves no file.
 TEST_F (CliReliability, SigintDuringABatchLeavesNothingBehind)
 {

@@ -151,3 +151,13 @@ TEST (InputWarnings, AnOpenMeshIsWarnedOfNamingTheWayOut)
   EXPECT_NE (w.find ("mesh 'bin.obj' is not closed"), std::string::npos) << w;
   EXPECT_NE (w.find ("give -orientation_b propagate"), std::string::npos) << w;
 }
+
+TEST (InputWarnings, AnInsideOutMeshIsWarnedOfNamingTheWayOut)
+{
+  EXPECT_TRUE (insideOutMeshWarning ("box.obj", true, 1.0, "-orientation_a", "-closed_a").empty ());
+  EXPECT_TRUE (insideOutMeshWarning ("bin.obj", false, -1.0, "-orientation_a", "-closed_a").empty ());
+  const std::string w = insideOutMeshWarning ("cavity.obj", true, -2.5, "-orientation_b", "-closed_b");
+  EXPECT_NE (w.find ("mesh 'cavity.obj' is closed but its faces wind inward (it encloses 2.5 cubic units negatively)"),
+             std::string::npos) << w;
+  EXPECT_NE (w.find ("give -orientation_b propagate -closed_b"), std::string::npos) << w;
+}

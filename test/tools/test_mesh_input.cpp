@@ -231,6 +231,10 @@ TEST_F (MeshInput, ClosedMeshesAreTheOnesThatBoundASolid)
     std::string error;
     ASSERT_TRUE (pcl_probcollision::io::loadTriangleMesh ((dir_ / name).string (), mesh, error)) << error;
     EXPECT_EQ (pcl_probcollision::io::isClosedMesh (mesh), closed) << name;
+    // The unit cube's volume, by its winding: negative wound inward.
+    if (closed)
+      EXPECT_NEAR (pcl_probcollision::io::meshSignedVolume (mesh), std::string (name) == "inside_out.obj" ? -1.0 : 1.0, 1e-12)
+          << name;
   }
 }
 
