@@ -415,7 +415,16 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
 
   // Beyond reach, a distance when asked (CollisionRequest::distance): beyond the surface layer's
   // reach where it ran in full, else where the separators reached no leaf pair.
-  const bool beyond_reach = surface_ran ? !surface_reached : result.no_leaf_tested;
+  // The separators' weighted traversal fits a pair of disjoint boxes at any separation (two
+  // clouds of a leaf each always do): a "free" answer of theirs is beyond reach where no leaf
+  // pair is within the surface layer's reach (clouds of under about 20 points never got a
+  // distance).
+  const bool beyond_reach =
+      surface_ran ? !surface_reached
+                  : result.no_leaf_tested ||
+                        (request.distance && result.verdict == Verdict::Free &&
+                         !detail::withinReach (a.hierarchy (), b.hierarchy (), T_local,
+                                               std::fmax (a.medianNeighbourSpacing (), b.medianNeighbourSpacing ())));
   if (request.distance && beyond_reach && std::isnan (result.signed_distance))
     sampleDistance (a, b, T_local, result);
   // Back to what the caller gave: the witness in A's frame, per-point values on the clouds.

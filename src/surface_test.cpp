@@ -1382,6 +1382,37 @@ containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry
   return answer;
 }
 
+namespace
+{
+/** \brief The traversal of the leaf pairs within reach: boxes grown to kReachSigmas point
+  * deviations and by one sample spacing, so that a point between two sparse samples still meets
+  * their leaves. Every pair is enumerated (exhaustive, no cap, no order). */
+TraversalParams
+reachParams (double spacing)
+{
+  TraversalParams params ((CollisionRequest ()));
+  params.mode = TraversalMode::ExpandedBV;
+  params.expanded_k_sigma = kReachSigmas;
+  params.exhaustive = true;
+  params.skip_dominated = false;
+  params.nearest_first = false;  // every pair is enumerated: the order is of no use here
+  params.max_leaf_tests = 0;      // the separators' cap (max_leaf_fits) is not this layer's
+  params.box_margin = std::isfinite (spacing) ? std::max (spacing, 0.0) : 0.0;
+  return params;
+}
+} // namespace
+
+bool
+withinReach (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b, double spacing)
+{
+  TraversalParams params = reachParams (spacing);
+  params.exhaustive = false;
+  params.stop_probability = 0.0;  // the first pair found stops the descent
+  return traverseHierarchies (a, b, T_a_b, params,
+                              [] (const ProbabilisticBVH::Node&, const ProbabilisticBVH::Node&, double) { return 1.0; })
+             .leaf_pairs_tested > 0;
+}
+
 SurfaceAnswer
 surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
              std::vector<float>* per_point_a, std::vector<float>* per_point_b)
@@ -1390,16 +1421,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   SurfaceAnswer answer;
   const ProbabilisticBVH& bvh_a = a.hierarchy ();
   const ProbabilisticBVH& bvh_b = b.hierarchy ();
-  // Leaf pairs within reach: boxes grown to kReachSigmas point deviations and by one sample
-  // spacing, so that a point between two sparse samples still meets their leaves.
-  TraversalParams params (request);
-  params.mode = TraversalMode::ExpandedBV;
-  params.expanded_k_sigma = kReachSigmas;
-  params.exhaustive = true;
-  params.skip_dominated = false;
-  params.nearest_first = false;  // every pair is enumerated: the order is of no use here
-  params.max_leaf_tests = 0;      // the separators' cap (max_leaf_fits) is not this layer's
-  params.box_margin = std::max (a.surface ().medianSpacing (), b.surface ().medianSpacing ());
+  const TraversalParams params = reachParams (std::max (a.surface ().medianSpacing (), b.surface ().medianSpacing ()));
   auto& pairs = scratch.pairs;
   pairs.clear ();
   const auto* nodes_a = bvh_a.nodes ().data ();

@@ -56,6 +56,14 @@ struct SurfaceAnswer
   std::size_t bv_tests = 0;      ///< node pairs tested by its traversal
 };
 
+/** \brief Whether any leaf pair of a and b (B mapped into A by T_a_b) lies within the surface
+  * layer's reach: their boxes grown to kReachSigmas point deviations and by `spacing` (the
+  * larger median sample spacing of the two) meet. The one rule of "within reach", for the
+  * surface layer's enumeration and for a distance asked beyond it (CollisionRequest::distance).
+  * Stops at the first such pair. */
+bool
+withinReach (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b, double spacing);
+
 /** \brief Every point of A and B within reach of the other's surface gets a local signed
   * distance d_i (an implicit surface of the nearest oriented samples, robust to creases) with a
   * standard deviation sigma_i (both clouds' noise along the normal, the fitted surface's own

@@ -426,6 +426,41 @@ TEST (CollideDistance, OnlyBeyondReachAndOnlyWhenAsked)
   EXPECT_TRUE (std::isnan (r.signed_distance));
 }
 
+// Clouds of a leaf each: the separators' weighted traversal fits their one leaf pair at any
+// separation, so no distance was ever given beyond reach (a probe, 2026-12-04: clouds under
+// about 20 points). Their free answer is beyond reach where no leaf pair lies within the surface
+// layer's reach (detail::withinReach), and the nearest samples' distance is given there.
+TEST (CollideDistance, CloudsOfOneLeafGetADistanceBeyondReach)
+{
+  const UncertainCloud ca = randomSheet (10, 0.05, 0.0, 0.002, 21);
+  const UncertainCloud cb = randomSheet (12, 0.05, 0.0, 0.002, 22);
+  const CloudModel a (ca), b (cb);
+  ASSERT_EQ (a.hierarchy ().nodes ().size (), 1u);
+  ASSERT_EQ (b.hierarchy ().nodes ().size (), 1u);
+  CollisionRequest rq;
+  rq.distance = true;
+  for (const double z : {0.1, 0.5, 3.0})
+  {
+    SCOPED_TRACE ("apart by " + std::to_string (z));
+    Eigen::Isometry3d far = Eigen::Isometry3d::Identity ();
+    far.translation () = Eigen::Vector3d (0.0, 0.0, z);
+    CollisionResult r;
+    ASSERT_TRUE (collide (a, b, far, rq, r)) << r.message;
+    EXPECT_FALSE (r.no_leaf_tested);  // the one leaf pair, fitted
+    EXPECT_EQ (r.verdict, Verdict::Free);
+    EXPECT_TRUE (r.sample_distance);
+    EXPECT_NEAR (r.signed_distance, bruteNearest (ca, cb, far).distance, 1e-12);
+    EXPECT_GT (r.signed_distance_std, std::sqrt (2.0) * 0.002 * (1.0 - 1e-6));
+  }
+  // Within reach (the sheets 3 mm apart, within three deviations): none, as for larger clouds.
+  Eigen::Isometry3d near = Eigen::Isometry3d::Identity ();
+  near.translation () = Eigen::Vector3d (0.0, 0.0, 0.003);
+  CollisionResult r;
+  ASSERT_TRUE (collide (a, b, near, rq, r)) << r.message;
+  EXPECT_FALSE (r.sample_distance);
+  EXPECT_TRUE (std::isnan (r.signed_distance));
+}
+
 TEST (CollideDistance, FarFromTheOriginTheDistanceKeepsItsPrecision)
 {
   const Eigen::Vector3d offset (1e5, 1e5, -1e5);
