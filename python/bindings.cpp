@@ -1740,6 +1740,21 @@ PYBIND11_MODULE (_core, m)
          "every edge of a triangle with an area borders two triangles wound oppositely. Given as normals, an open\n"
          "mesh's face normals still enclose an inside (a box resting in a bin reads inside the bin); build an open\n"
          "container's samples without normals (orientation=NormalOrientation.Propagate: two-sided) instead.");
+  m.def ("mesh_signed_volume",
+         [] (const py::object& vertices, const py::object& triangles) {
+           return pcl_probcollision::io::meshSignedVolume (meshOf (vertices, triangles));
+         },
+         py::arg ("vertices"), py::arg ("triangles"),
+         "The volume a closed mesh's faces enclose by their winding: positive wound outward, negative wound inward\n"
+         "(a cavity, or a solid exported inside out).");
+  m.def ("open_mesh_warning", &pcl_probcollision::io::openMeshWarning, py::arg ("path"), py::arg ("closed"),
+         py::arg ("orientation_option"),
+         "pcd_collision's warning for a mesh oriented by its faces under -surface that is not closed (closed:\n"
+         "is_closed_mesh), naming the option that makes it two-sided; '' for a closed mesh.");
+  m.def ("inside_out_mesh_warning", &pcl_probcollision::io::insideOutMeshWarning, py::arg ("path"), py::arg ("closed"),
+         py::arg ("signed_volume"), py::arg ("orientation_option"), py::arg ("closed_option"),
+         "pcd_collision's warning for a closed mesh oriented by its faces under -surface whose faces wind inward\n"
+         "(signed_volume: mesh_signed_volume < 0), naming the options that orient it outward; '' otherwise.");
   m.def ("mesh_diagonal",
          [] (const py::object& vertices, const py::object& triangles) {
            return pcl_probcollision::io::meshDiagonal (meshOf (vertices, triangles));

@@ -1271,3 +1271,14 @@ def test_is_closed_mesh_tells_a_solid_from_an_open_container(tmp_path):
     flipped = box.copy()
     flipped[0] = flipped[0][::-1]
     assert not pc.is_closed_mesh(V, flipped)
+
+
+def test_mesh_signed_volume_tells_a_solid_from_one_inside_out():
+    # pcd_collision -surface warns of a closed mesh wound inward: a part inside it reads free, as
+    # in a cavity (2026-12-04).
+    V = np.array([[x, y, z] for z in (0, 2) for y in (0, 1) for x in (0, 1)], float) + 1e4
+    box = np.array([[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
+                    [1, 3, 7], [1, 7, 5], [3, 2, 6], [3, 6, 7], [2, 0, 4], [2, 4, 6]])
+    assert pc.mesh_signed_volume(V, box) == pytest.approx(2.0, rel=1e-9)
+    assert pc.mesh_signed_volume(V, box[:, ::-1]) == pytest.approx(-2.0, rel=1e-9)
+    assert pc.is_closed_mesh(V, box[:, ::-1])

@@ -540,7 +540,8 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
     """pcd_collision's warnings on stderr, in the same words and order: the units (a millimetre
     cloud against a metre one, the default sigma on the millimetres), a float64 file rounded far
     from its origin, a float32 one whose model says so, and a free answer between two meshes'
-    samples. The answers stay equal."""
+    samples, and under the surface layer a mesh wound inward and one not closed. The answers stay
+    equal."""
     write_pcd(tmp_path / "mm.pcd", table_points * 1000.0)
     write_pcd_double(tmp_path / "far.pcd", table_points.astype(np.float64) + np.array([1e4, 0.0, 0.0]))
     write_pcd(tmp_path / "far32.pcd", table_points.astype(np.float64) + np.array([1e5, 0.0, 0.0]))
@@ -549,6 +550,8 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
     faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2), (3, 4, 8), (3, 8, 7), (1, 3, 7),
              (1, 7, 5), (2, 6, 8), (2, 8, 4)]
     (tmp_path / "cube.obj").write_text("".join("v %g %g %g\n" % c for c in corners) + "".join("f %d %d %d\n" % f for f in faces))
+    (tmp_path / "inside_out.obj").write_text("".join("v %g %g %g\n" % c for c in corners) +
+                                             "".join("f %d %d %d\n" % (f[0], f[2], f[1]) for f in faces))
     poses = tmp_path / "poses.txt"
     poses.write_text("0 0 0 0 0 0\n0 0 0.5 0 0 0\n")
     runs = {
@@ -556,6 +559,9 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
         "the models' precision": ([str(tmp_path / "far32.pcd")] * 2, ["-sigma", "0.002"], 2),
         # the cube through the plate, sampled 8 cm apart: free at pose 0, which collides
         "between samples": ([str(tmp_path / "cube.obj"), str(tmp_path / "plate.obj")], ["-mesh_density", "0.08"], 1),
+        # under the surface layer: the cube wound inward, the plate not closed
+        "meshes' winding": ([str(tmp_path / "inside_out.obj"), str(tmp_path / "plate.obj")],
+                            ["-surface", "-mesh_density", "0.02"], 2),
     }
     for name, (inputs, flags, count) in runs.items():
         cpp = subprocess.run([_pcd_collision(), *inputs, "-poses", str(poses), "-json", *flags], capture_output=True,

@@ -576,7 +576,8 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
         the distance between the two clouds' nearest samples (sample_distance True).
     Returns BatchResults in pose order, identical to the single-process answers.
     pcd_collision's warnings (inputs' sizes or sigma in other units, coordinates rounded far from
-    the origin, a model's precision, a free answer between two meshes' samples) come as
+    the origin, a model's precision, a free answer between two meshes' samples, a mesh under the
+    surface layer that is not closed or is wound inward) come as
     InputWarnings (RuntimeWarnings); the command line prints them as pcd_collision does."""
     o = resolve_options(options)
     T = as_pose_matrices(poses)
@@ -590,6 +591,14 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
         _warn(core.noise_warning(f))
     for f in facts:
         _warn(core.rounding_warning(f))
+    # A mesh oriented by its faces under the surface layer: not closed, or closed and wound inward.
+    for side, spec in (("a", A), ("b", B)):
+        if o["surface"] and spec["kind"] == "mesh" and o["orientation_" + side] not in ("propagate", "viewpoint"):
+            closed = core.is_closed_mesh(spec["vertices"], spec["triangles"])
+            _warn(core.open_mesh_warning(spec["path"], closed, "-orientation_" + side))
+            _warn(core.inside_out_mesh_warning(spec["path"], closed,
+                                               core.mesh_signed_volume(spec["vertices"], spec["triangles"]),
+                                               "-orientation_" + side, "-closed_" + side))
     _sample_meshes(A, B, o)
     sa, sb = _scattered(A, o["surface"]), _scattered(B, o["surface"])
     m = len(T)
