@@ -46,6 +46,19 @@ CloudModel::CloudModel (UncertainCloud points, const BVHParams& hierarchy, std::
                                << (i < 0 ? std::string (" is negative")
                                          : " is outside the source cloud's " + std::to_string (source_size) + " points (source_size)"));
   }
+  // Covariances by buildCloudModel's rule (detail::covarianceError); a non-finite one is refused
+  // by the hierarchy's build, which names it.
+  for (std::size_t j = 0; j < points.covariances.size (); ++j)
+  {
+    if (!points.covariances[j].allFinite ())
+      continue;
+    const std::string why = detail::covarianceError (points.covariances[j]);
+    if (!why.empty ())
+      PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                           "[pcl_probcollision::CloudModel] covariance of point "
+                               << j << (j < points.source_indices.size () ? " (source index " + std::to_string (points.source_indices[j]) + ")" : std::string ())
+                               << " " << why);
+  }
   const auto start = std::chrono::steady_clock::now ();
   params_.hierarchy = hierarchy;
   buildLocal (std::move (points), hierarchy, source_size);

@@ -976,3 +976,46 @@ TEST (CloudModel, GivenCovariancesMustBePositiveSemiDefinite)
     }
   }
 }
+
+// The constructor from points with covariances checks them by the same rule as buildCloudModel
+// (detail::covarianceError): it took -4e-6 I at every point and answered Ok, contact 0.541 (a
+// probe, 2026-12-04). The message names the point, its source index and the entries; singular
+// covariances (a flat disc, zero) are covariances.
+TEST (CloudModel, TheConstructorRefusesCovariancesThatAreNotPositiveSemiDefinite)
+{
+  const auto points = [] (const Eigen::Matrix3d& bad, int bad_point) {
+    UncertainCloud u;
+    for (int i = 0; i < 50; ++i)
+    {
+      u.means.emplace_back (0.01 * (i % 10), 0.01 * (i / 10), 0.0);
+      u.covariances.push_back (bad_point < 0 || i == bad_point ? bad : Eigen::Matrix3d (1e-6 * Eigen::Matrix3d::Identity ()));
+      u.source_indices.push_back (100 + i);
+    }
+    return u;
+  };
+  EXPECT_NO_THROW (CloudModel (points (Eigen::Vector3d (1e-6, 1e-6, 0.0).asDiagonal ().toDenseMatrix (), 7)));
+  EXPECT_NO_THROW (CloudModel (points (Eigen::Matrix3d::Zero (), -1)));
+  Eigen::Matrix3d indefinite = 1e-6 * Eigen::Matrix3d::Identity ();
+  indefinite (0, 1) = indefinite (1, 0) = 2e-6;
+  const struct
+  {
+    Eigen::Matrix3d covariance;
+    int bad_point;
+    std::string words;
+  } cases[] = {
+      {-4e-6 * Eigen::Matrix3d::Identity (), -1, "covariance of point 0 (source index 100) is not positive semi-definite (xx -4e-06"},
+      {indefinite, 7, "covariance of point 7 (source index 107) is not positive semi-definite (xx 1e-06, yy 1e-06, zz 1e-06, xy 2e-06"},
+  };
+  for (const auto& c : cases)
+  {
+    try
+    {
+      CloudModel model (points (c.covariance, c.bad_point));
+      ADD_FAILURE () << "accepted, size " << model.size () << "\n" << c.covariance;
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find ("[pcl_probcollision::CloudModel] " + c.words), std::string::npos) << e.what ();
+    }
+  }
+}

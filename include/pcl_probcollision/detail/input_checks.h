@@ -3,6 +3,8 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -44,6 +46,41 @@ poseError (const Eigen::Isometry3d& T, const std::string& name)
   if (!(T.translation ().cwiseAbs ().maxCoeff () <= kMaxCoordinate))
     return "pose " + name + " translation is beyond the supported range of +-1e15";
   return std::string ();
+}
+/** \brief The one check that a given covariance is a covariance: empty when the symmetric matrix
+  * with these entries is positive semi-definite within rounding, otherwise "is not positive
+  * semi-definite (xx .., yy .., zz .., xy .., xz .., yz ..)" with the entries at full precision.
+  * Principal minors in double against the matrix's own scale (1e-6 of its largest entry), so
+  * singular covariances (a flat disc, zero) pass. Finite entries expected: a non-finite one is
+  * the caller's case (buildCloudModel takes it for a missing value, the CloudModel constructor
+  * refuses it). buildCloudModel (and so ProbabilisticCollision::setInputCovariances) and the
+  * CloudModel constructor both call it (found in review: -1e-6 I read as a sure collision; a
+  * probe of 2026-12-04: the constructor took -4e-6 I everywhere and answered Ok). */
+inline std::string
+covarianceError (double xx, double xy, double xz, double yy, double yz, double zz)
+{
+  const double scale = std::max ({std::abs (xx), std::abs (yy), std::abs (zz), std::abs (xy), std::abs (xz), std::abs (yz)});
+  const double tol = 1e-6 * scale;
+  const double minor_xy = xx * yy - xy * xy, minor_xz = xx * zz - xz * xz, minor_yz = yy * zz - yz * yz;
+  const double det = xx * minor_yz - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+  if (xx < -tol || yy < -tol || zz < -tol || minor_xy < -tol * scale || minor_xz < -tol * scale ||
+      minor_yz < -tol * scale || det < -tol * scale * scale)
+  {
+    char why[256];
+    std::snprintf (why, sizeof why, "is not positive semi-definite (xx %.9g, yy %.9g, zz %.9g, xy %.9g, xz %.9g, yz %.9g)",
+                   xx, yy, zz, xy, xz, yz);
+    return why;
+  }
+  return std::string ();
+}
+
+/** \brief covarianceError() of the symmetric part (S + S^T) / 2 of s, the part a model keeps
+  * (PackedCovariance). */
+inline std::string
+covarianceError (const Eigen::Matrix3d& s)
+{
+  return covarianceError (s (0, 0), 0.5 * (s (0, 1) + s (1, 0)), 0.5 * (s (0, 2) + s (2, 0)), s (1, 1),
+                          0.5 * (s (1, 2) + s (2, 1)), s (2, 2));
 }
 } // namespace detail
 } // namespace pcl_probcollision

@@ -89,26 +89,18 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     throw pcl::BadArgumentException (err.str ());
   }
 
-  // Given covariances must be covariances: positive semi-definite within rounding (a NaN one marks
-  // a missing value and drops its point; a negative one is an error, found in review: -1e-6 I read
-  // as a sure collision). Principal minors, in double, against the matrix's own scale.
+  // Given covariances must be covariances (detail::covarianceError, the constructor's rule too): a
+  // NaN one marks a missing value and drops its point; a negative one is an error.
   if (covariances)
     for (std::size_t j = 0; j < n; ++j)
     {
       const Covariance& c = (*covariances)[at (j)];
       if (!c.isFinite ())
         continue;
-      const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
-      const double scale = std::max ({std::abs (xx), std::abs (yy), std::abs (zz), std::abs (xy), std::abs (xz), std::abs (yz)});
-      const double tol = 1e-6 * scale;
-      const double minor_xy = xx * yy - xy * xy, minor_xz = xx * zz - xz * xz, minor_yz = yy * zz - yz * yz;
-      const double det = xx * minor_yz - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-      if (xx < -tol || yy < -tol || zz < -tol || minor_xy < -tol * scale || minor_xz < -tol * scale ||
-          minor_yz < -tol * scale || det < -tol * scale * scale)
+      const std::string why = detail::covarianceError (c.xx, c.xy, c.xz, c.yy, c.yz, c.zz);
+      if (!why.empty ())
       {
-        err.precision (9);
-        err << name << " covariance of point " << at (j) << " is not positive semi-definite (xx " << xx << ", yy " << yy
-            << ", zz " << zz << ", xy " << xy << ", xz " << xz << ", yz " << yz << ")";
+        err << name << " covariance of point " << at (j) << " " << why;
         throw pcl::BadArgumentException (err.str ());
       }
     }
