@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace pcl_probcollision
 {
@@ -45,6 +46,18 @@ SensorPose::fromViewpoint (const Eigen::Vector4f& sensor_origin,
     q = Eigen::Quaterniond::Identity ();
   pose.axis = (q.normalized () * Eigen::Vector3d::UnitZ ()).normalized ();
   return pose;
+}
+
+std::string
+SensorNoiseModel::sensorPoseError (const SensorPose& sensor) const
+{
+  if (!usesSensorPose () || sensor.origin.allFinite ())
+    return std::string ();
+  std::ostringstream out;
+  out.precision (9);
+  out << "sensor origin (" << sensor.origin.x () << ", " << sensor.origin.y () << ", " << sensor.origin.z ()
+      << ") is not finite: the " << name () << " noise model measures each point's depth from it";
+  return out.str ();
 }
 
 SensorNoiseModel

@@ -1019,3 +1019,44 @@ TEST (CloudModel, TheConstructorRefusesCovariancesThatAreNotPositiveSemiDefinite
     }
   }
 }
+
+// A depth noise model with a NaN sensor origin: named as such, with buildCloudModel's function
+// in what() (it read ": cloud has no finite point with a finite covariance", an empty function
+// prefix and the points blamed; a probe, 2026-12-04).
+TEST (CloudModel, ANonFiniteSensorOriginIsNamedWithTheFunction)
+{
+  const Cloud::Ptr a = sheet (0.1, 0.01, 0.0, 1);
+  a->sensor_origin_ = Eigen::Vector4f (0.0f, std::nanf (""), 1.0f, 0.0f);
+  CloudModelParams params;
+  for (const SensorNoiseModel& noise : {SensorNoiseModel::kinect (), SensorNoiseModel::stereo (), SensorNoiseModel::lidar ()})
+  {
+    params.noise = noise;
+    try
+    {
+      buildCloudModel (*a, params, nullptr, nullptr, "scan.pcd");
+      ADD_FAILURE () << noise.name () << ": accepted";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_EQ (std::string (e.what ()).rfind ("pcl_probcollision::buildCloudModel : scan.pcd sensor origin (0, nan, 1) is not finite: the " +
+                                                 std::string (noise.name ()) + " noise model measures",
+                                                 0),
+                 0u)
+          << e.what ();
+    }
+  }
+  params.noise = SensorNoiseModel::isotropic (0.002);
+  EXPECT_NO_THROW (buildCloudModel (*a, params));
+  // Every refusal of buildCloudModel carries its function, not an empty one.
+  Cloud nan_only;
+  nan_only.push_back (pcl::PointXYZ (NAN, 0.0f, 0.0f));
+  try
+  {
+    buildCloudModel (nan_only);
+    ADD_FAILURE () << "accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_EQ (std::string (e.what ()), "pcl_probcollision::buildCloudModel : cloud has no finite point (1 given, 1 non-finite)");
+  }
+}

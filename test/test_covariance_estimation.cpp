@@ -15,12 +15,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 
 using pcl_probcollision::Covariance;
 using pcl_probcollision::CovarianceEstimation;
 using pcl_probcollision::SensorNoiseModel;
+using pcl_probcollision::SensorPose;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace
@@ -263,6 +265,36 @@ TEST (CovarianceEstimation, BadParametersAndEmptyInputFailClearly)
   est.setRadiusSearch (0.05);  // the method is defined on k neighbours
   est.compute (out);
   EXPECT_TRUE (out.empty ());
+}
+
+// A depth noise model with a non-finite sensor origin (the cloud's sensor_origin_, or
+// setSensorPose) fails in initCompute, as PCL features fail, instead of writing NaN covariances
+// at every point (a probe, 2026-12-04).
+TEST (CovarianceEstimation, ADepthNoiseModelWithANonFiniteSensorOriginFailsClearly)
+{
+  Cloud::Ptr cloud = grid (5, 5, 0.01);
+  cloud->sensor_origin_ = Eigen::Vector4f (std::nanf (""), 0.0f, 0.0f, 0.0f);
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setInputCloud (cloud);
+  est.setKSearch (5);
+  est.setSensorNoise (SensorNoiseModel::kinect ());
+  pcl::PointCloud<Covariance> out;
+  out.resize (5);
+  est.compute (out);
+  EXPECT_TRUE (out.empty ());
+  SensorPose pose;
+  pose.origin = Eigen::Vector3d (0.0, 0.0, 1.0);
+  est.setSensorPose (pose);  // given, it replaces the cloud's
+  est.compute (out);
+  EXPECT_EQ (out.size (), 25u);
+  pose.origin.z () = std::numeric_limits<double>::infinity ();
+  est.setSensorPose (pose);
+  est.compute (out);
+  EXPECT_TRUE (out.empty ());
+  // The rule's words, which buildCloudModel and initCompute both print.
+  EXPECT_EQ (SensorNoiseModel::kinect ().sensorPoseError (pose),
+             "sensor origin (0, 0, inf) is not finite: the kinect noise model measures each point's depth from it");
+  EXPECT_EQ (SensorNoiseModel::isotropic (0.01).sensorPoseError (pose), "");
 }
 
 TEST (CovarianceEstimation, RealStereoScanKeepsAlignmentAndGivesFinitePsdCovariances)

@@ -602,6 +602,41 @@ TEST (ProbabilisticCollisionReliability, AllNaNOrganizedCloudFailsWithNoFinitePo
   EXPECT_NE (q.r.message.find ("307200"), std::string::npos) << q.r.message;
 }
 
+// A depth noise model measures depth from the sensor: a NaN sensor_origin_ made every covariance
+// NaN and the query failed as "no finite point with a finite covariance", blaming the points (a
+// probe, 2026-12-04). The message names the sensor origin and the cloud (SensorNoiseModel::sensorPoseError).
+TEST (ProbabilisticCollisionReliability, ANonFiniteSensorOriginIsNamedNotThePoints)
+{
+  for (const std::string which : {"input", "target"})
+  {
+    const Cloud::Ptr a = patch (0.1, 0.01, 0.0, 0.0, 1);
+    const Cloud::Ptr b = patch (0.1, 0.01, 0.05, 0.0, 2);
+    (which == "input" ? a : b)->sensor_origin_ = Eigen::Vector4f (kNaN, 0.0f, 1.0f, 0.0f);
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    pc.setInputCloud (a);
+    pc.setTargetCloud (b);
+    pc.setInputNoise (SensorNoiseModel::kinect ());
+    pc.setTargetNoise (SensorNoiseModel::kinect ());
+    CollisionResult r;
+    EXPECT_FALSE (pc.compute (r));
+    expectSane (r, false);
+    EXPECT_EQ (r.status, CollisionResult::Status::InvalidInput);
+    EXPECT_EQ (r.message.rfind (which + " sensor origin (nan, 0, 1) is not finite: the kinect noise model measures", 0), 0u)
+        << r.message;
+    EXPECT_NE (r.message.find ("sensor_origin_"), std::string::npos) << r.message;
+    EXPECT_EQ (r.message.find ("no finite point"), std::string::npos) << r.message;
+  }
+  // A model that uses no sensor pose does not care.
+  const Cloud::Ptr a = patch (0.1, 0.01, 0.0, 0.0, 1);
+  a->sensor_origin_ = Eigen::Vector4f (kNaN, 0.0f, 1.0f, 0.0f);
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (a);
+  pc.setTargetCloud (patch (0.1, 0.01, 0.05, 0.0, 2));
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+  CollisionResult r;
+  EXPECT_TRUE (pc.compute (r)) << r.message;
+}
+
 TEST (ProbabilisticCollisionReliability, PartlyNaNOrganizedCloudSkipsHolesAndKeepsTheLayout)
 {
   // 640 x 480, a 0.2 m patch of 100 x 100 pixels in the middle with 1 in 7 pixels a hole (NaN or

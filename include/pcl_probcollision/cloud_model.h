@@ -34,9 +34,12 @@ class CloudModel;
   *            a non-finite one drops its point
   * \param[in] name what error messages call the cloud ("input", "target", a file name)
   * \return the model
-  * \throws pcl::BadArgumentException, its message starting with name, for invalid params,
-  *         covariances of the wrong size, an index outside the cloud, a coordinate beyond
-  *         +-1e15, or no finite point. A PCL warning (PCL_WARN) accompanies warning(). */
+  * \throws pcl::BadArgumentException, its description starting with name (what() puts
+  *         "pcl_probcollision::buildCloudModel : " before it; errorMessage() gives the
+  *         description alone), for invalid params, covariances of the wrong size or not positive
+  *         semi-definite, an index outside the cloud, a coordinate beyond +-1e15, a depth noise
+  *         model with a non-finite sensor_origin_ (SensorNoiseModel::sensorPoseError), or no
+  *         finite point. A PCL warning (PCL_WARN) accompanies warning(). */
 template <typename PointT>
 std::shared_ptr<const CloudModel>
 buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params = CloudModelParams (),

@@ -108,6 +108,12 @@ public:
   const char* name () const;
   /** \brief True when the model depends on the sensor pose (the depth models). */
   bool usesSensorPose () const;
+  /** \brief Whether this model can work from that sensor pose: empty when it can (a model that
+    * uses no sensor pose can work from any), otherwise why not, as "sensor origin (nan, 0, 1) is
+    * not finite: the kinect noise model measures each point's depth from it". The one rule:
+    * buildCloudModel() (naming the cloud) and CovarianceEstimation::initCompute() call it, so a
+    * NaN sensor_origin_ is named as such instead of every covariance coming out NaN. */
+  std::string sensorPoseError (const SensorPose& sensor) const;
   /** \brief True when the model depends on the surface normal (KinectV1). */
   bool usesNormal () const { return type_ == Type::KinectV1; }
 

@@ -29,19 +29,22 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
                  const pcl::PointCloud<Covariance>* covariances, const std::string& name)
 {
   const auto start = std::chrono::steady_clock::now ();
+  // what()'s function (PCLException's), without the source path PCL_THROW_EXCEPTION would add;
+  // the descriptions start with name (errorMessage() keeps them alone).
+  static constexpr const char* kFunction = "pcl_probcollision::buildCloudModel";
   params.validate ();
   std::ostringstream err;
   if (covariances && covariances->size () != cloud.size ())
   {
     err << name << " covariances have " << covariances->size () << " entries for " << cloud.size () << " points";
-    throw pcl::BadArgumentException (err.str ());
+    throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
   }
   if (indices)
     for (const int i : *indices)
       if (i < 0 || static_cast<std::size_t> (i) >= cloud.size ())
       {
         err << name << " index " << i << " outside the cloud of " << cloud.size () << " points";
-        throw pcl::BadArgumentException (err.str ());
+        throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
       }
   const std::size_t n = indices ? indices->size () : cloud.size ();
   auto at = [&] (std::size_t j) { return indices ? (*indices)[j] : static_cast<int> (j); };
@@ -68,7 +71,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       err.precision (9);
       err << name << " point " << at (j) << " at (" << p.x << ", " << p.y << ", " << p.z
           << ") is beyond the supported coordinate range of +-1e15";
-      throw pcl::BadArgumentException (err.str ());
+      throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
     }
     max_abs = std::max (max_abs, m);
     // NaN or zero marks a point without a normal (PCL's convention); an infinite component is a
@@ -78,7 +81,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       {
         err << name << " point " << at (j) << " has a normal with an infinite component (" << p.normal_x << ", "
             << p.normal_y << ", " << p.normal_z << "); give NaN or 0 for none";
-        throw pcl::BadArgumentException (err.str ());
+        throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
       }
   }
   // Refused here, before the estimation, whose PCL base class would also print "input_ is
@@ -86,7 +89,20 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   if (finite_points == 0)
   {
     err << name << " has no finite point (" << n << " given, " << n << " non-finite)";
-    throw pcl::BadArgumentException (err.str ());
+    throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
+  }
+
+  // A depth noise model needs the sensor's position (it would make every covariance NaN, and the
+  // points would be blamed); the merge below reads it too.
+  if (!covariances && params.noise.usesSensorPose ())
+  {
+    const std::string why =
+        params.noise.sensorPoseError (SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_));
+    if (!why.empty ())
+    {
+      err << name << " " << why << " (the cloud's sensor_origin_, a PCD file's VIEWPOINT)";
+      throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
+    }
   }
 
   // Given covariances must be covariances (detail::covarianceError, the constructor's rule too): a
@@ -101,7 +117,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
       if (!why.empty ())
       {
         err << name << " covariance of point " << at (j) << " " << why;
-        throw pcl::BadArgumentException (err.str ());
+        throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
       }
     }
 
@@ -268,7 +284,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     // rather than blame the positions.
     err << name << " has no finite point with a finite covariance (" << n << " given, " << n - finite_points
         << " non-finite, " << skipped - (n - finite_points) << " with a non-finite covariance)";
-    throw pcl::BadArgumentException (err.str ());
+    throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
   }
   // What the points took over is freed before the hierarchy's build, which is the peak of memory
   // (5,000,000 points: 52 bytes a point less).

@@ -352,6 +352,18 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
                this->getClassName ().c_str (), this->k_);
     return false;
   }
+  // A depth noise model measures depth from the sensor: without a finite origin every covariance
+  // would come out NaN (SensorNoiseModel::sensorPoseError, buildCloudModel's rule too).
+  if (noise_.usesSensorPose ())
+  {
+    const std::string why = noise_.sensorPoseError (getSensorPose ());
+    if (!why.empty ())
+    {
+      PCL_ERROR ("[pcl_probcollision::%s::initCompute] %s (%s).\n", this->getClassName ().c_str (), why.c_str (),
+                 sensor_pose_ ? "setSensorPose" : "the input cloud's sensor_origin_");
+      return false;
+    }
+  }
   // pcl::Feature would pick OrganizedNeighbor (a projective, camera-model search) for organized
   // clouds; Pauly et al. define the neighbourhood in Euclidean space. BatchKdTree is the k-d
   // tree of pcl::search::KdTree, queried a block of points at a time.
