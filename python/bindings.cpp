@@ -378,8 +378,8 @@ toPose (const py::object& obj, const char* arg)
     // A NaN anywhere is said as such, before the last row's test that it would fail too.
     if (!m.allFinite ())
       throw py::value_error (std::string (arg) + ": the pose is not finite (NaN or infinite entries)");
-    if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
-      throw py::value_error (std::string (arg) + ": the last row of a 4x4 pose must be [0, 0, 0, 1]");
+    if (const std::string row = pcl_probcollision::detail::lastRowError (m); !row.empty ())
+      throw py::value_error (std::string (arg) + ": " + row);
   }
   Eigen::Isometry3d T;
   T.matrix () = m;
@@ -469,8 +469,8 @@ poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool
       m (i, j) = p (k, i, j);
   if (!m.allFinite ())
     throw py::value_error (name + ": the pose is not finite (NaN or infinite entries)");
-  if (!(m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0))
-    throw py::value_error (name + ": the last row of a 4x4 pose must be [0, 0, 0, 1]");
+  if (const std::string row = pcl_probcollision::detail::lastRowError (m); !row.empty ())
+    throw py::value_error (name + ": " + row);
   Eigen::Isometry3d T;
   T.matrix () = m;
   if (rigid)

@@ -1012,6 +1012,48 @@ TEST (ProbabilisticCollisionReliability, NonFiniteOrNonRigidPosesFail)
   EXPECT_EQ (away.r.verdict, Verdict::Free);
 }
 
+// Eigen's Isometry3d keeps a 4 x 4 matrix but reads only its top three rows: a pose whose last
+// row is not (0, 0, 0, 1) (a projective matrix, a matrix written in by hand) was answered as if it
+// were (a probe, 2026-12-04). detail::poseError refuses it, naming the row, in compute(),
+// computeBatch() and collide().
+TEST (ProbabilisticCollisionReliability, APoseWhoseLastRowIsNotZeroZeroZeroOneFails)
+{
+  const auto a = patch (0.1, 0.01, 0.0, 0.0, 22);
+  const auto b = patch (0.1, 0.01, 0.05, 0.0, 23);
+  for (const Eigen::RowVector4d& row : {Eigen::RowVector4d (0, 0, 1, 1), Eigen::RowVector4d (0, 0, 0, 2),
+                                        Eigen::RowVector4d (0.5, 0, 0, 1), Eigen::RowVector4d (0, 0, 0, 0)})
+  {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity ();
+    pose.matrix ().row (3) = row;
+    const Query q = tryQuery (a, b, 0.002, CollisionRequest (), pose);
+    EXPECT_FALSE (q.ok) << row;
+    expectSane (q.r, false);
+    EXPECT_EQ (q.r.status, CollisionResult::Status::InvalidInput);
+    EXPECT_NE (q.r.message.find ("pose T_target_input: the last row must be (0, 0, 0, 1), got ("), std::string::npos)
+        << q.r.message;
+
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    pc.setInputCloud (a);
+    pc.setTargetCloud (b);
+    std::vector<CollisionResult> results;
+    EXPECT_FALSE (pc.computeBatch ({Eigen::Isometry3d::Identity (), pose}, results, 1));
+    ASSERT_EQ (results.size (), 2u);
+    EXPECT_TRUE (results[0].ok ()) << results[0].message;
+    EXPECT_FALSE (results[1].ok ());
+    EXPECT_NE (results[1].message.find ("pose 1: pose T_target_input: the last row"), std::string::npos) << results[1].message;
+
+    const auto model_a = buildCloudModel (*a);
+    const auto model_b = buildCloudModel (*b);
+    CollisionResult r;
+    EXPECT_FALSE (collide (*model_a, *model_b, pose, CollisionRequest (), r));
+    expectSane (r, false);
+    EXPECT_NE (r.message.find ("pose T_a_b: the last row must be (0, 0, 0, 1)"), std::string::npos) << r.message;
+  }
+  Eigen::Isometry3d exact = Eigen::Isometry3d::Identity ();
+  exact.matrix ().row (3) << 0, 0, 0, 1;
+  EXPECT_TRUE (tryQuery (a, b, 0.002, CollisionRequest (), exact).ok);
+}
+
 // Load.
 
 // A batch of 100,000 poses through one ProbabilisticCollision: memory does not grow per query,

@@ -21,14 +21,32 @@ constexpr double kMaxCoordinate = 1e15;
   * rotation written with 7 significant digits passes, a scale of 1 + 1e-6 does not. */
 constexpr double kRotationTolerance = 1e-6;
 
+/** \brief The one check of a pose's last row: empty when it is (0, 0, 0, 1) exactly, otherwise
+  * "the last row must be (0, 0, 0, 1), got (...)". Eigen's Isometry3d and Affine3d keep the row
+  * but read only the top three (a projective matrix, or one written in by hand, was answered as
+  * if the row were right: a probe, 2026-12-04); poseError() and the Python bindings call it. */
+inline std::string
+lastRowError (const Eigen::Matrix4d& m)
+{
+  if (m (3, 0) == 0.0 && m (3, 1) == 0.0 && m (3, 2) == 0.0 && m (3, 3) == 1.0)
+    return std::string ();
+  char why[200];
+  std::snprintf (why, sizeof why, "the last row must be (0, 0, 0, 1), got (%.9g, %.9g, %.9g, %.9g)", m (3, 0), m (3, 1),
+                 m (3, 2), m (3, 3));
+  return why;
+}
+
 /** \brief The one rigid-pose check of the library: empty when T is finite, a rotation
   * (orthonormal within kRotationTolerance, determinant +1) plus a translation within
-  * +-kMaxCoordinate; otherwise why not (by how much, for a rotation), naming the pose `name`. */
+  * +-kMaxCoordinate, its last row (0, 0, 0, 1) (lastRowError()); otherwise why not (by how much,
+  * for a rotation), naming the pose `name`. */
 inline std::string
 poseError (const Eigen::Isometry3d& T, const std::string& name)
 {
   if (!T.matrix ().allFinite ())
     return "pose " + name + " is not finite";
+  if (const std::string row = lastRowError (T.matrix ()); !row.empty ())
+    return "pose " + name + ": " + row;
   const Eigen::Matrix3d R = T.linear ();
   const double departure = (R.transpose () * R - Eigen::Matrix3d::Identity ()).cwiseAbs ().maxCoeff ();
   if (!(departure <= kRotationTolerance) || R.determinant () < 0.0)
