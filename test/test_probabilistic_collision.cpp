@@ -21,6 +21,7 @@
 #include "scenes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -1052,6 +1053,55 @@ TEST (ProbabilisticCollisionReliability, APoseWhoseLastRowIsNotZeroZeroZeroOneFa
   Eigen::Isometry3d exact = Eigen::Isometry3d::Identity ();
   exact.matrix ().row (3) << 0, 0, 0, 1;
   EXPECT_TRUE (tryQuery (a, b, 0.002, CollisionRequest (), exact).ok);
+}
+
+// PCLBase::setIndices (row_start, col_start, nb_rows, nb_cols) prints an error for a block that
+// does not fit the cloud and keeps the indices it had, so the query used every point (a probe,
+// 2026-12-04: setIndices (0, 0, 5, 5) on a 400 x 1 cloud); without an input cloud it dereferenced
+// null. The block is refused by the setter, naming it and the cloud; a block that fits is used.
+TEST (ProbabilisticCollisionReliability, ABlockOfIndicesOutsideTheCloudIsRefusedByName)
+{
+  const auto a = patch (0.1, 0.005, 0.0, 0.0, 24);  // unorganized, 441 x 1
+  const auto b = patch (0.1, 0.01, 0.001, 0.0, 25);
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  try
+  {
+    pc.setIndices (0, 0, 1, 5);
+    ADD_FAILURE () << "a block without an input cloud was accepted";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("[pcl_probcollision::ProbabilisticCollision::setIndices] rows 0 + 1, columns 0 "
+                                             "+ 5: no input cloud (call setInputCloud first)"),
+               std::string::npos)
+        << e.what ();
+  }
+  pc.setInputCloud (a);
+  pc.setTargetCloud (b);
+  for (const auto& [row, col, rows, cols] : {std::array<std::size_t, 4>{0, 0, 5, 5}, std::array<std::size_t, 4>{1, 0, 1, 5},
+                                             std::array<std::size_t, 4>{0, 440, 1, 2}})
+  {
+    try
+    {
+      pc.setIndices (row, col, rows, cols);
+      ADD_FAILURE () << "block " << row << " " << col << " " << rows << " " << cols << " accepted";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      const std::string expected = "rows " + std::to_string (row) + " + " + std::to_string (rows) + ", columns " +
+                                   std::to_string (col) + " + " + std::to_string (cols) +
+                                   " outside the input cloud of width 441, height 1";
+      EXPECT_NE (std::string (e.what ()).find (expected), std::string::npos) << e.what ();
+    }
+  }
+  // The refused block left the indices as they were (none: every point).
+  CollisionResult r;
+  ASSERT_TRUE (pc.compute (r)) << r.message;
+  EXPECT_EQ (r.points_a, a->size ());
+  // A block that fits a 1-row cloud is used.
+  pc.setIndices (0, 10, 1, 5);
+  ASSERT_TRUE (pc.compute (r)) << r.message;
+  EXPECT_EQ (r.points_a, 5u);
 }
 
 // Load.

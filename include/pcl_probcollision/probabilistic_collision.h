@@ -71,7 +71,12 @@ public:
   void setIndices (const pcl::IndicesConstPtr& indices) override;
   /** \brief Restricts A to these indices; marks its model for rebuild. */
   void setIndices (const pcl::PointIndicesConstPtr& indices) override;
-  /** \brief Restricts A to a block of an organized cloud; marks its model for rebuild. */
+  /** \brief Restricts A to a block of the input cloud (nb_rows rows from row_start, nb_cols
+    * columns from col_start; an unorganized cloud is one row); marks its model for rebuild.
+    * \throws pcl::BadArgumentException naming the block and the cloud's width and height when
+    *         there is no input cloud yet or the block does not fit it (PCL's own version prints
+    *         an error and keeps the previous indices, all points by default); the indices are
+    *         then unchanged. */
   void setIndices (std::size_t row_start, std::size_t col_start, std::size_t nb_rows, std::size_t nb_cols) override;
 
   /** \brief Object B; marks its model for rebuild (even for the same pointer). */

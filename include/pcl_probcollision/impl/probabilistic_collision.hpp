@@ -66,6 +66,20 @@ void
 ProbabilisticCollision<PointT>::setIndices (std::size_t row_start, std::size_t col_start, std::size_t nb_rows,
                                             std::size_t nb_cols)
 {
+  // PCLBase's version prints an error for a block that does not fit and keeps the indices it had
+  // (so a query silently used every point), and dereferences a null input: refuse both here.
+  const auto* cloud = this->input_.get ();
+  const std::string block = "rows " + std::to_string (row_start) + " + " + std::to_string (nb_rows) + ", columns " +
+                            std::to_string (col_start) + " + " + std::to_string (nb_cols);
+  if (!cloud)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::ProbabilisticCollision::setIndices] "
+                                                        << block << ": no input cloud (call setInputCloud first)");
+  if (nb_rows > cloud->height || row_start > cloud->height - nb_rows || nb_cols > cloud->width ||
+      col_start > cloud->width - nb_cols)
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticCollision::setIndices] "
+                             << block << " outside the input cloud of width " << cloud->width << ", height "
+                             << cloud->height << " (an unorganized cloud has height 1); the indices are unchanged");
   pcl::FilterIndices<PointT>::setIndices (row_start, col_start, nb_rows, nb_cols);
   markInput ();
 }
