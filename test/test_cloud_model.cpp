@@ -1060,3 +1060,47 @@ TEST (CloudModel, ANonFiniteSensorOriginIsNamedWithTheFunction)
     EXPECT_EQ (std::string (e.what ()), "pcl_probcollision::buildCloudModel : cloud has no finite point (1 given, 1 non-finite)");
   }
 }
+
+// A cloud resized in place without being set again: compute() answered with the old model (its
+// per-point values index-aligned with 400 points for a cloud of 5) where filter() refused; both
+// refuse now, by one rule and with one message (a probe, 2026-12-04). A change that keeps the size
+// is still not seen (the class comment says so).
+TEST (ProbabilisticCollisionRebuild, ACloudResizedInPlaceIsRefusedByComputeAsByFilter)
+{
+  for (const std::string which : {"input", "target"})
+  {
+    const Cloud::Ptr a = sheet (0.1, 0.005, 0.0, 1);
+    const Cloud::Ptr b = sheet (0.1, 0.005, 0.0, 2, Eigen::Vector3d (0.0, 0.0, 0.3));
+    const std::size_t size = a->size ();
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    pc.setInputCloud (a);
+    pc.setTargetCloud (b);
+    CollisionRequest request;
+    request.per_point = true;
+    pc.setRequest (request);
+    CollisionResult r;
+    ASSERT_TRUE (pc.compute (r)) << r.message;
+    (which == "input" ? a : b)->resize (5);
+    EXPECT_FALSE (pc.compute (r)) << which << ": answered with " << r.probabilities_a.size () << " per-point values";
+    EXPECT_EQ (r.status, CollisionResult::Status::InvalidInput);
+    EXPECT_TRUE (std::isnan (r.probability));
+    EXPECT_EQ (r.message.rfind ("the " + which + " model was built from a cloud of " + std::to_string (size) +
+                                    " points, the " + which + " cloud has 5",
+                                0),
+               0u)
+        << r.message;
+    std::vector<CollisionResult> results;
+    EXPECT_FALSE (pc.computeBatch ({Eigen::Isometry3d::Identity ()}, results, 1));
+    EXPECT_NE (results[0].message.find ("model was built from a cloud of"), std::string::npos) << results[0].message;
+    Cloud out;
+    out.resize (3);
+    pc.filter (out);
+    EXPECT_TRUE (out.empty ());
+    // Set again, it is rebuilt and answers.
+    if (which == "input")
+      pc.setInputCloud (a);
+    else
+      pc.setTargetCloud (b);
+    EXPECT_TRUE (pc.compute (r)) << r.message;
+  }
+}

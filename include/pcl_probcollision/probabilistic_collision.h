@@ -35,7 +35,9 @@ namespace pcl_probcollision
   * k, surface projection and hierarchy parameters) marks that model for rebuild, even when it
   * is given the same pointer again. A cloud changed in place (pcl::transformPointCloud (*a, *a,
   * T)) is NOT noticed until it is set again or markForRebuild() is called: until then the old
-  * model answers. Prebuilt models (setInputModel, setTargetModel) are used as they are.
+  * model answers. One resized in place is refused: compute() and filter() fail naming both
+  * sizes (their per-point results would not be index-aligned with it). Prebuilt models
+  * (setInputModel, setTargetModel) are used as they are.
   *
   * As a filter (pcl::FilterIndices), it keeps the points of A whose collision probability
   * reaches setProbabilityThreshold() (default 0.5); setNegative() keeps the others and
@@ -185,6 +187,10 @@ private:
   /** \brief Builds whichever model is marked for rebuild; false with result's status and
     * message on bad input, build_ms set to the time spent. */
   bool prepare (CollisionResult& result);
+  /** \brief The staleness rule, compute()'s (for a model it built and reuses) and filter()'s
+    * (for any input model): empty when the model's per-point results are index-aligned with the
+    * cloud (model.sourceSize() == cloud.size()), otherwise why not, naming `which` cloud. */
+  static std::string staleModelError (const CloudModel& model, const PointCloud& cloud, const char* which);
   /** \brief Turns collide()'s answer (A's frame) into compute()'s: the witness in the
     * target's frame and, with timings, build_ms. */
   void finishResult (const Eigen::Isometry3d& T_target_input, double build_ms, CollisionResult& result) const;

@@ -159,7 +159,11 @@ ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
                     CloudModel::ConstPtr& model, bool& dirty) {
     params.surface = params.surface || request_.surface;
     if (!dirty && model && (!params.surface || model->params ().surface))
-      return true;
+    {
+      // Reused: the cloud may have been resized in place since (filter()'s rule too).
+      result.message = cloud ? staleModelError (*model, *cloud, which) : std::string ();
+      return result.message.empty ();
+    }
     model.reset ();
     if (!cloud)
     {
@@ -195,6 +199,18 @@ ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
   }
   result.build_ms = built ? std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count () : 0.0;
   return true;
+}
+
+template <typename PointT>
+std::string
+ProbabilisticCollision<PointT>::staleModelError (const CloudModel& model, const PointCloud& cloud, const char* which)
+{
+  if (model.sourceSize () == cloud.size ())
+    return std::string ();
+  return std::string ("the ") + which + " model was built from a cloud of " + std::to_string (model.sourceSize ()) +
+         " points, the " + which + " cloud has " + std::to_string (cloud.size ()) +
+         " (a cloud changed in place needs to be set again, or markForRebuild(); a model given by set" +
+         (which == std::string ("input") ? "InputModel" : "TargetModel") + "() needs the cloud it was built from)";
 }
 
 template <typename PointT>
@@ -310,11 +326,11 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
     return;  // compute() printed the error; the output stays empty
 
   const std::vector<float>& p = result.probabilities_a;
-  if (p.size () != this->input_->size ())
+  // A model set by setInputModel() is not checked by compute() (it needs no cloud); here it must
+  // be the input cloud's.
+  if (const std::string stale = staleModelError (*input_model_, *this->input_, "input"); !stale.empty ())
   {
-    PCL_ERROR ("[pcl_probcollision::%s::applyFilter] the input model was built from a cloud of %zu points, the "
-               "input cloud has %zu\n",
-               this->getClassName ().c_str (), p.size (), this->input_->size ());
+    PCL_ERROR ("[pcl_probcollision::%s::applyFilter] %s\n", this->getClassName ().c_str (), stale.c_str ());
     return;
   }
   const pcl::Indices& candidates = *this->indices_;
