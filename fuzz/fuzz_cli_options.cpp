@@ -50,8 +50,8 @@ LLVMFuzzerTestOneInput (const std::uint8_t* data, std::size_t size)
     FUZZ_REQUIRE (std::isfinite (o.sigma_a) && o.sigma_a >= 0.0);  // 0: no sensor noise
     FUZZ_REQUIRE (std::isfinite (o.sigma_b) && o.sigma_b >= 0.0);
     FUZZ_REQUIRE (o.k >= 1);
-    FUZZ_REQUIRE (o.free_below >= 0.0 && o.free_below <= 0.5);
-    FUZZ_REQUIRE (o.collision_above >= 0.5 && o.collision_above <= 1.0);
+    FUZZ_REQUIRE (o.free_below > 0.0 && o.free_below <= 0.5);
+    FUZZ_REQUIRE (o.collision_above >= 0.5 && o.collision_above < 1.0);
     FUZZ_REQUIRE (o.n_max >= 1);
     FUZZ_REQUIRE (std::isfinite (o.sigma_max) && o.sigma_max >= 0.0);
     FUZZ_REQUIRE (o.epsilon >= 0.0 && o.epsilon < 0.5);

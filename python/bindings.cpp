@@ -1586,7 +1586,8 @@ PYBIND11_MODULE (_core, m)
          "(as pcd_collision refuses -threads).");
   m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
          "The verdict of a probability under a request's thresholds (Unknown for NaN). ValueError naming\n"
-         "free_below or collision_above when out of range.");
+         "free_below or collision_above when out of range (free_below in (0, 0.5], collision_above in [0.5, 1)),\n"
+         "or the probability when it is outside [0, 1].");
 
   // --- file input and poses as pcd_collision reads them (io/, used by pcl_probcollision.dask) ------
   m.def ("read_cloud", &readCloud, py::arg ("path"), py::kw_only (), py::arg ("rounding") = false,

@@ -254,6 +254,10 @@ verdictFor (double probability, const CollisionRequest& request)
   request.validateThresholds ();
   if (std::isnan (probability))
     return Verdict::Unknown;
+  // Not a probability: a caller's bug, never a verdict (1.5 read collision, -0.1 free).
+  if (!(probability >= 0.0 && probability <= 1.0))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::verdictFor] probability " << probability << " outside [0, 1]");
   if (probability < request.free_below)
     return Verdict::Free;
   if (probability > request.collision_above)

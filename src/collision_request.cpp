@@ -5,18 +5,16 @@
 #include <pcl/exceptions.h>
 
 #include <cmath>
+#include <string>
 
 namespace pcl_probcollision
 {
 void
 CollisionRequest::validateThresholds () const
 {
-  const char* where = "[pcl_probcollision::CollisionRequest::validate] ";
-  if (!(free_below >= 0.0 && free_below <= 0.5))
-    PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "free_below " << free_below << " outside [0, 0.5]");
-  if (!(collision_above >= 0.5 && collision_above <= 1.0))
-    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
-                         where << "collision_above " << collision_above << " outside [0.5, 1]");
+  const std::string why = thresholdsError ();
+  if (!why.empty ())
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CollisionRequest::validate] " << why);
 }
 
 void

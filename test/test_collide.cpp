@@ -753,9 +753,10 @@ TEST (VerdictFor, ThresholdsAreStrictSoTheBoundariesReadContact)
       {0.2, 0.6, 0.2, Verdict::InContact},
       {0.2, 0.6, 0.6, Verdict::InContact},
       {0.2, 0.6, 0.65, Verdict::InCollision},
-      // The range ends: free_below = 0 leaves nothing Free, collision_above = 1 nothing InCollision.
-      {0.0, 1.0, 0.0, Verdict::InContact},
-      {0.0, 1.0, 1.0, Verdict::InContact},
+      // Near the range ends every verdict is still reached: P = 0 is free, P = 1 collision.
+      {1e-12, 1.0 - 1e-12, 0.0, Verdict::Free},
+      {1e-12, 1.0 - 1e-12, 1e-12, Verdict::InContact},
+      {1e-12, 1.0 - 1e-12, 1.0, Verdict::InCollision},
       // A single threshold: only P = 0.5 itself is contact.
       {0.5, 0.5, std::nextafter (0.5, 0.0), Verdict::Free},
       {0.5, 0.5, 0.5, Verdict::InContact},
@@ -781,6 +782,31 @@ TEST (VerdictFor, DefaultRequestGivesTheDocumentedBands)
   EXPECT_EQ (verdictFor (0.9, request), Verdict::InContact);
   EXPECT_EQ (verdictFor (0.95, request), Verdict::InCollision);
   EXPECT_EQ (verdictFor (-std::numeric_limits<double>::quiet_NaN (), request), Verdict::Unknown);
+}
+
+// verdictFor took any P: 1.5 read collision, -0.1 free (a probe, 2026-12-04). A probability
+// outside [0, 1] (or infinite) is refused naming it; NaN is "not computed" and stays Unknown.
+TEST (VerdictFor, AProbabilityOutsideZeroToOneIsRefusedByName)
+{
+  const CollisionRequest request;
+  for (const double p : {1.5, -0.1, std::nextafter (1.0, 2.0), -std::numeric_limits<double>::denorm_min (),
+                         std::numeric_limits<double>::infinity (), -std::numeric_limits<double>::infinity ()})
+  {
+    try
+    {
+      const Verdict v = verdictFor (p, request);
+      ADD_FAILURE () << "P = " << p << " read " << verdictName (v);
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find ("[pcl_probcollision::verdictFor] probability "), std::string::npos) << e.what ();
+      EXPECT_NE (std::string (e.what ()).find (" outside [0, 1]"), std::string::npos) << e.what ();
+    }
+  }
+  EXPECT_EQ (verdictFor (std::numeric_limits<double>::quiet_NaN (), request), Verdict::Unknown);
+  EXPECT_EQ (verdictFor (0.0, request), Verdict::Free);
+  EXPECT_EQ (verdictFor (-0.0, request), Verdict::Free);
+  EXPECT_EQ (verdictFor (1.0, request), Verdict::InCollision);
 }
 
 TEST (VerdictFor, ThresholdsOutOfRangeAreRefusedByName)

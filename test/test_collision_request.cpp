@@ -169,13 +169,45 @@ TEST (CollisionRequest, ValidateNamesTheFirstMemberOutOfRange)
   }
 }
 
-TEST (CollisionRequest, ValidateAcceptsTheClosedRangeEnds)
+// free_below = 0 left nothing Free (P = 0 read contact) and collision_above = 1 nothing
+// InCollision (P = 1 read contact), both in range (a probe, 2026-12-04): the ranges are (0, 0.5]
+// and [0.5, 1) now, so that every verdict can be reached; thresholdsError() holds the rule and
+// its words, which pcd_collision's -thresholds prints too.
+TEST (CollisionRequest, ThresholdsThatLeaveAVerdictUnreachableAreRefused)
+{
+  const std::vector<std::pair<Change, std::string>> cases = {
+      {{"free_below 0", [] (CollisionRequest& r) { r.free_below = 0.0; }},
+       "free_below 0 outside (0, 0.5] (P < free_below is free: every verdict must be reachable)"},
+      {{"free_below -0", [] (CollisionRequest& r) { r.free_below = -0.0; }}, "free_below -0 outside (0, 0.5]"},
+      {{"collision_above 1", [] (CollisionRequest& r) { r.collision_above = 1.0; }},
+       "collision_above 1 outside [0.5, 1) (P > collision_above is collision: every verdict must be reachable)"},
+  };
+  for (const auto& [c, words] : cases)
+  {
+    CollisionRequest r;
+    c.apply (r);
+    EXPECT_EQ (r.thresholdsError ().rfind (words, 0), 0u) << c.name << ": " << r.thresholdsError ();
+    try
+    {
+      r.validate ();
+      ADD_FAILURE () << c.name << " did not throw";
+    }
+    catch (const pcl::BadArgumentException& e)
+    {
+      EXPECT_NE (std::string (e.what ()).find ("[pcl_probcollision::CollisionRequest::validate] " + words), std::string::npos)
+          << e.what ();
+    }
+  }
+  EXPECT_EQ (CollisionRequest ().thresholdsError (), "");
+}
+
+TEST (CollisionRequest, ValidateAcceptsTheRangeEnds)
 {
   const std::vector<Change> cases = {
-      {"free_below 0", [] (CollisionRequest& r) { r.free_below = 0.0; }},
+      {"free_below 1e-12", [] (CollisionRequest& r) { r.free_below = 1e-12; }},
       {"free_below 0.5", [] (CollisionRequest& r) { r.free_below = 0.5; }},
       {"collision_above 0.5", [] (CollisionRequest& r) { r.collision_above = 0.5; }},
-      {"collision_above 1", [] (CollisionRequest& r) { r.collision_above = 1.0; }},
+      {"collision_above 1 - 1e-12", [] (CollisionRequest& r) { r.collision_above = 1.0 - 1e-12; }},
       {"free_below = collision_above = 0.5",
        [] (CollisionRequest& r) { r.free_below = r.collision_above = 0.5; }},
       {"rho_min 0", [] (CollisionRequest& r) { r.rho_min = 0.0; }},

@@ -459,7 +459,7 @@ TEST (ProbabilisticCollision, UnusableInputsFailWithAMessage)
   }
   catch (const pcl::BadArgumentException& e)
   {
-    EXPECT_NE (std::string (e.what ()).find ("free_below nan outside [0, 0.5]"), std::string::npos) << e.what ();
+    EXPECT_NE (std::string (e.what ()).find ("free_below nan outside (0, 0.5]"), std::string::npos) << e.what ();
   }
   EXPECT_THROW (pc.setKSearch (0), pcl::BadArgumentException);
 }

@@ -493,10 +493,12 @@ parseCommandLine (const std::vector<std::string>& args)
       std::vector<double> vals;
       if (!parseDoubleList (v, 2, vals))
         return usage (bad + "must be two comma-separated numbers LOW,HIGH");
-      if (!(vals[0] >= 0.0 && vals[0] <= 0.5))
-        return usage (bad + "LOW must be in [0, 0.5]");
-      if (!(vals[1] >= 0.5 && vals[1] <= 1.0))
-        return usage (bad + "HIGH must be in [0.5, 1]");
+      // The library's rule and words (CollisionRequest::thresholdsError).
+      pcl_probcollision::CollisionRequest thresholds;
+      thresholds.free_below = vals[0];
+      thresholds.collision_above = vals[1];
+      if (const std::string why = thresholds.thresholdsError (); !why.empty ())
+        return usage (bad + "(LOW,HIGH: free_below,collision_above) " + why);
       o.free_below = vals[0];
       o.collision_above = vals[1];
     }

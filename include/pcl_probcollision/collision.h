@@ -64,8 +64,10 @@ bool collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<E
                    const CollisionRequest& request, std::vector<CollisionResult>& results, int threads = 0,
                    const RobustClassifier* classifier = nullptr);
 
-/** \brief The verdict of a probability under a request's thresholds (Unknown for NaN): the one
-  * rule every verdict, label and colour of the library and its tools derives from.
-  * \throws pcl::BadArgumentException for thresholds validate() refuses (validateThresholds()). */
+/** \brief The verdict of a probability under a request's thresholds (Unknown for NaN, "not
+  * computed"): the one rule every verdict, label and colour of the library and its tools derives
+  * from.
+  * \throws pcl::BadArgumentException for thresholds validate() refuses (validateThresholds()),
+  *         and for a probability outside [0, 1] (infinite ones included), naming it. */
 Verdict verdictFor (double probability, const CollisionRequest& request);
 } // namespace pcl_probcollision

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 
 namespace pcl_probcollision
 {
@@ -34,9 +36,11 @@ enum class TraversalMode
   */
 struct CollisionRequest
 {
-  /** \brief Below this P the pair is Free; [0, 0.5]. Default 0.1 (METHOD.md 7, A = 0.9). */
+  /** \brief Below this P the pair is Free; (0, 0.5] (at 0 nothing would be Free). Default 0.1
+    * (METHOD.md 7, A = 0.9). */
   double free_below = 0.1;
-  /** \brief Above this P the pair is InCollision; [0.5, 1], >= free_below. Default 0.9. */
+  /** \brief Above this P the pair is InCollision; [0.5, 1) (at 1 nothing would be), so
+    * >= free_below. Default 0.9. */
   double collision_above = 0.9;
   /** \brief false (default): stop as soon as a leaf pair's contribution exceeds
     * collision_above (the verdict is then final and P a lower bound). true: visit every leaf
@@ -141,6 +145,26 @@ struct CollisionRequest
   void validate () const;
   /** \brief The part of validate() that verdictFor() needs: free_below and collision_above. */
   void validateThresholds () const;
+  /** \brief The thresholds' rule, its one owner: empty when free_below is in (0, 0.5] and
+    * collision_above in [0.5, 1) (every verdict reachable), otherwise why not, naming the member
+    * and its value. validateThresholds() throws it; pcd_collision's -thresholds prints it
+    * (inline: the command line's parser links no library). */
+  std::string
+  thresholdsError () const
+  {
+    // P lies in [0, 1]: free_below = 0 would leave nothing free and collision_above = 1 nothing
+    // in collision, so the ranges are open at those ends; each within its half also keeps the two
+    // in order (contact then always holds P = 0.5) and names a NaN as out of range.
+    char why[160] = "";
+    if (!(free_below > 0.0 && free_below <= 0.5))
+      std::snprintf (why, sizeof why, "free_below %g outside (0, 0.5] (P < free_below is free: every verdict must be reachable)",
+                     free_below);
+    else if (!(collision_above >= 0.5 && collision_above < 1.0))
+      std::snprintf (why, sizeof why,
+                     "collision_above %g outside [0.5, 1) (P > collision_above is collision: every verdict must be reachable)",
+                     collision_above);
+    return why;
+  }
   /** \brief Every member equal (the classifier's parameters included). */
   bool operator== (const CollisionRequest& o) const;
   bool operator!= (const CollisionRequest& o) const { return !(*this == o); }

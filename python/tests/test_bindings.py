@@ -299,6 +299,25 @@ def test_nan_rows_are_skipped_and_counted(table_points, gripper_patch):
     assert np.nanmax(r.probabilities_a) > 0
 
 
+def test_thresholds_that_leave_a_verdict_unreachable_and_probabilities_outside_0_1_are_refused(table, gripper_patch):
+    """free_below = 0 left nothing free and collision_above = 1 nothing in collision (a probe,
+    2026-12-04); verdict_for took P = 1.5. The C++ rule and words (CollisionRequest::thresholdsError)."""
+    for request, words in ((pc.CollisionRequest(free_below=0.0), r"free_below 0 outside \(0, 0\.5\]"),
+                           (pc.CollisionRequest(collision_above=1.0), r"collision_above 1 outside \[0\.5, 1\)")):
+        with pytest.raises(ValueError, match=words):
+            request.validate()
+        with pytest.raises(ValueError, match=words):
+            pc.collide(table, gripper_patch, translation(0.1, 0.1, 0.03), request)
+        with pytest.raises(ValueError, match=words):
+            pc.verdict_for(0.5, request)
+    for p in (1.5, -0.1, np.inf):
+        with pytest.raises(ValueError, match=r"probability .* outside \[0, 1\]"):
+            pc.verdict_for(p, pc.CollisionRequest())
+    assert pc.verdict_for(np.nan, pc.CollisionRequest()) == pc.Verdict.Unknown
+    edges = pc.CollisionRequest(free_below=1e-12, collision_above=1 - 1e-12)
+    assert pc.verdict_for(0.0, edges) == pc.Verdict.Free and pc.verdict_for(1.0, edges) == pc.Verdict.InCollision
+
+
 def test_result_repr_and_verdict_enum(table, gripper_patch):
     r = pc.collide(table, gripper_patch, translation(0.1, 0.1, 0.03))
     assert isinstance(r.verdict, pc.Verdict) and r.verdict == pc.Verdict.Free

@@ -274,6 +274,11 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-thresholds", "0.6,0.9"}, "-thresholds");
   expectUsageError ({"-thresholds", "0.1,0.4"}, "-thresholds");
   expectUsageError ({"-thresholds", "0.1,,0.9"}, "-thresholds");
+  // Thresholds that leave a verdict unreachable, by the library's rule and words
+  // (CollisionRequest::thresholdsError): LOW = 0 never reads free, HIGH = 1 never collision.
+  expectUsageError ({"-thresholds", "0,0.9"}, "option -thresholds: '0,0.9' (LOW,HIGH: free_below,collision_above) free_below 0 outside (0, 0.5]");
+  expectUsageError ({"-thresholds", "0.1,1"}, "option -thresholds: '0.1,1' (LOW,HIGH: free_below,collision_above) collision_above 1 outside [0.5, 1)");
+  EXPECT_EQ (parse ({"-thresholds", "0.001,0.999"}).kind, Kind::Run);
   expectUsageError ({"-pose", "0,0,0,0,0"}, "-pose");
   expectUsageError ({"-pose", "0,0,0,0,0,0,0"}, "-pose");
   expectUsageError ({"-pose", "0,0,0,0,0,x"}, "-pose");

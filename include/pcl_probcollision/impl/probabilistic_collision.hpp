@@ -129,7 +129,7 @@ ProbabilisticCollision<PointT>::setThresholds (double free_below, double collisi
   CollisionRequest r = request_;
   r.free_below = free_below;
   r.collision_above = collision_above;
-  r.validate ();  // its ranges, [0, 0.5] and [0.5, 1], also keep the two in order; a NaN is named
+  r.validate ();  // its ranges, (0, 0.5] and [0.5, 1), also keep the two in order; a NaN is named
   request_ = r;
 }
 
