@@ -133,7 +133,7 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   detail::SurfaceAnswer s;
   try
   {
-    s = containment_only ? detail::containmentTest (a, b, T_a_b, request.per_point ? &result.probabilities_a : nullptr,
+    s = containment_only ? detail::containmentTest (a, b, T_a_b, request, request.per_point ? &result.probabilities_a : nullptr,
                                                     request.per_point ? &result.probabilities_b : nullptr)
                          : detail::surfaceTest (a, b, T_a_b, request, request.per_point ? &result.probabilities_a : nullptr,
                                                 request.per_point ? &result.probabilities_b : nullptr);

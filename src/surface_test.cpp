@@ -1318,6 +1318,29 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
   return deep;
 }
 
+/** \brief deepInside both ways where a surface says where its inside is: A's nodes inside B, then
+  * (unless decision mode found one) B's inside A; the deeper of the two. */
+DeepPoint
+insideEitherOutOfReach (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, double margin,
+                        bool may_stop, std::vector<float>* per_point_a, std::vector<float>* per_point_b)
+{
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
+  DeepPoint deep;
+  if (b.surface ().insideKnown ())
+  {
+    deep = deepInside (a, I, b, T_a_b, margin, !may_stop, per_point_a);
+    deep.side = +1;
+  }
+  if ((!deep.found || !may_stop) && a.surface ().insideKnown ())
+  {
+    DeepPoint other = deepInside (b, T_a_b, a, I, margin, !may_stop, per_point_b);
+    other.side = -1;
+    if (other.found && (!deep.found || other.depth > deep.depth))
+      deep = other;
+  }
+  return deep;
+}
+
 /** \brief A point found inside the other surface, out of reach of it (deepInside, containment):
   * P = 1, the distance minus its depth to the other's nearest sample (about a spacing uncertain),
   * unless the answer already reads deeper. */
@@ -1348,36 +1371,20 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
 } // namespace
 
 SurfaceAnswer
-containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, std::vector<float>* per_point_a,
-                 std::vector<float>* per_point_b)
+containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+                 std::vector<float>* per_point_a, std::vector<float>* per_point_b)
 {
   SurfaceAnswer answer;
-  // One point of `query` (its first), mapped by T_q into A's frame, against `surface` (by T_s).
-  auto inside = [] (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface,
-                    const Eigen::Isometry3d& T_s, int side) {
-    DeepPoint deep;
-    if (!surface.surface ().insideKnown () || query.hierarchy ().means ().empty () || surface.hierarchy ().nodes ().empty ())
-      return deep;
-    const Eigen::Vector3d point = T_q * query.hierarchy ().means ().front ();
-    const Eigen::Vector3d x = T_s.inverse () * point;
-    if (!insideOf (surface, x))
-      return deep;
-    deep.found = true;
-    deep.side = side;
-    deep.index = 0;
-    deep.point = point;
-    setDepth (surface, T_s, x, deep);
-    return deep;
-  };
-  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity ();
-  DeepPoint deep = inside (a, I, b, T_a_b, +1);
-  if (!deep.found)
-    deep = inside (b, T_a_b, a, I, -1);
+  // As surfaceTest out of reach: every node of one object clear of the other's surface is
+  // judged by one winding number, from the root down (it was the first point alone, so an
+  // object listed with a part outside first read free: a probe, 2026-12-04).
+  const bool may_stop = !request.exhaustive && !request.distance && !per_point_a && !per_point_b;
+  const DeepPoint deep = insideEitherOutOfReach (
+      a, b, T_a_b, std::max (a.surface ().medianSpacing (), b.surface ().medianSpacing ()), may_stop, per_point_a, per_point_b);
   if (deep.found)
   {
     answerDeep (deep, a, b, answer);
-    if (std::vector<float>* values = deep.side > 0 ? per_point_a : per_point_b)
-      std::fill (values->begin (), values->end (), 1.0f);
+    answer.stopped_early = may_stop;
   }
   return answer;
 }
@@ -1460,17 +1467,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   // pushed 30 cm through a wall: the wall's samples inside the piano are far from its surface),
   // or one object entirely inside the other. Only a trusted orientation (the points' own normals,
   // a viewpoint) may declare it: a propagated one can be inside out (a room seen from within).
-  const double margin = params.box_margin;
-  DeepPoint deep;
-  if (b.surface ().insideKnown ())
-    deep = deepInside (a, Eigen::Isometry3d::Identity (), b, T_a_b, margin, !may_stop, per_point_a);
-  if ((!deep.found || !may_stop) && a.surface ().insideKnown ())
-  {
-    DeepPoint other = deepInside (b, T_a_b, a, Eigen::Isometry3d::Identity (), margin, !may_stop, per_point_b);
-    other.side = -1;
-    if (other.found && (!deep.found || other.depth > deep.depth))
-      deep = other;
-  }
+  const DeepPoint deep = insideEitherOutOfReach (a, b, T_a_b, params.box_margin, may_stop, per_point_a, per_point_b);
   if (deep.found)
   {
     answerDeep (deep, a, b, answer);

@@ -80,15 +80,15 @@ SurfaceAnswer
 surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
              std::vector<float>* per_point_a, std::vector<float>* per_point_b);
 /** \brief Where no leaf pair comes within reach (the ladder, when the separators reached none):
-  * whether one object lies entirely inside the other, by the winding number of each surface
-  * that says where its inside is (SurfaceModel::insideKnown) at one point of the other object
-  * (its first). Found: P = 1 and the depth to the other's nearest sample, as surfaceTest's deep
-  * points, and P_in = 1 for every point of the object inside (per_point_a, per_point_b: as
-  * surfaceTest's); otherwise nothing reached. Two winding numbers at most: an object partly
-  * inside the other, through a gap between its leaves, is not seen (surfaceTest descends for
-  * that). */
+  * whether one object lies inside the other, wholly or in part, by the winding number of each
+  * surface that says where its inside is (SurfaceModel::insideKnown), as surfaceTest judges
+  * points out of reach: every node of one object clear of the other's surface (within `margin`,
+  * a sample spacing) by one of its points, from the root down. Found: P = 1 and the depth to the
+  * other's nearest sample, as surfaceTest's deep points (in decision mode the first node found,
+  * stopped_early: a bound), and P_in = 1 for the points of every node found inside (per_point_a,
+  * per_point_b: as surfaceTest's; the search is then exhaustive); otherwise nothing reached. */
 SurfaceAnswer
-containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, std::vector<float>* per_point_a,
-                 std::vector<float>* per_point_b);
+containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
+                 std::vector<float>* per_point_a, std::vector<float>* per_point_b);
 } // namespace detail
 } // namespace pcl_probcollision

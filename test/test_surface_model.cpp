@@ -837,6 +837,51 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   EXPECT_EQ (by_pool.answered_by, AnsweredBy::SurfaceLayer);
 }
 
+// The ladder's containment rung, where the separators reach no leaf pair, judged one point of
+// each object, its first: an object of two balls, the one outside listed first, read free with
+// the other ball wholly inside a closed sphere (a probe, 2026-12-04), and collision with the
+// order reversed. It now judges every node clear of the other's surface, as the surface layer
+// does out of reach: collision in either order, per point only the inside ball's points.
+TEST (SurfaceLayer, TheLaddersContainmentDoesNotDependOnThePointOrder)
+{
+  const auto big = buildCloudModel (sphere (2000, 1.0, Eigen::Vector3d::Zero ()), withSurface ());
+  const auto outside = sphere (200, 0.05, Eigen::Vector3d (2.5, 0.0, 0.0));
+  const auto inside = sphere (200, 0.05, Eigen::Vector3d (0.2, 0.1, 0.0));
+  pcl::PointCloud<pcl::PointNormal> outside_first = outside, inside_first = inside;
+  outside_first += inside;
+  inside_first += outside;
+  for (const auto* cloud : {&outside_first, &inside_first})
+  {
+    const bool first_outside = cloud == &outside_first;
+    SCOPED_TRACE (first_outside ? "the outside ball first" : "the inside ball first");
+    const auto two = buildCloudModel (*cloud, withSurface ());
+    const Answerers q (false);
+    CollisionResult rc, rl;
+    ASSERT_TRUE (collide (*two, *big, Eigen::Isometry3d::Identity (), q.separators, rc));
+    ASSERT_TRUE (rc.no_leaf_tested) << "the case needs separators that reach nothing";
+    ASSERT_TRUE (collide (*two, *big, Eigen::Isometry3d::Identity (), q.ladder, rl));
+    EXPECT_EQ (rl.verdict, Verdict::InCollision);
+    EXPECT_EQ (rl.answered_by, AnsweredBy::SurfaceLayer);
+    EXPECT_LT (rl.signed_distance, -0.5);  // the inside ball about 0.75 deep
+    CollisionRequest decision = q.ladder;  // without per-point values: the first node found decides
+    decision.per_point = false;
+    CollisionResult rd;
+    ASSERT_TRUE (collide (*two, *big, Eigen::Isometry3d::Identity (), decision, rd));
+    EXPECT_EQ (rd.verdict, Verdict::InCollision);
+    EXPECT_TRUE (rd.lower_bound);
+    // Per point (q asks for them): 1 for the inside ball's points, nothing for the outside one's.
+    ASSERT_EQ (rl.probabilities_a.size (), 400u);
+    for (std::size_t i = 0; i < 400; ++i)
+    {
+      const bool in = (i < 200) != first_outside;
+      if (in)
+        EXPECT_EQ (rl.probabilities_a[i], 1.0f) << i;
+      else
+        EXPECT_FALSE (rl.probabilities_a[i] > 0.0f) << i;
+    }
+  }
+}
+
 namespace
 {
 /** \brief The surface of the box of half extents h about c, sampled on a grid of about spacing
