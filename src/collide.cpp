@@ -192,24 +192,29 @@ addSeparators (CollisionResult& into, const CollisionResult& separators)
 /** \brief The surface layer's answer (into) pooled with the separators' on the same pair
   * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
   * reached it (else the one that did); the surface layer's distance and witness (the
-  * separators' when the surface layer reached nothing); the work of both counted. One object
-  * wholly inside the other (`contained`, found by the winding number out of every leaf's reach)
-  * is what the separators cannot see: their P = 0 then says nothing, and the surface layer's P = 1
-  * stands alone (it read contact 0.5): returns false then. */
+  * separators' when the surface layer reached nothing); the work of both counted. A point
+  * inside the other object by the winding number (SurfaceAnswer::inside_confirmed: deep inside,
+  * or one object wholly inside the other) is what the separators cannot see, since no two
+  * surfaces need cross there: their P then says nothing, and the surface layer's stands alone (a
+  * ball inside a box near its wall read contact 0.5): returns false then. */
 bool
-pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request, bool contained)
+pool (CollisionResult& into, const CollisionResult& separators, const CollisionRequest& request, bool inside_confirmed)
 {
-  const bool pooled = !(contained && separators.no_leaf_tested);
+  const bool pooled = !inside_confirmed;
   if (pooled)
     into.probability = 0.5 * (into.probability + separators.probability);
-  into.lower_bound = into.lower_bound || separators.lower_bound;
+  if (pooled)
+    into.lower_bound = into.lower_bound || separators.lower_bound;
   addSeparators (into, separators);
   auto mean = [] (std::vector<float>& values, const std::vector<float>& other) {
     for (std::size_t i = 0; i < values.size () && i < other.size (); ++i)
       values[i] = std::isnan (values[i]) ? other[i] : std::isnan (other[i]) ? values[i] : 0.5f * (values[i] + other[i]);
   };
-  mean (into.probabilities_a, separators.probabilities_a);
-  mean (into.probabilities_b, separators.probabilities_b);
+  if (pooled)
+  {
+    mean (into.probabilities_a, separators.probabilities_a);
+    mean (into.probabilities_b, separators.probabilities_b);
+  }
   into.verdict = verdictFor (into.probability, request);
   return pooled;
 }
@@ -324,7 +329,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
     from_surface = !separators.no_leaf_tested && !(separators.probability > request.collision_above);
     if (from_surface)
     {
-      if (!collideSurface (a, b, T_local, request, result))
+      detail::SurfaceAnswer answer;
+      if (!collideSurface (a, b, T_local, request, result, false, &answer))
         return false;
       surface_ran = true;
       surface_reached = !result.no_leaf_tested;
@@ -337,8 +343,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         result = std::move (separators);
         from_surface = pooled = false;
       }
-      else if (pooled)  // the separators reached a leaf pair here
-        pool (result, separators, request, false);
+      else if (pooled)
+        pooled = pool (result, separators, request, answer.inside_confirmed);
       else
         addSeparators (result, separators);
     }
@@ -406,7 +412,7 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         from_surface = pooled = false;
       }
       else
-        pooled = pool (result, separators, request, answer.contained);
+        pooled = pool (result, separators, request, answer.inside_confirmed);
     }
   }
   result.answered_by = !from_surface ? AnsweredBy::Separators : pooled ? AnsweredBy::Pooled : AnsweredBy::SurfaceLayer;

@@ -1015,6 +1015,9 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
   const SurfaceModel& q_model = query.surface ();
   const bool behind_unseen = s_model.seenFromViewpoint ();
   scratch.two_sided = !s_model.insideKnown ();
+  // A deep point inside by the winding number is inside a solid (inside_confirmed) only where
+  // the surface has a known inside and is no scan's view (behind a sheet is `unobserved`).
+  const bool inside_known = !scratch.two_sided && !behind_unseen;
   // Behind a scan from one viewpoint or any open surface (winding about 1/2 behind a sheet) the
   // space is occupied; inside a closed surface means a winding number above 1/2.
   const double behind_threshold =
@@ -1134,10 +1137,17 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         e.sigma = e.plane_sigma;
       }
       const bool matters = per_point || e.distance / std::max (e.sigma, 1e-300) < best_z;
-      if (matters && deep && s_model.windingNumber (s_bvh, T_s_inverse * x) < behind_threshold)
+      bool confirmed = false;
+      if (matters && deep)
       {
-        e.distance = e.nearest;
-        e.normal = Eigen::Vector3d::Zero ();
+        const double winding = s_model.windingNumber (s_bvh, T_s_inverse * x);
+        if (winding < behind_threshold)
+        {
+          e.distance = e.nearest;
+          e.normal = Eigen::Vector3d::Zero ();
+        }
+        else
+          confirmed = inside_known && winding > kInsideWinding;
       }
       // Over a bridged hole, or clearly behind a surface seen from one viewpoint (whose far
       // side no sample shows), the answer rests on surface the samples do not show.
@@ -1166,6 +1176,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
         // Toward A's side: the other surface's outward normal points away from it.
         answer.witness_normal = side > 0 ? e.normal : Eigen::Vector3d (-e.normal);
         answer.unobserved = unobserved;
+        answer.inside_confirmed = confirmed && !unobserved;
       }
     }
     crossings (scratch, center, side, per_point, answer, best_z);
@@ -1365,6 +1376,7 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
     answer.signed_distance_std = s.medianSpacing ();
     // Inside a surface seen from one viewpoint: behind it, where no sample looked.
     answer.unobserved = s.seenFromViewpoint ();
+    answer.inside_confirmed = !answer.unobserved;
   }
   answer.probability = 1.0;
 }

@@ -47,6 +47,12 @@ struct SurfaceAnswer
   /** \brief Stopped at the first point with P_in > collision_above (decision mode): P and the
     * distance are then bounds (the deepest point may lie elsewhere). */
   bool stopped_early = false;
+  /** \brief The deciding point lies inside the other's surface by its winding number (above
+    * 1/2), a surface with a known inside that is no scan's view (not behind a sheet): a deep point
+    * or an object wholly inside. Two surfaces need not cross there, so the separators cannot see
+    * it, and a pool (CollisionRequest::surface_pooled, the ladder's after a free fit) lets the
+    * surface layer's answer stand. */
+  bool inside_confirmed = false;
   /** \brief A query leaf within reach met only samples without a normal (a cloud of coincident,
     * collinear or too few points has no surface there): its points were not judged, so a P of
     * 0 with reached false does not mean "far". */

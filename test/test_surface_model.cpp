@@ -837,6 +837,38 @@ TEST (SurfaceLayer, ContainmentFromTheWindingNumber)
   EXPECT_EQ (by_pool.answered_by, AnsweredBy::SurfaceLayer);
 }
 
+// A ball wholly inside a closed sphere, 5 mm to 4 cm from its wall: the separators reach leaf
+// pairs there and read free or contact (no two surfaces cross), the surface layer collision (the
+// ball's points inside by the winding number). Pooled, and in the ladder after their free
+// answer, the mean read contact 0.50-0.65 (a probe, 2026-12-04); an answer inside by the
+// winding number (SurfaceAnswer::inside_confirmed) now stands alone.
+TEST (SurfaceLayer, APoolKeepsAPointInsideByTheWindingNumber)
+{
+  const auto big = buildCloudModel (sphere (4000, 0.3, Eigen::Vector3d::Zero ()), withSurface ());
+  const auto ball = buildCloudModel (sphere (300, 0.05, Eigen::Vector3d::Zero ()), withSurface ());
+  const Answerers q (false);
+  int separators_free = 0;
+  for (const double gap : {0.005, 0.01, 0.02, 0.04})
+  {
+    SCOPED_TRACE ("gap " + std::to_string (gap));
+    const Eigen::Isometry3d T = shift (-(0.3 - 0.05 - gap), 0.0, 0.0);  // the big sphere in the ball's frame
+    CollisionResult rc, rs, rp, rl;
+    ASSERT_TRUE (collide (*ball, *big, T, q.separators, rc));
+    ASSERT_TRUE (collide (*ball, *big, T, q.surface, rs));
+    ASSERT_TRUE (collide (*ball, *big, T, q.pooled, rp));
+    ASSERT_TRUE (collide (*ball, *big, T, q.ladder, rl));
+    separators_free += rc.verdict == Verdict::Free ? 1 : 0;
+    EXPECT_EQ (rs.verdict, Verdict::InCollision);
+    for (const CollisionResult* r : {&rp, &rl})
+    {
+      EXPECT_EQ (r->verdict, Verdict::InCollision);
+      EXPECT_EQ (r->answered_by, AnsweredBy::SurfaceLayer);
+      EXPECT_EQ (r->probability, rs.probability);
+    }
+  }
+  EXPECT_GE (separators_free, 2) << "the case needs separators that read free";
+}
+
 // The ladder's containment rung, where the separators reach no leaf pair, judged one point of
 // each object, its first: an object of two balls, the one outside listed first, read free with
 // the other ball wholly inside a closed sphere (a probe, 2026-12-04), and collision with the
