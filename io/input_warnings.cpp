@@ -149,10 +149,17 @@ modelWarning (const InputFacts& in, const std::string& model_warning)
 }
 
 std::string
-openMeshWarning (const std::string& path, bool closed, const std::string& orientation_option)
+openMeshWarning (const std::string& path, const MeshEdges& edges, const std::string& orientation_option)
 {
-  if (closed)
+  if (edges.closed > 0 && edges.open == 0 && edges.flipped == 0 && edges.fins == 0)
     return {};
+  if (edges.open == 0 && edges.fins == 0 && edges.flipped > 0)
+    return formatted ("mesh '%s' is not closed: at %zu of its edges both triangles run the same way, so some faces are "
+                      "wound against their neighbours (flipped). The surface layer takes each face's winding as "
+                      "outward, so behind a flipped face inside reads outside and a part there can read free: fix "
+                      "those faces' winding, or give %s propagate, which orients its samples by their neighbours "
+                      "(with -closed for a solid)",
+                      path.c_str (), edges.flipped, orientation_option.c_str ());
   return formatted ("mesh '%s' is not closed (an edge does not border exactly two triangles wound oppositely): the "
                     "surface layer takes its faces to enclose an inside all the same, so inside an open container (a "
                     "bin, a shelf) the space its walls surround reads inside. For such a container give %s propagate, "

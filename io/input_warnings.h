@@ -7,6 +7,7 @@
 // errors: each names a likely mistake the answer would silently carry.
 
 #include "cloud_input.h"
+#include "mesh_sampling.h"
 
 #include <pcl_probcollision/sensor_noise.h>
 
@@ -85,8 +86,10 @@ std::string modelWarning (const InputFacts& in, const std::string& model_warning
   * (-surface, oriented by its faces) although the mesh is not closed (isClosedMesh false): inside
   * an open container the space its walls half-enclose reads inside (a box resting in an open bin
   * read collision, 0.45 m deep). orientation_option names the option that makes its surface
-  * two-sided instead (-orientation_a or -orientation_b). Empty for a closed mesh. */
-std::string openMeshWarning (const std::string& path, bool closed, const std::string& orientation_option);
+  * two-sided instead (-orientation_a or -orientation_b). A mesh closed but for faces wound
+  * against their neighbours (MeshEdges::flipped, no open edge) is named as such: behind a flipped
+  * face inside reads outside. Empty for a closed mesh. */
+std::string openMeshWarning (const std::string& path, const MeshEdges& edges, const std::string& orientation_option);
 
 /** \brief The warning for a closed mesh whose faces wind inward (meshSignedVolume < 0), oriented
   * by its faces (-surface): the surface layer takes the space around it as its inside, so a part

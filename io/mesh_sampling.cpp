@@ -38,32 +38,47 @@ triangleArea (const TriangleMesh& mesh, const std::array<int, 3>& t)
 }
 } // namespace
 
-bool
-isClosedMesh (const TriangleMesh& mesh)
+MeshEdges
+meshEdges (const TriangleMesh& mesh)
 {
   // Vertices welded by position: exporters split them where faces meet at a crease.
   std::map<std::array<double, 3>, int> welded;
   std::vector<int> id (mesh.vertices.size ());
   for (std::size_t i = 0; i < mesh.vertices.size (); ++i)
     id[i] = welded.emplace (mesh.vertices[i], static_cast<int> (welded.size ())).first->second;
-  // Each directed edge once, and its reverse once.
-  std::map<std::pair<int, int>, int> edges;
+  // Per undirected edge (low, high): how many triangles run it low -> high, and high -> low.
+  std::map<std::pair<int, int>, std::array<int, 2>> edges;
   for (const auto& t : mesh.triangles)
   {
     if (!(triangleArea (mesh, t) > 0.0))
       continue;
     for (int k = 0; k < 3; ++k)
-      ++edges[{id[static_cast<std::size_t> (t[k])], id[static_cast<std::size_t> (t[(k + 1) % 3])]}];
+    {
+      const int u = id[static_cast<std::size_t> (t[k])], v = id[static_cast<std::size_t> (t[(k + 1) % 3])];
+      ++edges[{std::min (u, v), std::max (u, v)}][u < v ? 0 : 1];
+    }
   }
-  if (edges.empty ())
-    return false;
-  for (const auto& [edge, count] : edges)
+  MeshEdges counts;
+  for (const auto& [edge, runs] : edges)
   {
-    const auto reverse = edges.find ({edge.second, edge.first});
-    if (count != 1 || reverse == edges.end () || reverse->second != 1)
-      return false;
+    const int total = runs[0] + runs[1];
+    if (total == 1)
+      ++counts.open;
+    else if (total > 2)
+      ++counts.fins;
+    else if (runs[0] == 1)
+      ++counts.closed;
+    else
+      ++counts.flipped;
   }
-  return true;
+  return counts;
+}
+
+bool
+isClosedMesh (const TriangleMesh& mesh)
+{
+  const MeshEdges e = meshEdges (mesh);
+  return e.closed > 0 && e.open == 0 && e.flipped == 0 && e.fins == 0;
 }
 
 double

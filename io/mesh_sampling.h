@@ -46,6 +46,17 @@ double meshArea (const TriangleMesh& mesh);
   * (openMeshWarning). A closed mesh wound inward (a cavity) is closed. */
 bool isClosedMesh (const TriangleMesh& mesh);
 
+/** \brief How a mesh's edges are bordered (vertices welded and triangles without area left out
+  * as isClosedMesh does; each edge counted once): by two triangles that run it in opposite
+  * directions (closed there), by one (open), by two that run it the same way (a face wound
+  * against its neighbour: flipped), or by more than two (a fin). isClosedMesh: edges but no
+  * open, flipped or fin edge. */
+struct MeshEdges
+{
+  std::size_t closed = 0, open = 0, flipped = 0, fins = 0;
+};
+MeshEdges meshEdges (const TriangleMesh& mesh);
+
 /** \brief The volume the faces enclose by their winding (the divergence theorem, about the
   * vertices' centroid): positive for a closed mesh wound outward, negative for one wound inward
   * (a cavity, or a solid exported inside out; insideOutMeshWarning). Meaningful for a closed

@@ -1748,10 +1748,15 @@ PYBIND11_MODULE (_core, m)
          py::arg ("vertices"), py::arg ("triangles"),
          "The volume a closed mesh's faces enclose by their winding: positive wound outward, negative wound inward\n"
          "(a cavity, or a solid exported inside out).");
-  m.def ("open_mesh_warning", &pcl_probcollision::io::openMeshWarning, py::arg ("path"), py::arg ("closed"),
-         py::arg ("orientation_option"),
-         "pcd_collision's warning for a mesh oriented by its faces under -surface that is not closed (closed:\n"
-         "is_closed_mesh), naming the option that makes it two-sided; '' for a closed mesh.");
+  m.def ("open_mesh_warning",
+         [] (const std::string& path, const py::object& vertices, const py::object& triangles,
+             const std::string& orientation_option) {
+           return pcl_probcollision::io::openMeshWarning (path, pcl_probcollision::io::meshEdges (meshOf (vertices, triangles)),
+                                                          orientation_option);
+         },
+         py::arg ("path"), py::arg ("vertices"), py::arg ("triangles"), py::arg ("orientation_option"),
+         "pcd_collision's warning for a mesh oriented by its faces under -surface that is not closed (open, or with\n"
+         "faces wound against their neighbours), naming the option that orients it otherwise; '' for a closed mesh.");
   m.def ("inside_out_mesh_warning", &pcl_probcollision::io::insideOutMeshWarning, py::arg ("path"), py::arg ("closed"),
          py::arg ("signed_volume"), py::arg ("orientation_option"), py::arg ("closed_option"),
          "pcd_collision's warning for a closed mesh oriented by its faces under -surface whose faces wind inward\n"

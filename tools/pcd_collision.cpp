@@ -541,8 +541,9 @@ run (int argc, char** argv)
     if (o.surface && in->kind == InputKind::Mesh && orientation != pcl_probcollision::NormalOrientation::Propagate &&
         orientation != pcl_probcollision::NormalOrientation::Viewpoint)
     {
+      const pcl_probcollision::io::MeshEdges edges = pcl_probcollision::io::meshEdges (in->mesh);
       const bool closed = pcl_probcollision::io::isClosedMesh (in->mesh);
-      warn (pcl_probcollision::io::openMeshWarning (in->path, closed, option));
+      warn (pcl_probcollision::io::openMeshWarning (in->path, edges, option));
       warn (pcl_probcollision::io::insideOutMeshWarning (in->path, closed, pcl_probcollision::io::meshSignedVolume (in->mesh),
                                                          option, in == &a ? "-closed_a" : "-closed_b"));
     }

@@ -146,10 +146,20 @@ TEST (InputWarnings, ACloudsFactsCountAndSpanItsFinitePointsOnly)
 // naming the file and the option that makes it two-sided; a closed one is not.
 TEST (InputWarnings, AnOpenMeshIsWarnedOfNamingTheWayOut)
 {
-  EXPECT_TRUE (openMeshWarning ("box.obj", true, "-orientation_a").empty ());
-  const std::string w = openMeshWarning ("bin.obj", false, "-orientation_b");
-  EXPECT_NE (w.find ("mesh 'bin.obj' is not closed"), std::string::npos) << w;
+  MeshEdges closed, open, flipped;
+  closed.closed = open.closed = flipped.closed = 18;
+  open.open = 4;
+  flipped.flipped = 3;
+  EXPECT_TRUE (openMeshWarning ("box.obj", closed, "-orientation_a").empty ());
+  const std::string w = openMeshWarning ("bin.obj", open, "-orientation_b");
+  EXPECT_NE (w.find ("mesh 'bin.obj' is not closed (an edge does not border"), std::string::npos) << w;
   EXPECT_NE (w.find ("give -orientation_b propagate"), std::string::npos) << w;
+  // Closed but for a face wound against its neighbours: named as flipped, not as a container.
+  const std::string f = openMeshWarning ("box.obj", flipped, "-orientation_a");
+  EXPECT_NE (f.find ("mesh 'box.obj' is not closed: at 3 of its edges both triangles run the same way"), std::string::npos)
+      << f;
+  EXPECT_NE (f.find ("give -orientation_a propagate"), std::string::npos) << f;
+  EXPECT_EQ (f.find ("container"), std::string::npos) << f;
 }
 
 TEST (InputWarnings, AnInsideOutMeshIsWarnedOfNamingTheWayOut)

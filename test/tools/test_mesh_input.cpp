@@ -231,6 +231,12 @@ TEST_F (MeshInput, ClosedMeshesAreTheOnesThatBoundASolid)
     std::string error;
     ASSERT_TRUE (pcl_probcollision::io::loadTriangleMesh ((dir_ / name).string (), mesh, error)) << error;
     EXPECT_EQ (pcl_probcollision::io::isClosedMesh (mesh), closed) << name;
+    // The cube's 18 edges (its six quads' diagonals included): the bin's top four open, the
+    // flipped face's four run the same way by both its triangles and their neighbours'.
+    const pcl_probcollision::io::MeshEdges edges = pcl_probcollision::io::meshEdges (mesh);
+    EXPECT_EQ (edges.open, std::string (name) == "bin.obj" ? 4u : 0u) << name;
+    EXPECT_EQ (edges.flipped, std::string (name) == "flipped_face.obj" ? 4u : 0u) << name;
+    EXPECT_EQ (edges.fins, 0u) << name;
     // The unit cube's volume, by its winding: negative wound inward.
     if (closed)
       EXPECT_NEAR (pcl_probcollision::io::meshSignedVolume (mesh), std::string (name) == "inside_out.obj" ? -1.0 : 1.0, 1e-12)

@@ -595,7 +595,7 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     for side, spec in (("a", A), ("b", B)):
         if o["surface"] and spec["kind"] == "mesh" and o["orientation_" + side] not in ("propagate", "viewpoint"):
             closed = core.is_closed_mesh(spec["vertices"], spec["triangles"])
-            _warn(core.open_mesh_warning(spec["path"], closed, "-orientation_" + side))
+            _warn(core.open_mesh_warning(spec["path"], spec["vertices"], spec["triangles"], "-orientation_" + side))
             _warn(core.inside_out_mesh_warning(spec["path"], closed,
                                                core.mesh_signed_volume(spec["vertices"], spec["triangles"]),
                                                "-orientation_" + side, "-closed_" + side))
