@@ -42,7 +42,14 @@ SensorPose::fromViewpoint (const Eigen::Vector4f& sensor_origin,
   SensorPose pose;
   pose.origin = sensor_origin.head<3> ().cast<double> ();
   Eigen::Quaterniond q = sensor_orientation.cast<double> ();
-  if (!(q.norm () > 0.0) || !std::isfinite (q.norm ()))
+  // A non-finite orientation is no viewing axis: NaN, which sensorPoseError names (it was
+  // taken for the identity without a word). A zero one is PCL's unset orientation: the identity.
+  if (!q.coeffs ().allFinite ())
+  {
+    pose.axis = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+    return pose;
+  }
+  if (!(q.norm () > 0.0))
     q = Eigen::Quaterniond::Identity ();
   pose.axis = (q.normalized () * Eigen::Vector3d::UnitZ ()).normalized ();
   return pose;
@@ -51,12 +58,16 @@ SensorPose::fromViewpoint (const Eigen::Vector4f& sensor_origin,
 std::string
 SensorNoiseModel::sensorPoseError (const SensorPose& sensor) const
 {
-  if (!usesSensorPose () || sensor.origin.allFinite ())
+  if (!usesSensorPose () || (sensor.origin.allFinite () && sensor.axis.allFinite ()))
     return std::string ();
   std::ostringstream out;
   out.precision (9);
-  out << "sensor origin (" << sensor.origin.x () << ", " << sensor.origin.y () << ", " << sensor.origin.z ()
-      << ") is not finite: the " << name () << " noise model measures each point's depth from it";
+  if (!sensor.origin.allFinite ())
+    out << "sensor origin (" << sensor.origin.x () << ", " << sensor.origin.y () << ", " << sensor.origin.z ()
+        << ") is not finite: the " << name () << " noise model measures each point's depth from it";
+  else
+    out << "sensor orientation is not finite (viewing axis (" << sensor.axis.x () << ", " << sensor.axis.y () << ", "
+        << sensor.axis.z () << ")): the " << name () << " noise model measures each point's depth along it";
   return out.str ();
 }
 

@@ -295,6 +295,21 @@ TEST (CovarianceEstimation, ADepthNoiseModelWithANonFiniteSensorOriginFailsClear
   EXPECT_EQ (SensorNoiseModel::kinect ().sensorPoseError (pose),
              "sensor origin (0, 0, inf) is not finite: the kinect noise model measures each point's depth from it");
   EXPECT_EQ (SensorNoiseModel::isotropic (0.01).sensorPoseError (pose), "");
+  // A non-finite sensor_orientation_ was taken for the identity without a word (the axis a
+  // depth model measures along); a zero one is PCL's unset orientation, the identity.
+  const SensorPose nan_axis = SensorPose::fromViewpoint (Eigen::Vector4f (0, 0, 1, 0), Eigen::Quaternionf (NAN, 0, 0, 0));
+  EXPECT_EQ (SensorNoiseModel::stereo ().sensorPoseError (nan_axis),
+             "sensor orientation is not finite (viewing axis (nan, nan, nan)): the stereo noise model measures each "
+             "point's depth along it");
+  EXPECT_EQ (SensorNoiseModel::isotropic (0.01).sensorPoseError (nan_axis), "");
+  const SensorPose unset = SensorPose::fromViewpoint (Eigen::Vector4f (0, 0, 1, 0), Eigen::Quaternionf (0, 0, 0, 0));
+  EXPECT_TRUE (unset.axis.isApprox (Eigen::Vector3d::UnitZ ()));
+  EXPECT_EQ (SensorNoiseModel::kinect ().sensorPoseError (unset), "");
+  cloud->sensor_origin_ = Eigen::Vector4f (0.0f, 0.0f, 1.0f, 0.0f);
+  cloud->sensor_orientation_ = Eigen::Quaternionf (0.0f, std::nanf (""), 0.0f, 0.0f);
+  est.setSensorPose (SensorPose::fromViewpoint (cloud->sensor_origin_, cloud->sensor_orientation_));
+  est.compute (out);
+  EXPECT_TRUE (out.empty ());
 }
 
 TEST (CovarianceEstimation, RealStereoScanKeepsAlignmentAndGivesFinitePsdCovariances)

@@ -16,7 +16,9 @@ struct SensorPose
   Eigen::Vector3d origin = Eigen::Vector3d::Zero ();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ ();
 
-  /** \brief From PCL's viewpoint fields (sensor_origin_, sensor_orientation_). */
+  /** \brief From PCL's viewpoint fields (sensor_origin_, sensor_orientation_). A zero
+    * orientation (unset) is the identity; a non-finite one gives a NaN axis, which
+    * SensorNoiseModel::sensorPoseError refuses for a depth model. */
   static SensorPose fromViewpoint (const Eigen::Vector4f& sensor_origin,
                                    const Eigen::Quaternionf& sensor_orientation);
 };
@@ -110,7 +112,8 @@ public:
   bool usesSensorPose () const;
   /** \brief Whether this model can work from that sensor pose: empty when it can (a model that
     * uses no sensor pose can work from any), otherwise why not, as "sensor origin (nan, 0, 1) is
-    * not finite: the kinect noise model measures each point's depth from it". The one rule:
+    * not finite: the kinect noise model measures each point's depth from it", or a non-finite
+    * viewing axis (SensorPose::fromViewpoint of a non-finite orientation). The one rule:
     * buildCloudModel() (naming the cloud) and CovarianceEstimation::initCompute() call it, so a
     * NaN sensor_origin_ is named as such instead of every covariance coming out NaN. */
   std::string sensorPoseError (const SensorPose& sensor) const;
