@@ -192,5 +192,17 @@ betweenSamplesWarning (bool both_meshes, bool free, std::size_t leaf_pairs_teste
                     "reads free. Check it with a smaller -mesh_density (said once a run)",
                     where.c_str (), spacing);
 }
+
+std::string
+coarseMeshWarning (bool free, std::size_t leaf_pairs_tested, const std::string& where, const std::string& mesh_path,
+                   double mesh_spacing, double cloud_spacing)
+{
+  if (!free || leaf_pairs_tested == 0 || !(mesh_spacing > kCoarseMeshRatio * cloud_spacing))
+    return {};
+  return formatted ("%s reads free, but mesh '%s' is sampled %g apart, %.0f times the other input's median spacing "
+                    "%g, and their samples come within reach there: a part of the other thinner than that passes "
+                    "between the mesh's samples and reads free. Check it with a smaller -mesh_density (said once a run)",
+                    where.c_str (), mesh_path.c_str (), mesh_spacing, mesh_spacing / cloud_spacing, cloud_spacing);
+}
 } // namespace io
 } // namespace pcl_probcollision

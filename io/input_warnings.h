@@ -105,5 +105,17 @@ std::string insideOutMeshWarning (const std::string& path, bool closed, double s
   * The command lines say it once a run, of the first such answer. */
 std::string betweenSamplesWarning (bool both_meshes, bool free, std::size_t leaf_pairs_tested, const std::string& where,
                                    double spacing);
+
+/** \brief How much coarser than the other cloud's median spacing a mesh's samples may be (a
+  * -mesh_density of the user's) before a free answer within reach is warned of. */
+constexpr double kCoarseMeshRatio = 2.0;
+
+/** \brief The warning for a "free" answer (where: "pose 3", "the pose") between a mesh sampled
+  * mesh_spacing apart and a cloud of median spacing cloud_spacing, more than kCoarseMeshRatio
+  * times finer, where their samples came within reach (leaf pairs were tested): a part of the
+  * cloud thinner than the mesh's spacing passes between its samples (a 5 cm cube 2 cm into a
+  * ground mesh sampled 0.3 m apart read free). Empty otherwise; said once a run. */
+std::string coarseMeshWarning (bool free, std::size_t leaf_pairs_tested, const std::string& where,
+                               const std::string& mesh_path, double mesh_spacing, double cloud_spacing);
 } // namespace io
 } // namespace pcl_probcollision

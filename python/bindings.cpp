@@ -1648,6 +1648,10 @@ PYBIND11_MODULE (_core, m)
   m.def ("between_samples_warning", &pcl_probcollision::io::betweenSamplesWarning, py::arg ("both_meshes"),
          py::arg ("free"), py::arg ("leaf_pairs_tested"), py::arg ("where"), py::arg ("spacing"),
          "pcd_collision's warning for a free answer between two meshes' samples (where: 'pose 3'); '' when none.");
+  m.def ("coarse_mesh_warning", &pcl_probcollision::io::coarseMeshWarning, py::arg ("free"), py::arg ("leaf_pairs_tested"),
+         py::arg ("where"), py::arg ("mesh_path"), py::arg ("mesh_spacing"), py::arg ("cloud_spacing"),
+         "pcd_collision's warning for a free answer within reach between a mesh sampled mesh_spacing apart (its\n"
+         "-mesh_density) and a cloud more than twice finer (median spacing cloud_spacing); '' when none.");
   m.def ("is_faceless_ply",
          [] (const std::filesystem::path& p) {
            requireRegularFile (p);

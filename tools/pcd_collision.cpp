@@ -768,9 +768,27 @@ run (int argc, char** argv)
 
     if (!warned_between_samples)
     {
-      const std::string warning = pcl_probcollision::io::betweenSamplesWarning (
-          both_meshes, result.verdict == pcl_probcollision::Verdict::Free, result.leaf_pairs_tested,
-          batch ? "pose " + std::to_string (i) : "the pose", std::max (a.spacing, b.spacing));
+      const bool free = result.verdict == pcl_probcollision::Verdict::Free;
+      const std::string where = batch ? "pose " + std::to_string (i) : "the pose";
+      std::string warning = pcl_probcollision::io::betweenSamplesWarning (both_meshes, free, result.leaf_pairs_tested, where,
+                                                                          std::max (a.spacing, b.spacing));
+      // One mesh sampled at the user's -mesh_density, coarser than the cloud it meets.
+      if (warning.empty () && !both_meshes && o.mesh_spacing && (a.kind == InputKind::Mesh || b.kind == InputKind::Mesh))
+      {
+        const Input& mesh = a.kind == InputKind::Mesh ? a : b;
+        const Input& cloud = a.kind == InputKind::Mesh ? b : a;
+        const auto cloud_model = a.kind == InputKind::Mesh ? pc.getTargetModel () : pc.getInputModel ();
+        if (free && result.leaf_pairs_tested > 0)
+        {
+          // The build's neighbour search measured it; where it could not (merged samples), as the
+          // sampling measures it.
+          double spacing = cloud_model ? cloud_model->medianNeighbourSpacing () : std::nan ("");
+          if (std::isnan (spacing))
+            spacing = medianSpacing (*cloud.cloud);
+          warning = pcl_probcollision::io::coarseMeshWarning (free, result.leaf_pairs_tested, where, mesh.path, mesh.spacing,
+                                                              spacing);
+        }
+      }
       if (!warning.empty ())
       {
         warned_between_samples = true;

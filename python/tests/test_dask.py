@@ -550,6 +550,12 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
     faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2), (3, 4, 8), (3, 8, 7), (1, 3, 7),
              (1, 7, 5), (2, 6, 8), (2, 8, 4)]
     (tmp_path / "cube.obj").write_text("".join("v %g %g %g\n" % c for c in corners) + "".join("f %d %d %d\n" % f for f in faces))
+    (tmp_path / "ground.obj").write_text("".join("v %d %d %d\n" % (x, y, z) for z in (-1, 0) for y in (-5, 5) for x in (-5, 5))
+                                         + "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 2 4 8 6\nf 4 3 7 8\nf 3 1 5 7\n")
+    grid = np.arange(26) * 0.002
+    cube = np.array([(x, y, z) for x in grid for y in grid for z in grid
+                     if min(x, y, z) == 0 or max(x, y, z) > 0.0499]) + np.array([0.1, -2.5, -0.02])
+    write_pcd(tmp_path / "cube.pcd", cube)
     (tmp_path / "inside_out.obj").write_text("".join("v %g %g %g\n" % c for c in corners) +
                                              "".join("f %d %d %d\n" % (f[0], f[2], f[1]) for f in faces))
     poses = tmp_path / "poses.txt"
@@ -559,6 +565,10 @@ def test_cli_warns_as_pcd_collision_does(tmp_path, table_points):
         "the models' precision": ([str(tmp_path / "far32.pcd")] * 2, ["-sigma", "0.002"], 2),
         # the cube through the plate, sampled 8 cm apart: free at pose 0, which collides
         "between samples": ([str(tmp_path / "cube.obj"), str(tmp_path / "plate.obj")], ["-mesh_density", "0.08"], 1),
+        # a cloud 2 cm into a mesh sampled 0.3 m apart, over 100 times its spacing: free at pose 0 (and
+        # their sizes differ by over 100x)
+        "a coarse mesh": ([str(tmp_path / "cube.pcd"), str(tmp_path / "ground.obj")],
+                          ["-mesh_density", "0.3", "-sigma", "0.001"], 2),
         # under the surface layer: the cube wound inward, the plate not closed
         "meshes' winding": ([str(tmp_path / "inside_out.obj"), str(tmp_path / "plate.obj")],
                             ["-surface", "-mesh_density", "0.02"], 2),

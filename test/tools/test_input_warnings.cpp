@@ -162,6 +162,18 @@ TEST (InputWarnings, AnOpenMeshIsWarnedOfNamingTheWayOut)
   EXPECT_EQ (f.find ("container"), std::string::npos) << f;
 }
 
+TEST (InputWarnings, ACoarseMeshIsWarnedOfWhereAFreeAnswerCameWithinReach)
+{
+  EXPECT_TRUE (coarseMeshWarning (false, 10, "pose 2", "ground.obj", 0.3, 0.002).empty ());  // not free
+  EXPECT_TRUE (coarseMeshWarning (true, 0, "pose 2", "ground.obj", 0.3, 0.002).empty ());   // nothing within reach
+  EXPECT_TRUE (coarseMeshWarning (true, 10, "pose 2", "ground.obj", 0.004, 0.002).empty ());  // 2x: the ratio's edge
+  EXPECT_TRUE (coarseMeshWarning (true, 10, "pose 2", "ground.obj", 0.3, std::nan ("")).empty ());  // not measured
+  const std::string w = coarseMeshWarning (true, 10, "pose 2", "ground.obj", 0.3, 0.002);
+  EXPECT_NE (w.find ("pose 2 reads free, but mesh 'ground.obj' is sampled 0.3 apart, 150 times the other input's median "
+                     "spacing 0.002"),
+             std::string::npos) << w;
+}
+
 TEST (InputWarnings, AnInsideOutMeshIsWarnedOfNamingTheWayOut)
 {
   EXPECT_TRUE (insideOutMeshWarning ("box.obj", true, 1.0, "-orientation_a", "-closed_a").empty ());

@@ -1358,6 +1358,45 @@ TEST_F (PcdCollisionTool, TwoMeshesWarnWhereAFreeAnswerCameWithinReach)
   EXPECT_EQ (far.err.find ("warning"), std::string::npos) << far.err;
 }
 
+// A cloud against a mesh sampled at the user's -mesh_density, 150 times coarser than the cloud: a
+// 5 cm cube 2 cm into a ground box sampled 0.3 m apart read free with no warning (a probe,
+// 2026-12-04); the two-mesh warning above did not apply. It is warned of now, once; far above
+// the ground, free without a leaf pair, it is not.
+TEST_F (PcdCollisionTool, ACoarseMeshWarnsWhereAFreeAnswerCameWithinReach)
+{
+  std::ostringstream obj;
+  for (const int z : {-1, 0})
+    for (const int y : {-5, 5})
+      for (const int x : {-5, 5})
+        obj << "v " << x << " " << y << " " << z << "\n";
+  obj << "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 2 4 8 6\nf 4 3 7 8\nf 3 1 5 7\n";
+  writeFile (dir_ / "ground.obj", obj.str ());
+  std::ostringstream points;
+  int n = 0;
+  for (int i = 0; i <= 25; ++i)
+    for (int j = 0; j <= 25; ++j)
+      for (int k = 0; k <= 25; ++k)
+        if (i % 25 == 0 || j % 25 == 0 || k % 25 == 0)
+        {
+          points << 0.002 * i << " " << 0.002 * j << " " << 0.002 * k - 0.02 << "\n";  // 2 cm under z = 0
+          ++n;
+        }
+  writeFile (dir_ / "cube.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string (n) +
+                                    "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string (n) + "\nDATA ascii\n" +
+                                    points.str ());
+  const std::string cube = (dir_ / "cube.pcd").string (), ground = (dir_ / "ground.obj").string ();
+  const ToolRun into = run ({cube, ground, "-mesh_density", "0.3", "-sigma", "0.001", "-pose", "0.1,-2.5,0,0,0,0"});
+  ASSERT_EQ (into.status, 0) << into.err;
+  EXPECT_NE (into.out.find ("free"), std::string::npos) << into.out;  // the miss this warns of
+  EXPECT_NE (into.err.find ("pcd_collision: warning: the pose reads free, but mesh '" + ground + "' is sampled 0.3 apart, 150 "
+                            "times the other input's median spacing"),
+             std::string::npos) << into.err;
+  const ToolRun above = run ({cube, ground, "-mesh_density", "0.3", "-sigma", "0.001", "-pose", "0.1,-2.5,100,0,0,0"});
+  ASSERT_EQ (above.status, 0) << above.err;
+  EXPECT_NE (above.out.find ("free"), std::string::npos) << above.out;
+  EXPECT_EQ (above.err.find ("reads free, but"), std::string::npos) << above.err;
+}
+
 TEST_F (PcdCollisionTool, EmptyCloud)
 {
   writeFile (dir_ / "empty.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 0\n"

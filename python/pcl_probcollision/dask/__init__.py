@@ -643,11 +643,16 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     # The models' precision warnings (built on the workers, which leave them to the client).
     for f, side in zip(facts, "ab"):
         _warn(core.model_warning(f, r.model_warnings[side]))
+    free = np.flatnonzero((r.verdict == int(core.Verdict.Free)) & (r.leaf_pairs_tested > 0))
     if A["kind"] == B["kind"] == "mesh":
-        free = np.flatnonzero((r.verdict == int(core.Verdict.Free)) & (r.leaf_pairs_tested > 0))
         if free.size:
             _warn(core.between_samples_warning(True, True, int(r.leaf_pairs_tested[free[0]]), f"pose {free[0]}",
                                                max(A["spacing"], B["spacing"])))
+    elif "mesh" in (A["kind"], B["kind"]) and o["mesh_density"] is not None and free.size:
+        # One mesh sampled at the user's mesh_density, coarser than the cloud it meets.
+        mesh, cloud = (A, B) if A["kind"] == "mesh" else (B, A)
+        _warn(core.coarse_mesh_warning(True, int(r.leaf_pairs_tested[free[0]]), f"pose {free[0]}",
+                                       mesh["path"], mesh["spacing"], core.median_spacing(cloud["points"])))
     return r
 
 
