@@ -1376,8 +1376,9 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
     answer.signed_distance_std = s.medianSpacing ();
     // Inside a surface seen from one viewpoint: behind it, where no sample looked.
     answer.unobserved = s.seenFromViewpoint ();
-    answer.inside_confirmed = !answer.unobserved;
   }
+  // P = 1 rests on this point, inside a solid unless behind a scan's view.
+  answer.inside_confirmed = answer.inside_confirmed || !s.seenFromViewpoint ();
   answer.probability = 1.0;
 }
 } // namespace
