@@ -151,7 +151,7 @@ modelWarning (const InputFacts& in, const std::string& model_warning)
 std::string
 openMeshWarning (const std::string& path, const MeshEdges& edges, const std::string& orientation_option)
 {
-  if (edges.closed > 0 && edges.open == 0 && edges.flipped == 0 && edges.fins == 0)
+  if (edges.isClosed ())
     return {};
   if (edges.open == 0 && edges.fins == 0 && edges.flipped > 0)
     return formatted ("mesh '%s' is not closed: at %zu of its edges both triangles run the same way, so some faces are "

@@ -77,8 +77,7 @@ meshEdges (const TriangleMesh& mesh)
 bool
 isClosedMesh (const TriangleMesh& mesh)
 {
-  const MeshEdges e = meshEdges (mesh);
-  return e.closed > 0 && e.open == 0 && e.flipped == 0 && e.fins == 0;
+  return meshEdges (mesh).isClosed ();
 }
 
 double

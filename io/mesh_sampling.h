@@ -49,11 +49,16 @@ bool isClosedMesh (const TriangleMesh& mesh);
 /** \brief How a mesh's edges are bordered (vertices welded and triangles without area left out
   * as isClosedMesh does; each edge counted once): by two triangles that run it in opposite
   * directions (closed there), by one (open), by two that run it the same way (a face wound
-  * against its neighbour: flipped), or by more than two (a fin). isClosedMesh: edges but no
-  * open, flipped or fin edge. */
+  * against its neighbour: flipped), or by more than two (a fin). */
 struct MeshEdges
 {
   std::size_t closed = 0, open = 0, flipped = 0, fins = 0;
+  /** \brief isClosedMesh's rule: edges, none of them open, flipped or a fin. */
+  bool
+  isClosed () const
+  {
+    return closed > 0 && open == 0 && flipped == 0 && fins == 0;
+  }
 };
 MeshEdges meshEdges (const TriangleMesh& mesh);
 

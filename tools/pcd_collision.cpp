@@ -542,9 +542,8 @@ run (int argc, char** argv)
         orientation != pcl_probcollision::NormalOrientation::Viewpoint)
     {
       const pcl_probcollision::io::MeshEdges edges = pcl_probcollision::io::meshEdges (in->mesh);
-      const bool closed = pcl_probcollision::io::isClosedMesh (in->mesh);
       warn (pcl_probcollision::io::openMeshWarning (in->path, edges, option));
-      warn (pcl_probcollision::io::insideOutMeshWarning (in->path, closed, pcl_probcollision::io::meshSignedVolume (in->mesh),
+      warn (pcl_probcollision::io::insideOutMeshWarning (in->path, edges.isClosed (), pcl_probcollision::io::meshSignedVolume (in->mesh),
                                                          option, in == &a ? "-closed_a" : "-closed_b"));
     }
 

@@ -237,10 +237,13 @@ TEST_F (MeshInput, ClosedMeshesAreTheOnesThatBoundASolid)
     EXPECT_EQ (edges.open, std::string (name) == "bin.obj" ? 4u : 0u) << name;
     EXPECT_EQ (edges.flipped, std::string (name) == "flipped_face.obj" ? 4u : 0u) << name;
     EXPECT_EQ (edges.fins, 0u) << name;
+    EXPECT_EQ (edges.isClosed (), closed) << name;
     // The unit cube's volume, by its winding: negative wound inward.
     if (closed)
+    {
       EXPECT_NEAR (pcl_probcollision::io::meshSignedVolume (mesh), std::string (name) == "inside_out.obj" ? -1.0 : 1.0, 1e-12)
           << name;
+    }
   }
 }
 

@@ -594,9 +594,10 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     # A mesh oriented by its faces under the surface layer: not closed, or closed and wound inward.
     for side, spec in (("a", A), ("b", B)):
         if o["surface"] and spec["kind"] == "mesh" and o["orientation_" + side] not in ("propagate", "viewpoint"):
-            closed = core.is_closed_mesh(spec["vertices"], spec["triangles"])
-            _warn(core.open_mesh_warning(spec["path"], spec["vertices"], spec["triangles"], "-orientation_" + side))
-            _warn(core.inside_out_mesh_warning(spec["path"], closed,
+            # '' exactly for a closed mesh (MeshEdges::isClosed): the edges are counted once.
+            open_warning = core.open_mesh_warning(spec["path"], spec["vertices"], spec["triangles"], "-orientation_" + side)
+            _warn(open_warning)
+            _warn(core.inside_out_mesh_warning(spec["path"], not open_warning,
                                                core.mesh_signed_volume(spec["vertices"], spec["triangles"]),
                                                "-orientation_" + side, "-closed_" + side))
     _sample_meshes(A, B, o)
