@@ -1500,6 +1500,16 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("surface_hidden_from_viewpoint", surfaceNumber (&SurfaceModel::hiddenFromViewpoint),
                               "Where orientation Auto weighed a viewpoint outside the cloud, the share of points hidden from it\n"
                               "behind others (above 0.1 it propagated instead; SurfaceModel::hiddenFromViewpoint); NaN otherwise.")
+      .def_property_readonly ("surface_normals_turned_to_viewpoint",
+                              [] (const CloudModel& c) -> py::object {
+                                if (c.surface ().empty ())
+                                  return py::none ();
+                                return py::cast (c.surface ().normalsTurnedToViewpoint ());
+                              },
+                              "Whether orientation Auto set the given normals aside: they all face a viewpoint outside the\n"
+                              "cloud (as PCL's normal estimation turns them) that more than 0.1 of the points hide behind\n"
+                              "others from, so they are not outward; their sides were propagated\n"
+                              "(SurfaceModel::normalsTurnedToViewpoint). None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +

@@ -729,10 +729,37 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
   if (mode == NormalOrientation::Auto && !any_given && view_outside)
     hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
+  // Given normals that face a viewpoint outside the cloud as a scan's do: enough of them facing
+  // it, few away (PCL's normal estimation turns every normal toward its viewpoint). Outward
+  // normals of a closed object face a viewpoint on one side and away on the other.
+  bool given_face_view = false;
+  if (any_given && view_outside && (mode == NormalOrientation::Auto || mode == NormalOrientation::PointNormals))
+  {
+    std::size_t toward = 0, away = 0;
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      if (!in.given[i] || normals_[i].isZero ())
+        continue;
+      const Eigen::Vector3d sight = *in.viewpoint - points[i];
+      const double cosine = normals_[i].cast<double> ().dot (sight) / std::max (sight.norm (), 1e-300);
+      toward += cosine >= kMinViewCosine ? 1 : 0;
+      away += cosine <= -kMinViewCosine ? 1 : 0;
+    }
+    const double facing = static_cast<double> (toward + away);
+    given_face_view = facing >= kMinViewSeeds * static_cast<double> (n) &&
+                      static_cast<double> (away) <= kMaxViewDisagreement * facing;
+    if (given_face_view)
+      hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
+  }
+  // Such normals on a cloud that viewpoint cannot see as one scan (a sphere sampled all round,
+  // its normals turned toward PCL's default origin beside it: two thirds point in) say nothing
+  // of the outside: Auto keeps their directions and propagates their sides.
+  normals_turned_to_view_ = mode == NormalOrientation::Auto && given_face_view &&
+                            hidden_from_view_ > SurfaceModel::kMaxHiddenShare;
   if (mode == NormalOrientation::Auto)
-    mode = any_given ? NormalOrientation::PointNormals
-                     : view_outside && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
-                                                                           : NormalOrientation::Propagate;
+    mode = any_given && !normals_turned_to_view_ ? NormalOrientation::PointNormals
+           : view_outside && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
+                                                                              : NormalOrientation::Propagate;
   if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
     mode = NormalOrientation::Propagate;
   orientation_ = mode;
@@ -780,29 +807,10 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     orientation_ = mode = NormalOrientation::Propagate;
   // Seen from one viewpoint, the space behind the surface was never observed (the query's
   // `unobserved`). Given normals say so too when they face a viewpoint outside the cloud as a
-  // scan's do (PCL's normal estimation turns them toward it): enough of them facing it, few
-  // away, and nothing hidden. A closed mesh's samples face it on one side and away on the other.
-  seen_from_view_ = mode == NormalOrientation::Viewpoint;
-  if (mode == NormalOrientation::PointNormals && view_outside)
-  {
-    std::size_t toward = 0, away = 0;
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      if (!in.given[i] || normals_[i].isZero ())
-        continue;
-      const Eigen::Vector3d sight = *in.viewpoint - points[i];
-      const double cosine = normals_[i].cast<double> ().dot (sight) / std::max (sight.norm (), 1e-300);
-      toward += cosine >= kMinViewCosine ? 1 : 0;
-      away += cosine <= -kMinViewCosine ? 1 : 0;
-    }
-    const double facing = static_cast<double> (toward + away);
-    if (facing >= kMinViewSeeds * static_cast<double> (n) && static_cast<double> (away) <= kMaxViewDisagreement * facing)
-    {
-      if (std::isnan (hidden_from_view_))
-        hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
-      seen_from_view_ = hidden_from_view_ <= SurfaceModel::kMaxHiddenShare;
-    }
-  }
+  // scan's do and it hides nothing.
+  seen_from_view_ = mode == NormalOrientation::Viewpoint ||
+                    (mode == NormalOrientation::PointNormals && given_face_view &&
+                     hidden_from_view_ <= SurfaceModel::kMaxHiddenShare);
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));

@@ -1043,6 +1043,57 @@ TEST (SurfaceModel, ClosedObjectsCheckTheirPropagatedOrientation)
   EXPECT_TRUE (given->surface ().insideKnown ());
 }
 
+// A closed object saved with PCL's normals: NormalEstimation turns each one toward the cloud's
+// viewpoint (PCL's default origin, here beside the sphere), so those of the far side point in.
+// Taken as outward, they made a ball inside the sphere read free in every setting, without a
+// word (probe of 2026-12-04). Auto now sees normals that all face a viewpoint from which much
+// of the cloud is hidden, sets their sides aside and propagates; `closed_objects` then checks
+// the sphere closed and the ball reads collision.
+TEST (SurfaceModel, NormalsTurnedTowardAViewpointBesideAClosedObjectAreNotOutward)
+{
+  const Eigen::Vector3d c (0.6, 0.0, 0.0);
+  const auto outward = sphere (3000, 0.2, c);
+  auto turned = outward;
+  std::size_t inward = 0;
+  for (auto& p : turned)
+    if (p.getNormalVector3fMap ().dot (-p.getVector3fMap ()) < 0.0f)  // pcl::flipNormalTowardsViewpoint's rule
+    {
+      p.getNormalVector3fMap () = -p.getNormalVector3fMap ();
+      ++inward;
+    }
+  ASSERT_GT (inward, turned.size () / 2);  // the sphere's origin side is the smaller cap
+  const auto as_given = buildCloudModel (outward, withSurface ());
+  EXPECT_EQ (as_given->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_FALSE (as_given->surface ().normalsTurnedToViewpoint ());
+  const auto set_aside = buildCloudModel (turned, withSurface ());
+  EXPECT_EQ (set_aside->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_TRUE (set_aside->surface ().normalsTurnedToViewpoint ());
+  EXPECT_GT (set_aside->surface ().hiddenFromViewpoint (), SurfaceModel::kMaxHiddenShare);
+  EXPECT_FALSE (set_aside->surface ().insideKnown ());  // two-sided until declared closed
+  EXPECT_FALSE (set_aside->surface ().seenFromViewpoint ());
+  // Asked for by name, the normals are taken as they are.
+  CloudModelParams asked = withSurface ();
+  asked.orientation = NormalOrientation::PointNormals;
+  const auto taken = buildCloudModel (turned, asked);
+  EXPECT_EQ (taken->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_FALSE (taken->surface ().normalsTurnedToViewpoint ());
+
+  const auto closed = buildCloudModel (turned, closedObjects (withSurface ()));
+  ASSERT_EQ (closed->surface ().orientation (), NormalOrientation::Propagate);
+  ASSERT_TRUE (closed->surface ().insideKnown ()) << closed->surface ().closedShare ();
+  const auto ball = buildCloudModel (xyz (sphere (400, 0.05, c)), withSurface ());
+  for (const auto* model : {&as_given, &closed})
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*ball, **model, Eigen::Isometry3d::Identity (), surfaceRequest (), r));
+    EXPECT_EQ (r.verdict, Verdict::InCollision) << "P " << r.probability;
+    EXPECT_LT (r.signed_distance, -0.1) << r.signed_distance;  // the wall is 0.15 from the ball
+  }
+  CollisionResult taken_answer;
+  ASSERT_TRUE (collide (*ball, *taken, Eigen::Isometry3d::Identity (), surfaceRequest (), taken_answer));
+  EXPECT_NE (taken_answer.verdict, Verdict::InCollision) << "the turned normals' inside is no longer the sphere's";
+}
+
 // Uniformly random samples (not a lattice): the sample areas add up to about the surface's
 // area, on a plane and on a sphere, so that a declared closed sphere checks out (its winding
 // number at the centre about 1). Weighted by the squared spacings instead, the plane read 0.77

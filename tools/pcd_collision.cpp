@@ -335,7 +335,12 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   }
   std::string why;
   const double hidden = model.surface ().hiddenFromViewpoint ();
-  if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
+  if (model.surface ().normalsTurnedToViewpoint ())
+    why = "; not the file's normals: they all face its VIEWPOINT, as PCL's normal estimation turns them, and " +
+          std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
+          " % of the points lie behind others from there (one scan hides none), so they are not outward "
+          "(-orientation point_normals to take them)";
+  else if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
     why = hidden > pcl_probcollision::SurfaceModel::kMaxHiddenShare
               ? "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
                     " % of the points lie behind others (one scan hides none)"

@@ -138,6 +138,12 @@ public:
     * normals lie within 78 degrees of the line of sight (toward the viewpoint or away), at most a
     * tenth of those away, and at most kMaxHiddenShare of the points hidden behind others. */
   bool seenFromViewpoint () const { return seen_from_view_; }
+  /** \brief Whether Auto set the caller's normals aside because they all face a viewpoint outside
+    * the cloud, as PCL's normal estimation turns them, while more than kMaxHiddenShare of the
+    * points lie hidden from it (hiddenFromViewpoint()): turned toward a sensor that did not see the
+    * cloud as one scan, they are not outward (a closed object's would face it on one side only).
+    * Their directions are kept and their sides propagated (orientation() Propagate). */
+  bool normalsTurnedToViewpoint () const { return normals_turned_to_view_; }
   /** \brief Shares of the closed-objects check's probes that must read outside in front
     * (closedShare) and inside behind (solidShare) for a propagated orientation to be trusted
     * (insideKnown). In front, all but stray normals read outside on a closed surface oriented
@@ -223,6 +229,7 @@ private:
   std::size_t propagated_ = 0;
   double hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
   bool seen_from_view_ = false;
+  bool normals_turned_to_view_ = false;
   double closed_share_ = std::numeric_limits<double>::quiet_NaN ();
   double solid_share_ = std::numeric_limits<double>::quiet_NaN ();
 };

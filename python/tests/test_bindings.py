@@ -599,6 +599,36 @@ def test_closed_objects_know_their_inside():
     assert pc.collide(ball, undeclared, np.eye(4), request).verdict == pc.Verdict.Free
 
 
+def test_normals_turned_toward_a_viewpoint_beside_a_solid_are_set_aside():
+    # A sphere's normals as PCL's normal estimation leaves them, turned toward a viewpoint beside
+    # it: most point in. Auto sets them aside and propagates; declared closed, a ball inside reads
+    # collision. Asked for by name (PointNormals), they are taken as they are.
+    i = np.arange(3000) + 0.5
+    polar, azimuth = np.arccos(1.0 - 2.0 * i / 3000), np.pi * (1.0 + 5.0 ** 0.5) * i
+    unit = np.stack([np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=1)
+    centre, view = np.array([0.6, 0.0, 0.0]), (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    points = 0.2 * unit + centre
+    turned = np.where((np.einsum("ij,ij->i", unit, -points) < 0)[:, None], -unit, unit)
+    assert np.mean(np.einsum("ij,ij->i", turned, unit) < 0) > 0.5
+    closed = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, closed_objects=True)
+    aside = pc.build_model(points, params=closed, normals=turned, viewpoint=view)
+    assert aside.surface_normals_turned_to_viewpoint is True
+    assert aside.surface_orientation == pc.NormalOrientation.Propagate and aside.surface_inside_known is True
+    assert aside.surface_hidden_from_viewpoint > 0.1
+    outward = pc.build_model(points, params=closed, normals=unit, viewpoint=view)
+    assert outward.surface_normals_turned_to_viewpoint is False
+    assert outward.surface_orientation == pc.NormalOrientation.PointNormals
+    asked = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True,
+                                orientation=pc.NormalOrientation.PointNormals)
+    taken = pc.build_model(points, params=asked, normals=turned, viewpoint=view)
+    assert taken.surface_orientation == pc.NormalOrientation.PointNormals
+    assert taken.surface_normals_turned_to_viewpoint is False
+    assert pc.build_model(points).surface_normals_turned_to_viewpoint is None  # no surface model
+    ball = pc.build_model(0.05 * unit[::10] + centre, params=pc.CloudModelParams(surface=True))
+    inside = pc.collide(ball, aside, np.eye(4), pc.CollisionRequest(surface=True))
+    assert inside.verdict == pc.Verdict.InCollision, inside
+
+
 def test_surface_normals_and_orientation_options(sheets):
     a, b, A, B = sheets
     # The normals change the surface only: the points' model (origin, size) is the same.

@@ -1935,6 +1935,60 @@ TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
   }
 }
 
+// A sphere saved with PCL's normals, turned toward its VIEWPOINT beside it (most of them then
+// point in): taken as outward they made the probe inside read free even with -closed, without a
+// word. The normals are set aside (the Orienting line says why), so -closed_b checks the
+// propagated sphere closed and the probe collides; -orientation_b point_normals takes them anyway.
+TEST_F (PcdCollisionTool, NormalsTurnedTowardAViewpointBesideASolidAreSetAside)
+{
+  constexpr int kSphere = 2000, kProbe = 60;
+  std::string rows;
+  for (const std::string& row : lines (sphereRows (kSphere, 0.1, 1.0, true)))
+  {
+    double v[6];
+    ASSERT_EQ (std::sscanf (row.c_str (), "%lf %lf %lf %lf %lf %lf", v, v + 1, v + 2, v + 3, v + 4, v + 5), 6);
+    // pcl::flipNormalTowardsViewpoint toward (-0.3, 0, 0)
+    const double toward = v[3] * (-0.3 - v[0]) - v[4] * v[1] - v[5] * v[2];
+    char buf[160];
+    const double s = toward < 0.0 ? -1.0 : 1.0;
+    std::snprintf (buf, sizeof (buf), "%.7f %.7f %.7f %.7f %.7f %.7f\n", v[0], v[1], v[2], s * v[3], s * v[4], s * v[5]);
+    rows += buf;
+  }
+  std::string header = pcdHeader ("x y z normal_x normal_y normal_z", kSphere);
+  const std::string origin = "VIEWPOINT 0 0 0 ";
+  header.replace (header.find (origin), origin.size (), "VIEWPOINT -0.3 0 0 ");
+  writeFile (dir_ / "turned.pcd", header + rows);
+  writeFile (dir_ / "probe.pcd", pcdHeader ("x y z", kProbe) + sphereRows (kProbe, 0.005, 1.0, false));
+  const std::string sphere = (dir_ / "turned.pcd").string ();
+  auto query = [&] (std::vector<std::string> extra) {
+    std::vector<std::string> args = {(dir_ / "probe.pcd").string (), sphere, "-sigma", "0.001", "-json", "-surface"};
+    args.insert (args.end (), extra.begin (), extra.end ());
+    const ToolRun r = run (args);
+    EXPECT_EQ (r.status, 0) << r.err;
+    const auto out = lines (r.out);
+    EXPECT_EQ (out.size (), 1u) << r.out;
+    std::string stage;
+    for (const auto& l : lines (r.err))
+      if (l.rfind ("Orienting " + sphere + " [", 0) == 0)
+        stage = l;
+    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), stage);
+  };
+  const auto [closed, closed_stage] = query ({"-closed_b"});
+  EXPECT_EQ (closed["verdict"].text, "collision");
+  EXPECT_NE (closed_stage.find ("[propagate: propagated over the neighbours; not the file's normals: they all face its "
+                                "VIEWPOINT"),
+             std::string::npos)
+      << closed_stage;
+  EXPECT_NE (closed_stage.find ("; closed: "), std::string::npos) << closed_stage;
+  EXPECT_EQ (closed["inputs"]["b"]["surface"]["orientation"].text, "propagate");
+  EXPECT_GT (closed["inputs"]["b"]["surface"]["hidden_from_viewpoint"].number, 0.1);
+  const auto [open, open_stage] = query ({});
+  EXPECT_NE (open_stage.find ("two-sided (-closed if it samples closed solids)"), std::string::npos) << open_stage;
+  const auto [taken, taken_stage] = query ({"-closed_b", "-orientation_b", "point_normals"});
+  EXPECT_NE (taken_stage.find ("[point_normals: the file's normal_x"), std::string::npos) << taken_stage;
+  EXPECT_NE (taken["verdict"].text, "collision");
+}
+
 // -orientation_b: the table scan, oriented toward its VIEWPOINT by default, is propagated when
 // asked (two-sided: its inside no longer known), and when normals are asked of it, which it has
 // not; the JSON's parameters and inputs.b.surface and the Orienting line say so, and why. The
