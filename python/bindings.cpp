@@ -1498,17 +1498,18 @@ PYBIND11_MODULE (_core, m)
                               "With surface_closed_share, the share of the same probes behind which the surface reads inside\n"
                               "(SurfaceModel::solidShare); NaN where not checked.")
       .def_property_readonly ("surface_hidden_from_viewpoint", surfaceNumber (&SurfaceModel::hiddenFromViewpoint),
-                              "Where orientation Auto weighed a viewpoint outside the cloud, the share of points hidden from it\n"
-                              "behind others (above 0.1 it propagated instead; SurfaceModel::hiddenFromViewpoint); NaN otherwise.")
+                              "Where orientation Auto weighed a viewpoint outside the cloud, or given normals all faced the\n"
+                              "viewpoint, the share of points hidden from it behind others (above 0.1 it propagated instead;\n"
+                              "SurfaceModel::hiddenFromViewpoint); NaN otherwise.")
       .def_property_readonly ("surface_normals_turned_to_viewpoint",
                               [] (const CloudModel& c) -> py::object {
                                 if (c.surface ().empty ())
                                   return py::none ();
                                 return py::cast (c.surface ().normalsTurnedToViewpoint ());
                               },
-                              "Whether orientation Auto set the given normals aside: they all face a viewpoint outside the\n"
-                              "cloud (as PCL's normal estimation turns them) that more than 0.1 of the points hide behind\n"
-                              "others from, so they are not outward; their sides were propagated\n"
+                              "Whether orientation Auto set the given normals aside: they all face the viewpoint (as PCL's\n"
+                              "normal estimation turns them) while more than 0.1 of the points lie behind others from it, so\n"
+                              "they are not outward; their sides were propagated\n"
                               "(SurfaceModel::normalsTurnedToViewpoint). None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {

@@ -75,10 +75,11 @@ constexpr double kClosedProbeSigmas = 3.0;
   * one minus it (an open sheet reads about -1/2 in front and 1/2 behind). */
 constexpr double kClosedProbeWinding = 0.25;
 
-/** \brief The share of `points` hidden from `view` (outside their bounding box lo..hi) behind
-  * others: in one bin of directions from view (gnomonic, across the axis that separates view
-  * from the box; bins two median spacings wide at the median depth), farther than the bin's
-  * nearest point by more than three spacings (the point's and the median). */
+/** \brief The share of `points` hidden from `view` behind others: in one bin of directions from
+  * view, farther than the bin's nearest point by more than three spacings (the point's and the
+  * median). Bins are two median spacings wide at the median depth: gnomonic across the axis that
+  * separates a view outside the bounding box lo..hi from it, or, for a view inside it, on the
+  * face of a cube about the view that each direction crosses (its largest component). */
 double
 hiddenFromView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
                 const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
@@ -104,12 +105,23 @@ hiddenFromView (const std::vector<Eigen::Vector3d>& points, const std::vector<fl
       sign = -1.0;
     }
   }
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  // Inside the box (best <= 0), each point is binned on the cube face its direction crosses.
+  const bool inside = !(best > 0.0);
+  std::vector<int> face (n, 0);
   std::vector<double> depth (n), range (n), scratch;
   for (std::size_t i = 0; i < n; ++i)
   {
-    depth[i] = sign * (points[i][axis] - view[axis]);
-    range[i] = (points[i] - view).norm ();
+    const Eigen::Vector3d r = points[i] - view;
+    int a = axis;
+    double s = sign;
+    if (inside)
+    {
+      r.cwiseAbs ().maxCoeff (&a);
+      s = r[a] < 0.0 ? -1.0 : 1.0;
+      face[i] = 2 * a + (s < 0.0 ? 1 : 0);
+    }
+    depth[i] = s * r[a];
+    range[i] = r.norm ();
   }
   auto median = [&scratch] (auto begin, auto end) {
     scratch.assign (begin, end);
@@ -120,11 +132,12 @@ hiddenFromView (const std::vector<Eigen::Vector3d>& points, const std::vector<fl
   const double bin = 2.0 * s_median / std::max (median (depth.begin (), depth.end ()), 1e-300);
   if (!(bin > 0.0) || !std::isfinite (bin))
     return 0.0;
-  std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> cells (n);
+  std::vector<std::pair<std::array<std::int64_t, 3>, std::size_t>> cells (n);
   for (std::size_t i = 0; i < n; ++i)
   {
+    const int a = inside ? face[i] / 2 : axis, u = (a + 1) % 3, v = (a + 2) % 3;
     const double t = std::max (depth[i], 1e-300);
-    cells[i] = {{static_cast<std::int64_t> (std::floor ((points[i][u] - view[u]) / t / bin)),
+    cells[i] = {{face[i], static_cast<std::int64_t> (std::floor ((points[i][u] - view[u]) / t / bin)),
                  static_cast<std::int64_t> (std::floor ((points[i][v] - view[v]) / t / bin))},
                 i};
   }
@@ -729,17 +742,19 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
   if (mode == NormalOrientation::Auto && !any_given && view_outside)
     hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
-  // Given normals that face a viewpoint outside the cloud as a scan's do: enough of them facing
-  // it, few away (PCL's normal estimation turns every normal toward its viewpoint). Outward
-  // normals of a closed object face a viewpoint on one side and away on the other.
-  bool given_face_view = false;
-  if (any_given && view_outside && (mode == NormalOrientation::Auto || mode == NormalOrientation::PointNormals))
+  // Given normals that face the viewpoint as a scan's do: enough of them facing it, few away
+  // (PCL's normal estimation turns every normal toward its viewpoint). Outward normals of a
+  // closed object face a viewpoint outside it on one side and away on the other.
+  bool given_face_view = false, most_face_view = false;
+  if (any_given && in.viewpoint && in.viewpoint->allFinite () &&
+      (mode == NormalOrientation::Auto || mode == NormalOrientation::PointNormals))
   {
-    std::size_t toward = 0, away = 0;
+    std::size_t toward = 0, away = 0, given = 0;
     for (std::size_t i = 0; i < n; ++i)
     {
       if (!in.given[i] || normals_[i].isZero ())
         continue;
+      ++given;
       const Eigen::Vector3d sight = *in.viewpoint - points[i];
       const double cosine = normals_[i].cast<double> ().dot (sight) / std::max (sight.norm (), 1e-300);
       toward += cosine >= kMinViewCosine ? 1 : 0;
@@ -748,13 +763,18 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     const double facing = static_cast<double> (toward + away);
     given_face_view = facing >= kMinViewSeeds * static_cast<double> (n) &&
                       static_cast<double> (away) <= kMaxViewDisagreement * facing;
-    if (given_face_view)
+    // Setting normals aside asks more: most of them facing it, not a few seen edge-on (a sheet
+    // with PCL's default origin in its own plane).
+    most_face_view = given_face_view && 2 * (toward + away) >= given;
+    if (given_face_view && (view_outside || most_face_view))
       hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
   }
   // Such normals on a cloud that viewpoint cannot see as one scan (a sphere sampled all round,
-  // its normals turned toward PCL's default origin beside it: two thirds point in) say nothing
-  // of the outside: Auto keeps their directions and propagates their sides.
-  normals_turned_to_view_ = mode == NormalOrientation::Auto && given_face_view &&
+  // its normals turned toward PCL's default origin beside it: two thirds point in; a mug's,
+  // turned toward the origin inside it: all point in) say nothing of the outside: Auto keeps
+  // their directions and propagates their sides. From inside a convex object nothing is hidden,
+  // and its normals turned inward cannot be told from a room's scanned from within: kept.
+  normals_turned_to_view_ = mode == NormalOrientation::Auto && most_face_view &&
                             hidden_from_view_ > SurfaceModel::kMaxHiddenShare;
   if (mode == NormalOrientation::Auto)
     mode = any_given && !normals_turned_to_view_ ? NormalOrientation::PointNormals
@@ -809,7 +829,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // `unobserved`). Given normals say so too when they face a viewpoint outside the cloud as a
   // scan's do and it hides nothing.
   seen_from_view_ = mode == NormalOrientation::Viewpoint ||
-                    (mode == NormalOrientation::PointNormals && given_face_view &&
+                    (mode == NormalOrientation::PointNormals && given_face_view && view_outside &&
                      hidden_from_view_ <= SurfaceModel::kMaxHiddenShare);
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)

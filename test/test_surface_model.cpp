@@ -1094,6 +1094,38 @@ TEST (SurfaceModel, NormalsTurnedTowardAViewpointBesideAClosedObjectAreNotOutwar
   EXPECT_NE (taken_answer.verdict, Verdict::InCollision) << "the turned normals' inside is no longer the sphere's";
 }
 
+// The same from a viewpoint inside the cloud's bounding box: two spheres either side of PCL's
+// default origin, their normals turned toward it (83 % point in), hide their far sides from it,
+// so the normals are set aside; declared closed, a ball inside one reads collision. From the
+// centre of one sphere nothing is hidden: its normals turned inward are kept, as a room's
+// scanned from within would be (the two cannot be told apart).
+TEST (SurfaceModel, NormalsTurnedTowardAViewpointInsideANonConvexCloudAreNotOutward)
+{
+  pcl::PointCloud<pcl::PointNormal> turned;
+  for (const double x : {-0.3, 0.3})
+    for (pcl::PointNormal p : sphere (2000, 0.2, Eigen::Vector3d (x, 0.0, 0.0)))
+    {
+      if (p.getNormalVector3fMap ().dot (-p.getVector3fMap ()) < 0.0f)
+        p.getNormalVector3fMap () = -p.getNormalVector3fMap ();
+      turned.push_back (p);
+    }
+  const auto aside = buildCloudModel (turned, closedObjects (withSurface ()));
+  EXPECT_TRUE (aside->surface ().normalsTurnedToViewpoint ());
+  EXPECT_GT (aside->surface ().hiddenFromViewpoint (), 0.3);  // the far halves
+  ASSERT_EQ (aside->surface ().orientation (), NormalOrientation::Propagate);
+  ASSERT_TRUE (aside->surface ().insideKnown ()) << aside->surface ().closedShare ();
+  const auto ball = buildCloudModel (xyz (sphere (300, 0.05, Eigen::Vector3d (0.3, 0.0, 0.0))), withSurface ());
+  CollisionResult r;
+  ASSERT_TRUE (collide (*ball, *aside, Eigen::Isometry3d::Identity (), surfaceRequest (), r));
+  EXPECT_EQ (r.verdict, Verdict::InCollision) << "P " << r.probability;
+
+  const auto convex = buildCloudModel (sphere (2000, 0.2, Eigen::Vector3d::Zero (), true), withSurface ());
+  EXPECT_FALSE (convex->surface ().normalsTurnedToViewpoint ());
+  EXPECT_EQ (convex->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_EQ (convex->surface ().hiddenFromViewpoint (), 0.0);
+  EXPECT_FALSE (convex->surface ().seenFromViewpoint ());  // a viewpoint inside marks nothing unobserved
+}
+
 // Uniformly random samples (not a lattice): the sample areas add up to about the surface's
 // area, on a plane and on a sphere, so that a declared closed sphere checks out (its winding
 // number at the centre about 1). Weighted by the squared spacings instead, the plane read 0.77

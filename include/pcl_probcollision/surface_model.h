@@ -126,9 +126,9 @@ public:
     * few); a closed object sampled all round, seen from a point outside it, about half (its far
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
-  /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced one
-    * (seenFromViewpoint()): the share of points hidden from it behind others (a scan from there
-    * hides none). Above kMaxHiddenShare the viewpoint is not the cloud's (a mesh's samples with
+  /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced the
+    * viewpoint (outside the cloud or within its bounding box): the share of points hidden from it
+    * behind others (a scan from there hides none). Above kMaxHiddenShare the viewpoint is not the cloud's (a mesh's samples with
     * PCL's default sensor origin) and Auto propagates instead. NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
   /** \brief Whether the samples are one scan's from the cloud's viewpoint, so that the space
@@ -138,11 +138,15 @@ public:
     * normals lie within 78 degrees of the line of sight (toward the viewpoint or away), at most a
     * tenth of those away, and at most kMaxHiddenShare of the points hidden behind others. */
   bool seenFromViewpoint () const { return seen_from_view_; }
-  /** \brief Whether Auto set the caller's normals aside because they all face a viewpoint outside
-    * the cloud, as PCL's normal estimation turns them, while more than kMaxHiddenShare of the
-    * points lie hidden from it (hiddenFromViewpoint()): turned toward a sensor that did not see the
-    * cloud as one scan, they are not outward (a closed object's would face it on one side only).
-    * Their directions are kept and their sides propagated (orientation() Propagate). */
+  /** \brief Whether Auto set the caller's normals aside because they all face the viewpoint, as
+    * PCL's normal estimation turns them (at least half within 78 degrees of the line of sight, at
+    * most a tenth of those away from it), while more than kMaxHiddenShare of the points lie hidden
+    * from it (hiddenFromViewpoint()): turned toward a sensor that did not see the cloud as one
+    * scan, they are not outward (a closed object's would face a viewpoint outside it on one side
+    * only, and a viewpoint inside a non-convex object sees parts of it behind others). Their
+    * directions are kept and their sides propagated (orientation() Propagate). From inside a
+    * convex object nothing is hidden: its normals, turned inward, are kept (a room scanned from
+    * within looks the same). */
   bool normalsTurnedToViewpoint () const { return normals_turned_to_view_; }
   /** \brief Shares of the closed-objects check's probes that must read outside in front
     * (closedShare) and inside behind (solidShare) for a propagated orientation to be trusted
