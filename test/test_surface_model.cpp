@@ -1238,6 +1238,42 @@ TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
   }
 }
 
+// One scanned view of a solid box (its top and the two sides a sensor above a corner sees): a ball
+// 5 cm over the unseen bottom, wholly out of the surface's reach, lies behind the view, in space
+// the scan counts as occupied, as near the surface. Its winding number there is between 1/4 and
+// 1/2 (three faces of six), and under 1/2 such a part read free, unmarked (a probe, 2026-12-04).
+TEST (SurfaceLayer, DeepBehindOneScannedViewIsOccupied)
+{
+  pcl::PointCloud<pcl::PointXYZ> view;
+  std::mt19937 rng (5);
+  std::normal_distribution<double> noise (0.0, 0.001);
+  auto add = [&] (double x, double y, double z) {
+    view.push_back (pcl::PointXYZ (static_cast<float> (x + noise (rng)), static_cast<float> (y + noise (rng)),
+                                   static_cast<float> (z + noise (rng))));
+  };
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j)
+    {
+      add (-0.1 + 0.01 * i, -0.1 + 0.01 * j, 0.2);  // top
+      add (0.1, -0.1 + 0.01 * i, 0.01 * j);         // the side facing +x
+      add (-0.1 + 0.01 * i, -0.1, 0.01 * j);        // the side facing -y
+    }
+  view.sensor_origin_ = Eigen::Vector4f (0.6f, -0.6f, 0.7f, 0.0f);
+  const auto scan = buildCloudModel (view, noisy (0.001));
+  ASSERT_EQ (scan->surface ().orientation (), NormalOrientation::Viewpoint);
+  ASSERT_TRUE (scan->surface ().seenFromViewpoint ());
+  const auto ball = buildCloudModel (xyz (sphere (300, 0.02, Eigen::Vector3d::Zero ())), withSurface ());
+  CollisionResult behind, above;
+  // T_a_b: the scan's frame seen from the ball's, so the ball sits at z = 0.05 in the scan's.
+  ASSERT_TRUE (collide (*ball, *scan, shift (0.0, 0.0, -0.05), surfaceRequest (), behind));
+  EXPECT_EQ (behind.verdict, Verdict::InCollision) << "P " << behind.probability;
+  EXPECT_TRUE (behind.unobserved);
+  EXPECT_LT (behind.signed_distance, -0.05) << behind.signed_distance;  // 8 cm from the nearest seen side
+  ASSERT_TRUE (collide (*ball, *scan, shift (0.0, 0.0, -0.3), surfaceRequest (), above));
+  EXPECT_EQ (above.verdict, Verdict::Free) << "P " << above.probability;
+  EXPECT_FALSE (above.unobserved);
+}
+
 // A small ball half inside a big closed surface: its far side lies deeper than any point's
 // reach of the big surface, and only the winding number of the nodes out of reach sees it.
 TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)
