@@ -588,6 +588,15 @@ surfaceNumber (double (SurfaceModel::*member) () const)
   };
 }
 
+/** \brief A CloudModel property reading one flag of its surface model: None without one. */
+auto
+surfaceFlag (bool (SurfaceModel::*member) () const)
+{
+  return [member] (const CloudModel& c) -> py::object {
+    return c.surface ().empty () ? py::none () : py::cast ((c.surface ().*member) ());
+  };
+}
+
 /** A loaded cloud's x y z as an (N, 3) float32 array. */
 template <typename PointT>
 py::array_t<float>
@@ -1482,12 +1491,7 @@ PYBIND11_MODULE (_core, m)
                                 return py::cast (c.surface ().orientation ());
                               },
                               "The NormalOrientation the surface model used (Auto resolved), None without a surface.")
-      .def_property_readonly ("surface_inside_known",
-                              [] (const CloudModel& c) -> py::object {
-                                if (c.surface ().empty ())
-                                  return py::none ();
-                                return py::cast (c.surface ().insideKnown ());
-                              },
+      .def_property_readonly ("surface_inside_known", surfaceFlag (&SurfaceModel::insideKnown),
                               "Whether the surface model's orientation says where the inside is (given normals, a viewpoint,\n"
                               "or a propagated one checked closed with CloudModelParams.closed_objects); False: two-sided.\n"
                               "None without a surface.")
@@ -1501,12 +1505,7 @@ PYBIND11_MODULE (_core, m)
                               "Where orientation Auto weighed a viewpoint outside the cloud, or given normals all faced the\n"
                               "viewpoint, the share of points hidden from it behind others (above 0.1 it propagated instead;\n"
                               "SurfaceModel::hiddenFromViewpoint); NaN otherwise.")
-      .def_property_readonly ("surface_normals_turned_to_viewpoint",
-                              [] (const CloudModel& c) -> py::object {
-                                if (c.surface ().empty ())
-                                  return py::none ();
-                                return py::cast (c.surface ().normalsTurnedToViewpoint ());
-                              },
+      .def_property_readonly ("surface_normals_turned_to_viewpoint", surfaceFlag (&SurfaceModel::normalsTurnedToViewpoint),
                               "Whether orientation Auto set the given normals aside: they all face the viewpoint (as PCL's\n"
                               "normal estimation turns them) while more than 0.1 of the points lie behind others from it, so\n"
                               "they are not outward; their sides were propagated\n"

@@ -114,6 +114,22 @@ protected:
     return r;
   }
 
+  /** \brief A -json query that must succeed with one line: its answer, and the stage line
+    * `Orienting <input> [...]` it printed for `input` ("" if none). */
+  std::pair<Value, std::string>
+  answerAndOrienting (const std::vector<std::string>& args, const std::string& input) const
+  {
+    const ToolRun r = run (args);
+    EXPECT_EQ (r.status, 0) << r.err;
+    const auto out = lines (r.out);
+    EXPECT_EQ (out.size (), 1u) << r.out;
+    std::string stage;
+    for (const auto& l : lines (r.err))
+      if (l.rfind ("Orienting " + input + " [", 0) == 0)
+        stage = l;
+    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), stage);
+  }
+
   /** \brief Runs a query that must fail: exit status, one error line naming `mention`, nothing
     * on stdout, no other error/warning text, and the listed files byte- and mtime-identical. */
   void expectFailure (const std::vector<std::string>& args, int status, const std::string& mention,
@@ -1900,15 +1916,7 @@ TEST_F (PcdCollisionTool, ClosedGivesAPropagatedSolidAnInside)
     std::vector<std::string> args = {(dir_ / "probe.pcd").string (), sphere, "-sigma", "0.001", "-pose",
                                      "0.085,0,0,0,0,0", "-json", "-surface"};
     args.insert (args.end (), extra.begin (), extra.end ());
-    const ToolRun r = run (args);
-    EXPECT_EQ (r.status, 0) << r.err;
-    const auto out = lines (r.out);
-    EXPECT_EQ (out.size (), 1u) << r.out;
-    std::string stage;
-    for (const auto& l : lines (r.err))
-      if (l.rfind ("Orienting " + sphere + " [", 0) == 0)
-        stage = l;
-    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), stage);
+    return answerAndOrienting (args, sphere);
   };
   const auto [closed, closed_stage] = query ({"-closed_b"});
   EXPECT_EQ (closed["verdict"].text, "collision");
@@ -1963,15 +1971,7 @@ TEST_F (PcdCollisionTool, NormalsTurnedTowardAViewpointBesideASolidAreSetAside)
   auto query = [&] (std::vector<std::string> extra) {
     std::vector<std::string> args = {(dir_ / "probe.pcd").string (), sphere, "-sigma", "0.001", "-json", "-surface"};
     args.insert (args.end (), extra.begin (), extra.end ());
-    const ToolRun r = run (args);
-    EXPECT_EQ (r.status, 0) << r.err;
-    const auto out = lines (r.out);
-    EXPECT_EQ (out.size (), 1u) << r.out;
-    std::string stage;
-    for (const auto& l : lines (r.err))
-      if (l.rfind ("Orienting " + sphere + " [", 0) == 0)
-        stage = l;
-    return std::make_pair (out.empty () ? Value () : mini_json::parse (out[0]), stage);
+    return answerAndOrienting (args, sphere);
   };
   const auto [closed, closed_stage] = query ({"-closed_b"});
   EXPECT_EQ (closed["verdict"].text, "collision");
