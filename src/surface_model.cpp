@@ -744,10 +744,11 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
   // Given normals that face the viewpoint as a scan's do: enough of them facing it, few away
   // (PCL's normal estimation turns every normal toward its viewpoint). Outward normals of a
-  // closed object face a viewpoint outside it on one side and away on the other.
+  // closed object face a viewpoint outside it on one side and away on the other. Read by Auto
+  // (normals_turned_to_view_) and, for a viewpoint outside, by seen_from_view_.
   bool given_face_view = false, most_face_view = false;
   if (any_given && in.viewpoint && in.viewpoint->allFinite () &&
-      (mode == NormalOrientation::Auto || mode == NormalOrientation::PointNormals))
+      (mode == NormalOrientation::Auto || (mode == NormalOrientation::PointNormals && view_outside)))
   {
     std::size_t toward = 0, away = 0, given = 0;
     for (std::size_t i = 0; i < n; ++i)
@@ -766,7 +767,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // Setting normals aside asks more: most of them facing it, not a few seen edge-on (a sheet
     // with PCL's default origin in its own plane).
     most_face_view = given_face_view && 2 * (toward + away) >= given;
-    if (given_face_view && (view_outside || most_face_view))
+    if (given_face_view && (view_outside || (mode == NormalOrientation::Auto && most_face_view)))
       hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
   }
   // Such normals on a cloud that viewpoint cannot see as one scan (a sphere sampled all round,

@@ -334,16 +334,15 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
     case pcl_probcollision::NormalOrientation::Auto: break;
   }
   std::string why;
+  auto percent = [] (double share) { return std::to_string (static_cast<int> (std::lround (100.0 * share))); };
   const double hidden = model.surface ().hiddenFromViewpoint ();
   if (model.surface ().normalsTurnedToViewpoint ())
     why = "; not the file's normals: they all face its VIEWPOINT, as PCL's normal estimation turns them, and " +
-          std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
-          " % of the points lie behind others from there (one scan hides none), so they are not outward "
+          percent (hidden) + " % of the points lie behind others from there (one scan hides none), so they are not outward "
           "(-orientation point_normals to take them)";
   else if (orientation == pcl_probcollision::NormalOrientation::Propagate && std::isfinite (hidden))
     why = hidden > pcl_probcollision::SurfaceModel::kMaxHiddenShare
-              ? "; not toward its VIEWPOINT, from which " + std::to_string (static_cast<int> (std::lround (100.0 * hidden))) +
-                    " % of the points lie behind others (one scan hides none)"
+              ? "; not toward its VIEWPOINT, from which " + percent (hidden) + " % of the points lie behind others (one scan hides none)"
               : std::string ("; not toward its VIEWPOINT, which sees it edge-on or not as one scan does");
   // -orientation asked for a rule that could not orient this input (SurfaceModel falls back to
   // propagation): say which, and why.
@@ -354,7 +353,6 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
     why = "; -orientation point_normals refused: it has no normals";
   // -closed: whether the winding number confirmed a closed solid, so that the surface has an inside.
   const double closed = model.surface ().closedShare ();
-  auto percent = [] (double share) { return std::to_string (static_cast<int> (std::lround (100.0 * share))); };
   if (std::isfinite (closed))
     why += std::string (model.surface ().insideKnown () ? "; closed: " : "; not closed, so two-sided: ") + "outside in front of " +
            percent (closed) + " %, inside behind " + percent (model.surface ().solidShare ()) +

@@ -23,8 +23,8 @@ namespace pcl_probcollision
 enum class NormalOrientation
 {
   /** \brief Default: the point type's normals when it has finite ones (meshes: the faces'),
-    * unless they all face a viewpoint outside the cloud that does not see it as one scan (PCL's
-    * normal estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint), else the
+    * unless they all face the viewpoint while it does not see the cloud as one scan (PCL's normal
+    * estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint), else the
     * viewpoint when the cloud's sensor_origin_ lies outside its bounding box and sees
     * it as one scan does (at most 10 % of the points hidden behind others from there:
     * SurfaceModel::hiddenFromViewpoint), else propagation. */

@@ -127,9 +127,10 @@ public:
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
   /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced the
-    * viewpoint (outside the cloud or within its bounding box): the share of points hidden from it
-    * behind others (a scan from there hides none). Above kMaxHiddenShare the viewpoint is not the cloud's (a mesh's samples with
-    * PCL's default sensor origin) and Auto propagates instead. NaN where not weighed. */
+    * viewpoint (outside the cloud, or within its bounding box for Auto): the share of points
+    * hidden from it behind others (a scan from there hides none). Above kMaxHiddenShare the
+    * viewpoint is not the cloud's (a mesh's samples with PCL's default sensor origin) and Auto
+    * propagates instead. NaN where not weighed. */
   double hiddenFromViewpoint () const { return hidden_from_view_; }
   /** \brief Whether the samples are one scan's from the cloud's viewpoint, so that the space
     * behind the surface was never observed (CollisionResult::unobserved): oriented toward the
