@@ -1392,7 +1392,9 @@ PYBIND11_MODULE (_core, m)
       .def_readonly ("unobserved", &CollisionResult::unobserved,
                      "True when the surface layer's answer rests on surface the samples do not show\n"
                      "(docs/SURFACE.md): the deciding point lies over a hole in the other cloud's samples that the\n"
-                     "surface bridges (an occlusion shadow), or behind a scanned sheet whose far side was never seen.\n"
+                     "surface bridges (an occlusion shadow), or behind a scanned sheet whose far side was never seen\n"
+                     "(a point clear of the scan's surface there, where none reads inside, reads unknown: P 0.5,\n"
+                     "at least 0.25 pooled).\n"
                      "P and the verdict then say what the bridged or occupied surface implies; a planner may treat\n"
                      "such a pose as unknown. Always False without request.surface.")
       .def_readonly ("witness_side", &CollisionResult::witness_side,

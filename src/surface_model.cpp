@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <future>
+#include <optional>
 #include <limits>
 #include <queue>
 #include <tuple>
@@ -74,90 +75,6 @@ constexpr double kClosedProbeSigmas = 3.0;
 /** \brief A probe in front reads outside below this |winding number|, one behind inside above
   * one minus it (an open sheet reads about -1/2 in front and 1/2 behind). */
 constexpr double kClosedProbeWinding = 0.25;
-
-/** \brief The share of `points` hidden from `view` behind others: in one bin of directions from
-  * view, farther than the bin's nearest point by more than three spacings (the point's and the
-  * median). Bins are two median spacings wide at the median depth: gnomonic across the axis that
-  * separates a view outside the bounding box lo..hi from it, or, for a view inside it, on the
-  * face of a cube about the view that each direction crosses (its largest component). */
-double
-hiddenFromView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
-                const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
-{
-  const std::size_t n = points.size ();
-  if (n < 2)
-    return 0.0;
-  // The axis along which view lies farthest outside the box: every point is in front of it.
-  int axis = 0;
-  double sign = 1.0, best = -1.0;
-  for (int d = 0; d < 3; ++d)
-  {
-    if (lo[d] - view[d] > best)
-    {
-      best = lo[d] - view[d];
-      axis = d;
-      sign = 1.0;
-    }
-    if (view[d] - hi[d] > best)
-    {
-      best = view[d] - hi[d];
-      axis = d;
-      sign = -1.0;
-    }
-  }
-  // Inside the box (best <= 0), each point is binned on the cube face its direction crosses.
-  const bool inside = !(best > 0.0);
-  std::vector<int> face (n, 0);
-  std::vector<double> depth (n), range (n), scratch;
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const Eigen::Vector3d r = points[i] - view;
-    int a = axis;
-    double s = sign;
-    if (inside)
-    {
-      r.cwiseAbs ().maxCoeff (&a);
-      s = r[a] < 0.0 ? -1.0 : 1.0;
-      face[i] = 2 * a + (s < 0.0 ? 1 : 0);
-    }
-    depth[i] = s * r[a];
-    range[i] = r.norm ();
-  }
-  auto median = [&scratch] (auto begin, auto end) {
-    scratch.assign (begin, end);
-    std::nth_element (scratch.begin (), scratch.begin () + static_cast<std::ptrdiff_t> (scratch.size () / 2), scratch.end ());
-    return scratch[scratch.size () / 2];
-  };
-  const double s_median = median (spacing.begin (), spacing.end ());
-  const double bin = 2.0 * s_median / std::max (median (depth.begin (), depth.end ()), 1e-300);
-  if (!(bin > 0.0) || !std::isfinite (bin))
-    return 0.0;
-  std::vector<std::pair<std::array<std::int64_t, 3>, std::size_t>> cells (n);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    const int a = inside ? face[i] / 2 : axis, u = (a + 1) % 3, v = (a + 2) % 3;
-    const double t = std::max (depth[i], 1e-300);
-    cells[i] = {{face[i], static_cast<std::int64_t> (std::floor ((points[i][u] - view[u]) / t / bin)),
-                 static_cast<std::int64_t> (std::floor ((points[i][v] - view[v]) / t / bin))},
-                i};
-  }
-  std::sort (cells.begin (), cells.end ());
-  std::size_t hidden = 0;
-  for (std::size_t b = 0; b < n;)
-  {
-    std::size_t e = b;
-    double nearest = std::numeric_limits<double>::infinity ();
-    for (; e < n && cells[e].first == cells[b].first; ++e)
-      nearest = std::min (nearest, range[cells[e].second]);
-    for (std::size_t j = b; j < e; ++j)
-    {
-      const std::size_t i = cells[j].second;
-      hidden += range[i] > nearest + 3.0 * std::max<double> (spacing[i], s_median) ? 1 : 0;
-    }
-    b = e;
-  }
-  return static_cast<double> (hidden) / static_cast<double> (n);
-}
 
 /** \brief Symmetric neighbour graph in compressed rows: the k-nearest-neighbour relation is
   * not symmetric, and propagation must be able to cross an edge from either end. */
@@ -640,6 +557,219 @@ openingOf (const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3f& no
 }
 } // namespace
 
+bool
+SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
+{
+  const Eigen::Vector3d r = x - view;
+  int a = axis;
+  double s = sign;
+  std::int64_t face = 0;
+  if (inside)
+  {
+    r.cwiseAbs ().maxCoeff (&a);
+    s = r[a] < 0.0 ? -1.0 : 1.0;
+    face = 2 * a + (s < 0.0 ? 1 : 0);
+  }
+  const double t = s * r[a];
+  if (!(t > 0.0) || !(bin > 0.0))
+    return false;
+  const int u = (a + 1) % 3, v = (a + 2) % 3;
+  const double cu = std::floor (r[u] / t / bin), cv = std::floor (r[v] / t / bin);
+  // Far off the axis (a line of sight nearly parallel to the view's plane) no sample is binned.
+  constexpr double kLimit = 1e15;
+  if (!(std::abs (cu) < kLimit && std::abs (cv) < kLimit))
+    return false;
+  key = {face, static_cast<std::int64_t> (cu), static_cast<std::int64_t> (cv)};
+  return true;
+}
+
+SurfaceModel::ViewBins
+SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
+                       const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double* hidden)
+{
+  ViewBins bins;
+  if (hidden)
+    *hidden = 0.0;
+  const std::size_t n = points.size ();
+  if (n < 2)
+    return bins;
+  bins.view = view;
+  // The axis along which view lies farthest outside the box: every point is in front of it.
+  double best = -1.0;
+  for (int d = 0; d < 3; ++d)
+  {
+    if (lo[d] - view[d] > best)
+    {
+      best = lo[d] - view[d];
+      bins.axis = d;
+      bins.sign = 1.0;
+    }
+    if (view[d] - hi[d] > best)
+    {
+      best = view[d] - hi[d];
+      bins.axis = d;
+      bins.sign = -1.0;
+    }
+  }
+  // Inside the box (best <= 0), each point is binned on the cube face its direction crosses.
+  bins.inside = !(best > 0.0);
+  std::vector<double> depth (n), range (n), scratch;
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Eigen::Vector3d r = points[i] - view;
+    int a = bins.axis;
+    double s = bins.sign;
+    if (bins.inside)
+    {
+      r.cwiseAbs ().maxCoeff (&a);
+      s = r[a] < 0.0 ? -1.0 : 1.0;
+    }
+    depth[i] = s * r[a];
+    range[i] = r.norm ();
+  }
+  auto median = [&scratch] (auto begin, auto end) {
+    scratch.assign (begin, end);
+    std::nth_element (scratch.begin (), scratch.begin () + static_cast<std::ptrdiff_t> (scratch.size () / 2), scratch.end ());
+    return scratch[scratch.size () / 2];
+  };
+  const double s_median = median (spacing.begin (), spacing.end ());
+  bins.bin = 2.0 * s_median / std::max (median (depth.begin (), depth.end ()), 1e-300);
+  if (!(bins.bin > 0.0) || !std::isfinite (bins.bin))
+  {
+    bins.bin = 0.0;
+    return bins;
+  }
+  std::vector<std::pair<ViewBins::Key, std::size_t>> cells;
+  cells.reserve (n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    ViewBins::Key key;
+    if (bins.keyOf (points[i], key))
+      cells.emplace_back (key, i);
+  }
+  std::sort (cells.begin (), cells.end ());
+  std::size_t count = 0;
+  for (std::size_t b = 0; b < cells.size ();)
+  {
+    std::size_t e = b;
+    double nearest = std::numeric_limits<double>::infinity ();
+    for (; e < cells.size () && cells[e].first == cells[b].first; ++e)
+      nearest = std::min (nearest, range[cells[e].second]);
+    for (std::size_t j = b; j < e; ++j)
+    {
+      const std::size_t i = cells[j].second;
+      count += range[i] > nearest + kHiddenSpacings * std::max<double> (spacing[i], s_median) ? 1 : 0;
+    }
+    bins.keys.push_back (cells[b].first);
+    bins.nearest.push_back (static_cast<float> (nearest));
+    b = e;
+  }
+  if (hidden)
+    *hidden = static_cast<double> (count) / static_cast<double> (n);
+  // A view outside: one face, the bins a grid (a scan's cover its field of view densely).
+  if (!bins.inside && !bins.keys.empty ())
+  {
+    std::int64_t u1 = bins.keys.front ()[1], v1 = bins.keys.front ()[2];
+    bins.u0 = u1;
+    bins.v0 = v1;
+    for (const ViewBins::Key& key : bins.keys)
+    {
+      bins.u0 = std::min (bins.u0, key[1]);
+      u1 = std::max (u1, key[1]);
+      bins.v0 = std::min (bins.v0, key[2]);
+      v1 = std::max (v1, key[2]);
+    }
+    const double cells = (double (u1 - bins.u0) + 1.0) * (double (v1 - bins.v0) + 1.0);
+    if (cells <= double (ViewBins::kDenseCells) * double (bins.keys.size ()))
+    {
+      bins.width = u1 - bins.u0 + 1;
+      bins.height = v1 - bins.v0 + 1;
+      bins.grid.assign (static_cast<std::size_t> (bins.width * bins.height), std::numeric_limits<float>::quiet_NaN ());
+      for (std::size_t j = 0; j < bins.keys.size (); ++j)
+        bins.grid[static_cast<std::size_t> ((bins.keys[j][2] - bins.v0) * bins.width + (bins.keys[j][1] - bins.u0))] =
+            bins.nearest[j];
+      bins.keys = std::vector<ViewBins::Key> ();
+      bins.nearest = std::vector<float> ();
+    }
+  }
+  return bins;
+}
+
+double
+SurfaceModel::ViewBins::nearestOf (const Key& key) const
+{
+  if (!grid.empty ())
+  {
+    const std::int64_t u = key[1] - u0, v = key[2] - v0;
+    return u < 0 || v < 0 || u >= width || v >= height ? std::numeric_limits<double>::quiet_NaN ()
+                                                       : double (grid[static_cast<std::size_t> (v * width + u)]);
+  }
+  const auto it = std::lower_bound (keys.begin (), keys.end (), key);
+  return it == keys.end () || *it != key ? std::numeric_limits<double>::quiet_NaN ()
+                                         : double (nearest[static_cast<std::size_t> (it - keys.begin ())]);
+}
+
+bool
+SurfaceModel::mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, double margin, std::int64_t max_bins) const
+{
+  const ViewBins& b = view_bins_;
+  if (b.grid.empty ())
+    return !b.empty ();
+  const int u = (b.axis + 1) % 3, v = (b.axis + 2) % 3;
+  double u_lo = std::numeric_limits<double>::infinity (), u_hi = -u_lo, v_lo = u_lo, v_hi = -u_lo, farthest = 0.0;
+  for (const Eigen::Vector3d& c : corners)
+  {
+    const Eigen::Vector3d r = c - b.view;
+    const double t = b.sign * r[b.axis];
+    if (!(t > 0.0))
+      return true;
+    // A central projection maps the box to the hull of its corners' images; the distance to the
+    // view is convex, so its largest value on the box is at a corner.
+    u_lo = std::min (u_lo, r[u] / t / b.bin);
+    u_hi = std::max (u_hi, r[u] / t / b.bin);
+    v_lo = std::min (v_lo, r[v] / t / b.bin);
+    v_hi = std::max (v_hi, r[v] / t / b.bin);
+    farthest = std::max (farthest, r.norm ());
+  }
+  const double u0 = std::max (std::floor (u_lo), double (b.u0)), u1 = std::min (std::floor (u_hi), double (b.u0 + b.width - 1));
+  const double v0 = std::max (std::floor (v_lo), double (b.v0)), v1 = std::min (std::floor (v_hi), double (b.v0 + b.height - 1));
+  if (u0 > u1 || v0 > v1)
+    return false;  // beside every bin the scan filled
+  if ((u1 - u0 + 1.0) * (v1 - v0 + 1.0) > double (max_bins))
+    return true;
+  for (auto j = static_cast<std::int64_t> (v0); j <= static_cast<std::int64_t> (v1); ++j)
+    for (auto i = static_cast<std::int64_t> (u0); i <= static_cast<std::int64_t> (u1); ++i)
+    {
+      const float nearest = b.grid[static_cast<std::size_t> ((j - b.v0) * b.width + (i - b.u0))];
+      if (farthest - double (nearest) > margin)  // false for an empty (NaN) bin
+        return true;
+    }
+  return false;
+}
+
+double
+SurfaceModel::behindView (const Eigen::Vector3d& x) const
+{
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN ();
+  ViewBins::Key key;
+  if (view_bins_.empty () || !view_bins_.keyOf (x, key))
+    return kNaN;
+  const double range = (x - view_bins_.view).norm ();
+  // x's own bin first: most points a query asks about lie in front of what the scan saw.
+  double least = range - view_bins_.nearestOf (key);
+  if (!(least > 0.0))
+    return least;
+  for (std::int64_t du = -1; du <= 1; ++du)
+    for (std::int64_t dv = -1; dv <= 1; ++dv)
+    {
+      const double nearest = view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv});
+      if (std::isnan (nearest))
+        return kNaN;  // beside a silhouette, or where the scan saw nothing
+      least = std::min (least, range - nearest);
+    }
+  return least;
+}
+
 void
 SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation mode)
 {
@@ -724,7 +854,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     spacingStatistics ();
 
   // Resolve Auto: the caller's normals, else a viewpoint outside the cloud that sees it as one
-  // scan does (hiddenFromView), else propagation.
+  // scan does (binView's hidden share), else propagation.
   bool any_given = false;
   for (std::size_t i = 0; i < in.given.size () && !any_given; ++i)
     any_given = in.given[i] && !normals_[i].isZero ();
@@ -740,8 +870,15 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   const bool view_outside = in.viewpoint && in.viewpoint->allFinite () &&
                             ((in.viewpoint->array () < lo.array ()).any () || (in.viewpoint->array () > hi.array ()).any ());
   hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
+  // The viewpoint's bins, built once: for the hidden share, and kept for behindView.
+  std::optional<ViewBins> bins;
+  auto hiddenShare = [&] {
+    double share = 0.0;
+    bins = binView (points, spacing_, *in.viewpoint, lo, hi, &share);
+    return share;
+  };
   if (mode == NormalOrientation::Auto && !any_given && view_outside)
-    hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
+    hidden_from_view_ = hiddenShare ();
   // Given normals that face the viewpoint as a scan's do: enough of them facing it, few away
   // (PCL's normal estimation turns every normal toward its viewpoint). Outward normals of a
   // closed object face a viewpoint outside it on one side and away on the other. Read by Auto
@@ -768,7 +905,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // with PCL's default origin in its own plane).
     most_face_view = given_face_view && 2 * (toward + away) >= given;
     if (given_face_view && (view_outside || (mode == NormalOrientation::Auto && most_face_view)))
-      hidden_from_view_ = hiddenFromView (points, spacing_, *in.viewpoint, lo, hi);
+      hidden_from_view_ = hiddenShare ();
   }
   // Such normals on a cloud that viewpoint cannot see as one scan (a sphere sampled all round,
   // its normals turned toward PCL's default origin beside it: two thirds point in; a mug's,
@@ -832,6 +969,10 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   seen_from_view_ = mode == NormalOrientation::Viewpoint ||
                     (mode == NormalOrientation::PointNormals && given_face_view && view_outside &&
                      hidden_from_view_ <= SurfaceModel::kMaxHiddenShare);
+  // Where the scan looked, and how far it saw, for the query's parts behind it.
+  view_bins_ = ViewBins ();
+  if (seen_from_view_)
+    view_bins_ = bins ? std::move (*bins) : binView (points, spacing_, *in.viewpoint, lo, hi, nullptr);
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));
@@ -1132,6 +1273,8 @@ SurfaceModel::bytes () const
 {
   return normals_.capacity () * sizeof (Eigen::Vector3f) + (spacing_.capacity () + areas_.capacity ()) * sizeof (float) +
          open_words_.capacity () * sizeof (OpenWord) + open_values_.capacity () * sizeof (Eigen::Vector4f) +
-         owned_.capacity () * sizeof (std::uint64_t) + dipoles_.capacity () * sizeof (Dipole);
+         owned_.capacity () * sizeof (std::uint64_t) + dipoles_.capacity () * sizeof (Dipole) +
+         view_bins_.keys.capacity () * sizeof (ViewBins::Key) +
+         (view_bins_.nearest.capacity () + view_bins_.grid.capacity ()) * sizeof (float);
 }
 } // namespace pcl_probcollision

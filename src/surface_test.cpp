@@ -1237,6 +1237,16 @@ struct DeepPoint
   /** \brief That sample's outward normal, in A's local frame (zero where it has none): the way
     * out of the other object from there. */
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
+  /** \brief Where no point was found inside: a point in the space behind the other's scan, clear
+    * of its surface (SurfaceModel::behindView), which the sensor never observed; index, point
+    * (A's frame) and the way back toward that sensor (A's frame) as above; depth, how far
+    * behind what the scan saw. */
+  bool shadowed = false;
+  int shadow_side = 1;
+  int shadow_index = -1;
+  Eigen::Vector3d shadow_point = Eigen::Vector3d::Zero ();
+  Eigen::Vector3d shadow_normal = Eigen::Vector3d::Zero ();
+  double shadow_depth = 0.0;
 };
 
 /** \brief The depth of x (in `surface`'s local frame, mapped into A's by T_s) below `surface`:
@@ -1263,6 +1273,71 @@ insideOf (const CloudModel& surface, const Eigen::Vector3d& x)
   const OrientedBox& bound = bvh.node (ProbabilisticBVH::rootId ()).box;
   return (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () <= 0.0 &&
          surface.surface ().windingNumber (bvh, x) > behindThreshold (surface.surface ());
+}
+
+/** \brief The points of `node` (of q_bvh, mapped into `surface`'s frame by T_s_q) that lie in the
+  * space behind `surface`'s scan, within its bounding box and more than
+  * SurfaceModel::kHiddenSpacings median spacings behind what the sensor saw along their line of
+  * sight (SurfaceModel::behindView): the first is recorded in deep (shadowed), and each gets
+  * P = 1/2 in per_point when given (else the first ends the search). The node is clear of the
+  * surface (out of reach) and outside it by the winding number: the scan cannot tell whether
+  * the object it saw reaches there. */
+void
+shadowedPoints (const ProbabilisticBVH& q_bvh, const ProbabilisticBVH::Node& node, const Eigen::Isometry3d& T_s_q,
+                const CloudModel& surface, const Eigen::Isometry3d& T_s, std::vector<float>* per_point, DeepPoint& deep)
+{
+  const SurfaceModel& s = surface.surface ();
+  if (!s.seenFromViewpoint ())
+    return;
+  const OrientedBox& bound = surface.hierarchy ().node (ProbabilisticBVH::rootId ()).box;
+  const double margin = SurfaceModel::kHiddenSpacings * s.medianSpacing ();
+  // Whole nodes in front of what the sensor saw are passed over (a gripper above a scanned
+  // table, most of a query's points): the points of a node are read only where its box may
+  // reach behind the scan, from the node down to its leaves.
+  constexpr std::int64_t kMaxBins = 64;
+  thread_local std::vector<const ProbabilisticBVH::Node*> stack;
+  stack.assign (1, &node);
+  while (!stack.empty ())
+  {
+    const ProbabilisticBVH::Node& n = *stack.back ();
+    stack.pop_back ();
+    std::array<Eigen::Vector3d, 8> corners;
+    const Eigen::Matrix3d axes = n.box.axes ();
+    const Eigen::Vector3d h = n.box.halfExtents ();
+    for (int c = 0; c < 8; ++c)
+      corners[static_cast<std::size_t> (c)] =
+          T_s_q * (n.box.center + axes * Eigen::Vector3d ((c & 1) ? h.x () : -h.x (), (c & 2) ? h.y () : -h.y (), (c & 4) ? h.z () : -h.z ()));
+    if (!s.mayLieBehindView (corners, margin, kMaxBins))
+      continue;
+    if (!n.isLeaf ())
+    {
+      for (int c = 0; c < n.num_children; ++c)
+        stack.push_back (&q_bvh.node (n.first_child + c));
+      continue;
+    }
+    for (const int i : q_bvh.indices (n))
+    {
+      const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (i)];
+      if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0)
+        continue;
+      const double behind = s.behindView (x);
+      if (!(behind > margin))
+        continue;
+      if (!deep.shadowed)
+      {
+        deep.shadowed = true;
+        deep.shadow_index = i;
+        deep.shadow_point = T_s * x;
+        deep.shadow_normal = T_s.linear () * (s.viewpoint () - x).normalized ();
+        deep.shadow_depth = behind;
+      }
+      if (!per_point)
+        return;
+      float& p = (*per_point)[static_cast<std::size_t> (i)];
+      if (!(p >= 0.5f))
+        p = 0.5f;
+    }
+  }
 }
 
 /** \brief True when some leaf box of `s_bvh` (mapped into the box's frame by T_box_s), grown by
@@ -1320,7 +1395,11 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
     const int first = *q_bvh.indices (node).begin ();
     const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (first)];
     if (!insideOf (surface, x))
+    {
+      if (!deep.found && (per_point || !deep.shadowed))
+        shadowedPoints (q_bvh, node, T_s_q, surface, T_s, per_point, deep);
       continue;
+    }
     // In decision mode the first inside node decides; otherwise the deepest one sets the depth.
     DeepPoint here;
     setDepth (surface, T_s, x, here);
@@ -1356,9 +1435,18 @@ insideEitherOutOfReach (const CloudModel& a, const CloudModel& b, const Eigen::I
   if ((!deep.found || !may_stop) && a.surface ().insideKnown ())
   {
     DeepPoint other = deepInside (b, T_a_b, a, I, margin, !may_stop, per_point_b);
-    other.side = -1;
+    other.side = other.shadow_side = -1;
+    const DeepPoint first = deep;
     if (other.found && (!deep.found || other.depth > deep.depth))
       deep = other;
+    // Behind a scan: A's point first, as found.
+    const DeepPoint& shadow = first.shadowed ? first : other;
+    deep.shadowed = shadow.shadowed;
+    deep.shadow_side = shadow.shadow_side;
+    deep.shadow_index = shadow.shadow_index;
+    deep.shadow_point = shadow.shadow_point;
+    deep.shadow_normal = shadow.shadow_normal;
+    deep.shadow_depth = shadow.shadow_depth;
   }
   return deep;
 }
@@ -1392,6 +1480,26 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
   answer.inside_confirmed = answer.inside_confirmed || !s.seenFromViewpoint ();
   answer.probability = 1.0;
 }
+/** \brief A point in the space behind the other's scan (DeepPoint::shadowed), where no point was
+  * found inside: the scan cannot tell whether the object it saw reaches there. Unless the
+  * answer already reads P >= 1/2: P = 1/2, unobserved, d = 0 with a standard deviation of its
+  * depth behind what the sensor saw (the surface may lie anywhere between), the witness normal
+  * toward that sensor (turned toward A's side): the way back to observed space. */
+void
+answerShadow (const DeepPoint& deep, SurfaceAnswer& answer)
+{
+  if (answer.probability >= 0.5)
+    return;
+  answer.reached = true;
+  answer.probability = 0.5;
+  answer.unobserved = true;
+  answer.witness_side = deep.shadow_side;
+  answer.witness_index = deep.shadow_index;
+  answer.witness_point = deep.shadow_point;
+  answer.witness_normal = deep.shadow_side > 0 ? deep.shadow_normal : Eigen::Vector3d (-deep.shadow_normal);
+  answer.signed_distance = 0.0;
+  answer.signed_distance_std = deep.shadow_depth;
+}
 } // namespace
 
 SurfaceAnswer
@@ -1410,6 +1518,8 @@ containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry
     answerDeep (deep, a, b, answer);
     answer.stopped_early = may_stop;
   }
+  else if (deep.shadowed)
+    answerShadow (deep, answer);
   return answer;
 }
 
@@ -1500,6 +1610,8 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
     return answer;
   }
   answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;
+  if (deep.shadowed)
+    answerShadow (deep, answer);
   return answer;
 }
 } // namespace detail

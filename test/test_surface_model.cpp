@@ -1242,8 +1242,17 @@ TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
 // 5 cm over the unseen bottom, wholly out of the surface's reach, lies behind the view, in space
 // the scan counts as occupied, as near the surface. Its winding number there is between 1/4 and
 // 1/2 (three faces of six), and under 1/2 such a part read free, unmarked (a probe, 2026-12-04).
-TEST (SurfaceLayer, DeepBehindOneScannedViewIsOccupied)
+namespace
 {
+/** \brief One scanned view of a 20 cm box standing on z = 0, seen from (0.6, -0.6, 0.7): its top
+  * and the two sides facing +x and -y, sampled every 1 cm with 1 mm noise; with_table, the table
+  * it stands on (60 cm square) where the sensor sees it, not under the box or in its shadow, and
+  * not within 1.5 cm of its sides (with the table's grid touching them the viewpoint is refused:
+  * over a tenth of the points disagree with their part's side there). */
+std::shared_ptr<const CloudModel>
+oneScannedViewOfABox (bool with_table = false)
+{
+  const Eigen::Vector3d sensor (0.6, -0.6, 0.7);
   pcl::PointCloud<pcl::PointXYZ> view;
   std::mt19937 rng (5);
   std::normal_distribution<double> noise (0.0, 0.001);
@@ -1258,8 +1267,34 @@ TEST (SurfaceLayer, DeepBehindOneScannedViewIsOccupied)
       add (0.1, -0.1 + 0.01 * i, 0.01 * j);         // the side facing +x
       add (-0.1 + 0.01 * i, -0.1, 0.01 * j);        // the side facing -y
     }
-  view.sensor_origin_ = Eigen::Vector4f (0.6f, -0.6f, 0.7f, 0.0f);
-  const auto scan = buildCloudModel (view, noisy (0.001));
+  // The line of sight from the sensor to p meets the box (a slab test) before p.
+  auto hidden = [&] (const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = p - sensor;
+    double enter = 0.0, leave = 1.0;
+    for (int a = 0; a < 3; ++a)
+    {
+      const double lo = a < 2 ? -0.1 : 0.0, hi = a < 2 ? 0.1 : 0.2;
+      const double t0 = (lo - sensor[a]) / d[a], t1 = (hi - sensor[a]) / d[a];
+      enter = std::max (enter, std::min (t0, t1));
+      leave = std::min (leave, std::max (t0, t1));
+    }
+    return enter < leave;
+  };
+  for (int i = 0; with_table && i <= 60; ++i)
+    for (int j = 0; j <= 60; ++j)
+    {
+      const double x = -0.3 + 0.01 * i, y = -0.3 + 0.01 * j;
+      if (!hidden (Eigen::Vector3d (x, y, 0.0)) && std::max (std::abs (x), std::abs (y)) > 0.115)
+        add (x, y, 0.0);
+    }
+  view.sensor_origin_ = Eigen::Vector4f (sensor.x (), sensor.y (), sensor.z (), 0.0).cast<float> ();
+  return buildCloudModel (view, noisy (0.001));
+}
+} // namespace
+
+TEST (SurfaceLayer, DeepBehindOneScannedViewIsOccupied)
+{
+  const auto scan = oneScannedViewOfABox ();
   ASSERT_EQ (scan->surface ().orientation (), NormalOrientation::Viewpoint);
   ASSERT_TRUE (scan->surface ().seenFromViewpoint ());
   const auto ball = buildCloudModel (xyz (sphere (300, 0.02, Eigen::Vector3d::Zero ())), withSurface ());
@@ -1272,6 +1307,49 @@ TEST (SurfaceLayer, DeepBehindOneScannedViewIsOccupied)
   ASSERT_TRUE (collide (*ball, *scan, shift (0.0, 0.0, -0.3), surfaceRequest (), above));
   EXPECT_EQ (above.verdict, Verdict::Free) << "P " << above.probability;
   EXPECT_FALSE (above.unobserved);
+}
+
+// Low in the box, beside its unseen sides, one view's winding number falls under the 1/4 that
+// reads occupied, and a ball there read free. The sensor's line of sight to it passes through
+// the seen faces: the space was never observed, so it reads unknown (P = 1/2, unobserved), with
+// the way back toward the sensor. A ball the sensor could see reads free.
+TEST (SurfaceLayer, BehindOneScannedViewOutOfTheOccupiedIsUnknown)
+{
+  const auto scan = oneScannedViewOfABox (true);
+  const SurfaceModel& surface = scan->surface ();
+  ASSERT_EQ (surface.orientation (), NormalOrientation::Viewpoint);
+  ASSERT_TRUE (surface.seenFromViewpoint ());
+  // Low in the box near its unseen sides; beside the seen side facing +x, 3 cm off it.
+  const Eigen::Vector3d low (-0.07, 0.07, 0.03), seen (0.15, 0.0, 0.1);
+  const Eigen::Vector3d o = scan->origin ();
+  EXPECT_LT (surface.windingNumber (scan->hierarchy (), low - o), 0.25);
+  EXPECT_GT (surface.behindView (low - o), 0.2);   // 29 cm behind the corner nearest the sensor
+  EXPECT_LT (surface.behindView (seen - o), 0.0);  // in front of what it saw
+  EXPECT_TRUE (std::isnan (surface.behindView (Eigen::Vector3d (0.6, 0.6, 0.0) - o)));  // no sample that way
+  const auto ball = buildCloudModel (xyz (sphere (300, 0.02, Eigen::Vector3d::Zero ())), withSurface ());
+  CollisionResult r;
+  ASSERT_TRUE (collide (*ball, *scan, shift (-low.x (), -low.y (), -low.z ()), surfaceRequest (), r));
+  EXPECT_EQ (r.verdict, Verdict::InContact) << "P " << r.probability;
+  EXPECT_DOUBLE_EQ (r.probability, 0.5);
+  EXPECT_TRUE (r.unobserved);
+  EXPECT_EQ (r.signed_distance, 0.0);
+  EXPECT_GT (r.signed_distance_std, 0.2);
+  ASSERT_EQ (r.witness_side, 1);
+  const Eigen::Vector3d toward_sensor = (Eigen::Vector3d (0.6, -0.6, 0.7) - low).normalized ();
+  EXPECT_GT (r.witness_normal.dot (toward_sensor), 0.99) << r.witness_normal.transpose ();
+  // The ladder and the pool do not read it free either.
+  for (const bool pooled : {false, true})
+  {
+    CollisionRequest request = surfaceRequest ();
+    request.surface_ladder = !pooled;
+    request.surface_pooled = pooled;
+    ASSERT_TRUE (collide (*ball, *scan, shift (-low.x (), -low.y (), -low.z ()), request, r));
+    EXPECT_NE (r.verdict, Verdict::Free) << (pooled ? "pooled" : "ladder") << " P " << r.probability;
+    EXPECT_TRUE (r.unobserved);
+  }
+  ASSERT_TRUE (collide (*ball, *scan, shift (-seen.x (), -seen.y (), -seen.z ()), surfaceRequest (), r));
+  EXPECT_EQ (r.verdict, Verdict::Free) << "P " << r.probability;
+  EXPECT_FALSE (r.unobserved);
 }
 
 // A small ball half inside a big closed surface: its far side lies deeper than any point's

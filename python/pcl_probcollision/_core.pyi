@@ -190,7 +190,8 @@ class CollisionResult:
     @property
     def unobserved(self) -> bool:
         """True when the surface layer's answer rests on surface the samples do not show (a bridged hole or
-        occlusion shadow, or space behind a scanned sheet); always False without request.surface."""
+        occlusion shadow, or space behind a scanned sheet: a point clear of the scan's surface there, where
+        none reads inside, reads unknown: P 0.5, at least 0.25 pooled); always False without request.surface."""
     @property
     def witness_side(self) -> int:
         """Which input holds the point attaining P: +1 a (the moved one), -1 b, 0 none."""
