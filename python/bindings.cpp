@@ -1512,6 +1512,14 @@ PYBIND11_MODULE (_core, m)
                               "normal estimation turns them) while more than 0.1 of the points lie behind others from it, so\n"
                               "they are not outward; their sides were propagated\n"
                               "(SurfaceModel::normalsTurnedToViewpoint). None without a surface.")
+      .def_property_readonly ("surface_given_normal_spread_ratio", surfaceNumber (&SurfaceModel::givenNormalSpreadRatio),
+                              "Where normals were given, the median over probed samples of their neighbours' spread along the\n"
+                              "normal over their mean spread across it: about 0 where the normals belong to the points, 2 where\n"
+                              "they lie in the surface (SurfaceModel::givenNormalSpreadRatio); NaN otherwise.")
+      .def_property_readonly ("surface_normals_off_surface", surfaceFlag (&SurfaceModel::normalsOffSurface),
+                              "Whether orientation Auto set the given normals aside: surface_given_normal_spread_ratio above\n"
+                              "1.2, most of them lie along the surface, so they were not moved with their points; each point\n"
+                              "took its neighbours' plane instead (SurfaceModel::normalsOffSurface). None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +

@@ -175,6 +175,22 @@ CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
     warning_ = out.str ();
   }
 }
+
+void
+CloudModel::assessNormals (const std::string& name)
+{
+  const double ratio = surface_.givenNormalSpreadRatio ();
+  if (!(ratio > SurfaceModel::kMaxNormalSpreadRatio))
+    return;
+  std::ostringstream out;
+  out.precision (2);
+  out << name << ": its normals lie along its surface, not across it (the neighbours spread " << ratio
+      << " times as much along a normal as across it, median; about 0 where they belong), so they do not belong to these "
+         "points (moved with pcl::transformPointCloud instead of transformPointCloudWithNormals?): "
+      << (surface_.normalsOffSurface () ? "set aside, the surface oriented as a cloud's without normals"
+                                        : "taken as given, as orientation point_normals asks");
+  warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+}
 } // namespace pcl_probcollision
 
 #ifndef PCL_NO_PRECOMPILE

@@ -63,6 +63,10 @@ constexpr float kCarryCosine = 0.9f;
   * degrees above its plane, 89, every one toward it. */
 constexpr double kMinViewSeeds = 0.01;
 
+/** \brief Samples probed by the given normals' check (SurfaceModel::givenNormalSpreadRatio),
+  * evenly spread over those with a given normal. */
+constexpr std::size_t kNormalProbes = 1024;
+
 /** \brief Samples probed by the closed-objects check (SurfaceModel::closedShare), evenly spread:
   * 2,048 winding numbers, on one thread 7 ms for a 9,000-point sphere and 25-40 ms for a
   * 50,000-point room (docs/SURFACE.md, "Closed objects"). */
@@ -794,6 +798,73 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   const double scale = std::sqrt (kPi / in.k);
   const std::size_t k = static_cast<std::size_t> (in.k);
   const std::size_t workers = detail::threadCount (in.threads);
+  // The spread of point i and its k neighbours (their covariance), or nothing for fewer than
+  // three.
+  auto neighbourSpread = [&] (std::size_t i) -> std::optional<Eigen::Matrix3d> {
+    Eigen::Vector3d mean = points[i];
+    Eigen::Matrix3d second = points[i] * points[i].transpose ();
+    double count = 1.0;
+    for (std::size_t j = 0; j < k; ++j)
+    {
+      const int t = in.neighbours[i * k + j];
+      if (t < 0 || static_cast<std::size_t> (t) >= n)
+        continue;
+      mean += points[static_cast<std::size_t> (t)];
+      second += points[static_cast<std::size_t> (t)] * points[static_cast<std::size_t> (t)].transpose ();
+      count += 1.0;
+    }
+    if (count < 3.0)
+      return std::nullopt;
+    mean /= count;
+    return Eigen::Matrix3d (second / count - mean * mean.transpose ());
+  };
+  // Given normals that do not belong to their points (moved with pcl::transformPointCloud
+  // rather than transformPointCloudWithNormals, or another cloud's) lie along the surface: the
+  // neighbours spread more along such a normal than across it. The median, over probes, of the
+  // spread along the normal over the mean spread across it: about 0 for normals that belong
+  // (the noise's share), 1 where the noise hides the surface, 2 for normals lying in the surface.
+  normal_spread_ratio_ = std::numeric_limits<double>::quiet_NaN ();
+  normals_off_surface_ = false;
+  {
+    std::vector<std::size_t> given;
+    for (std::size_t i = 0; i < in.given.size (); ++i)
+      if (in.given[i] && !normals_[i].isZero () && std::isfinite (in.radii[i]))
+        given.push_back (i);
+    std::vector<double> ratios;
+    const std::size_t probes = std::min (given.size (), kNormalProbes);
+    for (std::size_t j = 0; j < probes; ++j)
+    {
+      const std::size_t i = given[j * given.size () / probes];
+      const std::optional<Eigen::Matrix3d> spread = neighbourSpread (i);
+      if (!spread)
+        continue;
+      const Eigen::Vector3d nd = normals_[i].cast<double> ();
+      const double along = nd.dot (*spread * nd), across = 0.5 * (spread->trace () - along);
+      if (across > 0.0)
+        ratios.push_back (along / across);
+    }
+    if (!ratios.empty ())
+    {
+      std::nth_element (ratios.begin (), ratios.begin () + static_cast<std::ptrdiff_t> (ratios.size () / 2), ratios.end ());
+      normal_spread_ratio_ = ratios[ratios.size () / 2];
+    }
+    // Auto sets them aside: each point takes its neighbours' plane, unoriented, as without them.
+    normals_off_surface_ = mode == NormalOrientation::Auto && normal_spread_ratio_ > kMaxNormalSpreadRatio;
+    if (normals_off_surface_)
+    {
+      in.given.assign (n, 0);
+      forEachPoint (n, workers, [&] (std::size_t i) {
+        const std::optional<Eigen::Matrix3d> spread = std::isfinite (in.radii[i]) ? neighbourSpread (i) : std::nullopt;
+        normals_[i] = Eigen::Vector3f::Zero ();
+        if (spread)
+        {
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+          solver.computeDirect (*spread, Eigen::ComputeEigenvectors);
+          normals_[i] = solver.eigenvectors ().col (0).cast<float> ();
+        }
+      });
+    }
+  }
   forEachPoint (n, workers, [&] (std::size_t i) {
     if (!std::isfinite (in.radii[i]))
     {

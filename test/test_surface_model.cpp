@@ -1094,6 +1094,62 @@ TEST (SurfaceModel, NormalsTurnedTowardAViewpointBesideAClosedObjectAreNotOutwar
   EXPECT_NE (taken_answer.verdict, Verdict::InCollision) << "the turned normals' inside is no longer the sphere's";
 }
 
+// Normals that were not moved with their points (pcl::transformPointCloud where
+// transformPointCloudWithNormals was meant) lie along the surface where the rotation turned a
+// face: a box's samples rotated 90 degrees about x, their face normals not, read the box's
+// inside wherever those normals point. Auto sets them aside, with a warning, and the surface is
+// oriented as a cloud's without normals (propagated here, and checked closed with -closed).
+TEST (SurfaceModel, NormalsNotMovedWithTheirPointsAreSetAside)
+{
+  const Eigen::Vector3d c (0.5, 0.0, 0.3), h = Eigen::Vector3d::Constant (0.15);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd (0.5 * 3.14159265358979323846, Eigen::Vector3d::UnitX ()).toRotationMatrix ();
+  pcl::PointCloud<pcl::PointNormal> moved, stale;
+  for (const pcl::PointXYZ& q : boxSurface (c, h, 0.01, 0.001, 21))
+  {
+    const Eigen::Vector3d p = q.getVector3fMap ().cast<double> ();
+    const Eigen::Vector3d d = (p - c).cwiseQuotient (h);
+    int a = 0;
+    d.cwiseAbs ().maxCoeff (&a);
+    Eigen::Vector3d n = Eigen::Vector3d::Zero ();
+    n[a] = d[a] > 0.0 ? 1.0 : -1.0;
+    const Eigen::Vector3d r = c + R * (p - c);
+    moved.push_back (pointNormal (r.x (), r.y (), r.z (), (R * n).cast<float> ()));
+    stale.push_back (pointNormal (r.x (), r.y (), r.z (), n.cast<float> ()));
+  }
+  const auto kept = buildCloudModel (moved, closedObjects (withSurface ()));
+  EXPECT_LT (kept->surface ().givenNormalSpreadRatio (), 0.1);
+  EXPECT_FALSE (kept->surface ().normalsOffSurface ());
+  EXPECT_EQ (kept->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_TRUE (kept->warning ().empty ()) << kept->warning ();
+  const auto set_aside = buildCloudModel (stale, closedObjects (withSurface ()));
+  EXPECT_GT (set_aside->surface ().givenNormalSpreadRatio (), SurfaceModel::kMaxNormalSpreadRatio);
+  EXPECT_TRUE (set_aside->surface ().normalsOffSurface ());
+  EXPECT_EQ (set_aside->surface ().orientation (), NormalOrientation::Propagate);
+  EXPECT_TRUE (set_aside->surface ().insideKnown ()) << set_aside->surface ().closedShare ();
+  EXPECT_NE (set_aside->warning ().find ("lie along its surface"), std::string::npos) << set_aside->warning ();
+  EXPECT_NE (set_aside->warning ().find ("set aside"), std::string::npos) << set_aside->warning ();
+  // Asked for by name, they are taken as given, with the warning.
+  CloudModelParams asked = closedObjects (withSurface ());
+  asked.orientation = NormalOrientation::PointNormals;
+  const auto taken = buildCloudModel (stale, asked);
+  EXPECT_EQ (taken->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_FALSE (taken->surface ().normalsOffSurface ());
+  EXPECT_NE (taken->warning ().find ("taken as given"), std::string::npos) << taken->warning ();
+  // A ball at the box's centre, 10 cm from every face: inside, unless the stale normals are
+  // taken (then free, P = 0, as Auto read it before 2026-12-04's sixth session).
+  const auto ball = buildCloudModel (xyz (sphere (400, 0.05, c)), withSurface ());
+  for (const auto* model : {&kept, &set_aside})
+  {
+    CollisionResult r;
+    ASSERT_TRUE (collide (*ball, **model, Eigen::Isometry3d::Identity (), surfaceRequest (), r));
+    EXPECT_EQ (r.verdict, Verdict::InCollision) << "P " << r.probability;
+    EXPECT_LT (r.signed_distance, -0.08) << r.signed_distance;
+  }
+  CollisionResult r;
+  ASSERT_TRUE (collide (*ball, *taken, Eigen::Isometry3d::Identity (), surfaceRequest (), r));
+  EXPECT_NE (r.verdict, Verdict::InCollision) << "the stale normals' inside is not the box's";
+}
+
 // The same from a viewpoint inside the cloud's bounding box: two spheres either side of PCL's
 // default origin, their normals turned toward it (83 % point in), hide their far sides from it,
 // so the normals are set aside; declared closed, a ball inside one reads collision. From the

@@ -336,7 +336,10 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   std::string why;
   auto percent = [] (double share) { return std::to_string (static_cast<int> (std::lround (100.0 * share))); };
   const double hidden = model.surface ().hiddenFromViewpoint ();
-  if (model.surface ().normalsTurnedToViewpoint ())
+  if (model.surface ().normalsOffSurface ())
+    why = "; not the file's normals: they lie along its surface, not across it, so they were not moved with its points "
+          "(-orientation point_normals to take them)";
+  else if (model.surface ().normalsTurnedToViewpoint ())
     why = "; not the file's normals: they all face its VIEWPOINT, as PCL's normal estimation turns them, and " +
           percent (hidden) + " % of the points lie behind others from there (one scan hides none), so they are not outward "
           "(-orientation point_normals to take them)";

@@ -169,6 +169,9 @@ private:
                    const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
   void assessPrecision (double max_abs_coordinate, const std::string& name);
+  /** \brief Adds to warning() where the given normals lie off their points' planes
+    * (SurfaceModel::givenNormalSpreadRatio above kMaxNormalSpreadRatio). */
+  void assessNormals (const std::string& name);
 
   /** \brief Builds the surface model from the local points alone (the constructor from an
     * UncertainCloud): normals and neighbours estimated here; there is no viewpoint and

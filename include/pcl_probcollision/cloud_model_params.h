@@ -24,7 +24,8 @@ enum class NormalOrientation
 {
   /** \brief Default: the point type's normals when it has finite ones (meshes: the faces'),
     * unless they all face the viewpoint while it does not see the cloud as one scan (PCL's normal
-    * estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint), else the
+    * estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint) or lie along the
+    * surface (not moved with their points: SurfaceModel::normalsOffSurface), else the
     * viewpoint when the cloud's sensor_origin_ lies outside its bounding box and sees
     * it as one scan does (at most 10 % of the points hidden behind others from there:
     * SurfaceModel::hiddenFromViewpoint), else propagation. */

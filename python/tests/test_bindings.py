@@ -629,6 +629,38 @@ def test_normals_turned_toward_a_viewpoint_beside_a_solid_are_set_aside():
     assert inside.verdict == pc.Verdict.InCollision, inside
 
 
+def test_normals_not_moved_with_their_points_are_set_aside():
+    # A box's samples rotated 90 degrees about x, their face normals not (as transformPointCloud
+    # leaves them): Auto sets them aside with a RuntimeWarning, asked for by name they are taken.
+    g = np.linspace(-0.1, 0.1, 21)
+    u, v = [a.ravel() for a in np.meshgrid(g, g)]
+    points, normals = [], []
+    for axis in range(3):
+        for side in (-1.0, 1.0):
+            p = np.zeros((u.size, 3))
+            p[:, axis], p[:, (axis + 1) % 3], p[:, (axis + 2) % 3] = 0.1 * side, u, v
+            n = np.zeros_like(p)
+            n[:, axis] = side
+            points.append(p)
+            normals.append(n)
+    points, normals = np.concatenate(points), np.concatenate(normals)
+    rotated = np.stack([points[:, 0], -points[:, 2], points[:, 1]], axis=1)
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, closed_objects=True)
+    with pytest.warns(RuntimeWarning, match="lie along its surface"):
+        aside = pc.build_model(rotated, params=params, normals=normals)
+    assert aside.surface_normals_off_surface is True
+    assert aside.surface_given_normal_spread_ratio > 1.2
+    assert aside.surface_orientation == pc.NormalOrientation.Propagate and aside.surface_inside_known is True
+    moved = np.stack([normals[:, 0], -normals[:, 2], normals[:, 1]], axis=1)
+    kept = pc.build_model(rotated, params=params, normals=moved)
+    assert kept.surface_normals_off_surface is False and kept.surface_given_normal_spread_ratio < 0.1
+    assert kept.surface_orientation == pc.NormalOrientation.PointNormals
+    assert np.isnan(pc.build_model(rotated, params=params).surface_given_normal_spread_ratio)  # none given
+    ball = pc.build_model(0.03 * rotated[::20] / 0.1, params=pc.CloudModelParams(surface=True))
+    inside = pc.collide(ball, aside, np.eye(4), pc.CollisionRequest(surface=True))
+    assert inside.verdict == pc.Verdict.InCollision, inside
+
+
 def test_surface_normals_and_orientation_options(sheets):
     a, b, A, B = sheets
     # The normals change the surface only: the points' model (origin, size) is the same.

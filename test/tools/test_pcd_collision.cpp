@@ -1989,6 +1989,50 @@ TEST_F (PcdCollisionTool, NormalsTurnedTowardAViewpointBesideASolidAreSetAside)
   EXPECT_NE (taken["verdict"].text, "collision");
 }
 
+// A closed box's samples rotated 90 degrees about x, their face normals not (transformPointCloud
+// where transformPointCloudWithNormals was meant): the normals lie along four of the faces. Auto
+// sets them aside with a warning naming the file, the Orienting line says why, and a ball at the
+// box's centre reads collision with -closed_b; taken by name they read it otherwise.
+TEST_F (PcdCollisionTool, NormalsNotMovedWithTheirPointsAreSetAside)
+{
+  std::string rows;
+  int count = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double side : {-1.0, 1.0})
+      for (int i = 0; i <= 20; ++i)
+        for (int j = 0; j <= 20; ++j)
+        {
+          double p[3], n[3] = {0.0, 0.0, 0.0};
+          p[axis] = 0.1 * side;
+          p[(axis + 1) % 3] = -0.1 + 0.01 * i;
+          p[(axis + 2) % 3] = -0.1 + 0.01 * j;
+          n[axis] = side;
+          char buf[160];
+          // (x, y, z) -> (x, -z, y) about the box's centre (0.5, 0, 0.3); the normal as it was.
+          std::snprintf (buf, sizeof (buf), "%.6f %.6f %.6f %.0f %.0f %.0f\n", 0.5 + p[0], -p[2], 0.3 + p[1], n[0], n[1], n[2]);
+          rows += buf;
+          ++count;
+        }
+  writeFile (dir_ / "stale.pcd", pcdHeader ("x y z normal_x normal_y normal_z", count) + rows);
+  writeFile (dir_ / "ball.pcd", pcdHeader ("x y z", 60) + sphereRows (60, 0.03, 1.0, false));
+  const std::string box = (dir_ / "stale.pcd").string ();
+  const std::vector<std::string> args = {(dir_ / "ball.pcd").string (), box, "-sigma", "0.001", "-json", "-surface", "-closed_b",
+                                         "-pose", "0.5,0,0.3,0,0,0"};
+  const ToolRun r = run (args);
+  ASSERT_EQ (r.status, 0) << r.err;
+  EXPECT_NE (r.err.find ("stale.pcd"), std::string::npos) << r.err;
+  EXPECT_NE (r.err.find ("its normals lie along its surface, not across it"), std::string::npos) << r.err;
+  const auto [answer, stage] = answerAndOrienting (args, box);
+  EXPECT_EQ (answer["verdict"].text, "collision");
+  EXPECT_NE (stage.find ("not the file's normals: they lie along its surface"), std::string::npos) << stage;
+  EXPECT_NE (stage.find ("; closed: "), std::string::npos) << stage;
+  std::vector<std::string> taken_args = args;
+  taken_args.insert (taken_args.end (), {"-orientation_b", "point_normals"});
+  const auto [taken, taken_stage] = answerAndOrienting (taken_args, box);
+  EXPECT_NE (taken_stage.find ("[point_normals: the file's normal_x"), std::string::npos) << taken_stage;
+  EXPECT_NE (taken["verdict"].text, "collision");
+}
+
 // -orientation_b: the table scan, oriented toward its VIEWPOINT by default, is propagated when
 // asked (two-sided: its inside no longer known), and when normals are asked of it, which it has
 // not; the JSON's parameters and inputs.b.surface and the Orienting line say so, and why. The
