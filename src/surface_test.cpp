@@ -1237,16 +1237,18 @@ struct DeepPoint
   /** \brief That sample's outward normal, in A's local frame (zero where it has none): the way
     * out of the other object from there. */
   Eigen::Vector3d normal = Eigen::Vector3d::Zero ();
-  /** \brief Where no point was found inside: a point in the space behind the other's scan, clear
-    * of its surface (SurfaceModel::behindView), which the sensor never observed; index, point
-    * (A's frame) and the way back toward that sensor (A's frame) as above; depth, how far
-    * behind what the scan saw. */
-  bool shadowed = false;
-  int shadow_side = 1;
-  int shadow_index = -1;
-  Eigen::Vector3d shadow_point = Eigen::Vector3d::Zero ();
-  Eigen::Vector3d shadow_normal = Eigen::Vector3d::Zero ();
-  double shadow_depth = 0.0;
+  /** \brief A point in the space behind the other's scan, clear of its surface
+    * (SurfaceModel::behindView), which the sensor never observed: read where no point was found
+    * inside. */
+  struct Shadowed
+  {
+    bool found = false;
+    int side = 1;
+    int index = -1;  ///< hierarchy index in its own model
+    Eigen::Vector3d point = Eigen::Vector3d::Zero ();   ///< in A's local frame
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero ();  ///< toward that sensor, in A's local frame
+    double depth = 0.0;  ///< how far behind what the scan saw
+  } shadowed;
 };
 
 /** \brief The depth of x (in `surface`'s local frame, mapped into A's by T_s) below `surface`:
@@ -1278,7 +1280,7 @@ insideOf (const CloudModel& surface, const Eigen::Vector3d& x)
 /** \brief The points of `node` (of q_bvh, mapped into `surface`'s frame by T_s_q) that lie in the
   * space behind `surface`'s scan, within its bounding box and more than
   * SurfaceModel::kHiddenSpacings median spacings behind what the sensor saw along their line of
-  * sight (SurfaceModel::behindView): the first is recorded in deep (shadowed), and each gets
+  * sight (SurfaceModel::behindView): the first is recorded in deep.shadowed, and each gets
   * P = 1/2 in per_point when given (else the first ends the search). The node is clear of the
   * surface (out of reach) and outside it by the winding number: the scan cannot tell whether
   * the object it saw reaches there. */
@@ -1323,14 +1325,8 @@ shadowedPoints (const ProbabilisticBVH& q_bvh, const ProbabilisticBVH::Node& nod
       const double behind = s.behindView (x);
       if (!(behind > margin))
         continue;
-      if (!deep.shadowed)
-      {
-        deep.shadowed = true;
-        deep.shadow_index = i;
-        deep.shadow_point = T_s * x;
-        deep.shadow_normal = T_s.linear () * (s.viewpoint () - x).normalized ();
-        deep.shadow_depth = behind;
-      }
+      if (!deep.shadowed.found)
+        deep.shadowed = {true, deep.shadowed.side, i, T_s * x, T_s.linear () * (s.viewpoint () - x).normalized (), behind};
       if (!per_point)
         return;
       float& p = (*per_point)[static_cast<std::size_t> (i)];
@@ -1396,7 +1392,7 @@ deepInside (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMo
     const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (first)];
     if (!insideOf (surface, x))
     {
-      if (!deep.found && (per_point || !deep.shadowed))
+      if (!deep.found && (per_point || !deep.shadowed.found))
         shadowedPoints (q_bvh, node, T_s_q, surface, T_s, per_point, deep);
       continue;
     }
@@ -1435,18 +1431,11 @@ insideEitherOutOfReach (const CloudModel& a, const CloudModel& b, const Eigen::I
   if ((!deep.found || !may_stop) && a.surface ().insideKnown ())
   {
     DeepPoint other = deepInside (b, T_a_b, a, I, margin, !may_stop, per_point_b);
-    other.side = other.shadow_side = -1;
-    const DeepPoint first = deep;
+    other.side = other.shadowed.side = -1;
+    const DeepPoint::Shadowed shadowed = deep.shadowed.found ? deep.shadowed : other.shadowed;  // A's first
     if (other.found && (!deep.found || other.depth > deep.depth))
       deep = other;
-    // Behind a scan: A's point first, as found.
-    const DeepPoint& shadow = first.shadowed ? first : other;
-    deep.shadowed = shadow.shadowed;
-    deep.shadow_side = shadow.shadow_side;
-    deep.shadow_index = shadow.shadow_index;
-    deep.shadow_point = shadow.shadow_point;
-    deep.shadow_normal = shadow.shadow_normal;
-    deep.shadow_depth = shadow.shadow_depth;
+    deep.shadowed = shadowed;
   }
   return deep;
 }
@@ -1480,25 +1469,25 @@ answerDeep (const DeepPoint& deep, const CloudModel& a, const CloudModel& b, Sur
   answer.inside_confirmed = answer.inside_confirmed || !s.seenFromViewpoint ();
   answer.probability = 1.0;
 }
-/** \brief A point in the space behind the other's scan (DeepPoint::shadowed), where no point was
+/** \brief A point in the space behind the other's scan (DeepPoint::Shadowed), where no point was
   * found inside: the scan cannot tell whether the object it saw reaches there. Unless the
   * answer already reads P >= 1/2: P = 1/2, unobserved, d = 0 with a standard deviation of its
   * depth behind what the sensor saw (the surface may lie anywhere between), the witness normal
   * toward that sensor (turned toward A's side): the way back to observed space. */
 void
-answerShadow (const DeepPoint& deep, SurfaceAnswer& answer)
+answerShadow (const DeepPoint::Shadowed& shadowed, SurfaceAnswer& answer)
 {
   if (answer.probability >= 0.5)
     return;
   answer.reached = true;
   answer.probability = 0.5;
   answer.unobserved = true;
-  answer.witness_side = deep.shadow_side;
-  answer.witness_index = deep.shadow_index;
-  answer.witness_point = deep.shadow_point;
-  answer.witness_normal = deep.shadow_side > 0 ? deep.shadow_normal : Eigen::Vector3d (-deep.shadow_normal);
+  answer.witness_side = shadowed.side;
+  answer.witness_index = shadowed.index;
+  answer.witness_point = shadowed.point;
+  answer.witness_normal = shadowed.side > 0 ? shadowed.normal : Eigen::Vector3d (-shadowed.normal);
   answer.signed_distance = 0.0;
-  answer.signed_distance_std = deep.shadow_depth;
+  answer.signed_distance_std = shadowed.depth;
 }
 } // namespace
 
@@ -1518,8 +1507,8 @@ containmentTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry
     answerDeep (deep, a, b, answer);
     answer.stopped_early = may_stop;
   }
-  else if (deep.shadowed)
-    answerShadow (deep, answer);
+  else if (deep.shadowed.found)
+    answerShadow (deep.shadowed, answer);
   return answer;
 }
 
@@ -1610,8 +1599,8 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
     return answer;
   }
   answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;
-  if (deep.shadowed)
-    answerShadow (deep, answer);
+  if (deep.shadowed.found)
+    answerShadow (deep.shadowed, answer);
   return answer;
 }
 } // namespace detail
