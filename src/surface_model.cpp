@@ -589,7 +589,8 @@ SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
 
 SurfaceModel::ViewBins
 SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
-                       const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double* hidden)
+                       const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& view, const Eigen::Vector3d& lo,
+                       const Eigen::Vector3d& hi, double* hidden)
 {
   ViewBins bins;
   if (hidden)
@@ -657,15 +658,25 @@ SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::ve
   {
     std::size_t e = b;
     double nearest = std::numeric_limits<double>::infinity ();
+    std::size_t nearest_index = cells[b].second;
     for (; e < cells.size () && cells[e].first == cells[b].first; ++e)
-      nearest = std::min (nearest, range[cells[e].second]);
+      if (range[cells[e].second] < nearest)
+      {
+        nearest = range[cells[e].second];
+        nearest_index = cells[e].second;
+      }
+    const Eigen::Vector3d plane = normals[nearest_index].cast<double> ();
     for (std::size_t j = b; j < e; ++j)
     {
       const std::size_t i = cells[j].second;
-      count += range[i] > nearest + kHiddenSpacings * std::max<double> (spacing[i], s_median) ? 1 : 0;
+      const double margin = kHiddenSpacings * std::max<double> (spacing[i], s_median);
+      count += range[i] > nearest + margin &&
+                       (plane.isZero () || std::abs (plane.dot (points[i] - points[nearest_index])) > margin)
+                   ? 1
+                   : 0;
     }
     bins.keys.push_back (cells[b].first);
-    bins.nearest.push_back (static_cast<float> (nearest));
+    bins.nearest.push_back ({static_cast<float> (nearest), static_cast<std::int32_t> (nearest_index)});
     b = e;
   }
   if (hidden)
@@ -688,29 +699,27 @@ SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::ve
     {
       bins.width = u1 - bins.u0 + 1;
       bins.height = v1 - bins.v0 + 1;
-      bins.grid.assign (static_cast<std::size_t> (bins.width * bins.height), std::numeric_limits<float>::quiet_NaN ());
+      bins.grid.assign (static_cast<std::size_t> (bins.width * bins.height), ViewBins::Nearest ());
       for (std::size_t j = 0; j < bins.keys.size (); ++j)
         bins.grid[static_cast<std::size_t> ((bins.keys[j][2] - bins.v0) * bins.width + (bins.keys[j][1] - bins.u0))] =
             bins.nearest[j];
       bins.keys = std::vector<ViewBins::Key> ();
-      bins.nearest = std::vector<float> ();
+      bins.nearest = std::vector<ViewBins::Nearest> ();
     }
   }
   return bins;
 }
 
-double
+SurfaceModel::ViewBins::Nearest
 SurfaceModel::ViewBins::nearestOf (const Key& key) const
 {
   if (!grid.empty ())
   {
     const std::int64_t u = key[1] - u0, v = key[2] - v0;
-    return u < 0 || v < 0 || u >= width || v >= height ? std::numeric_limits<double>::quiet_NaN ()
-                                                       : double (grid[static_cast<std::size_t> (v * width + u)]);
+    return u < 0 || v < 0 || u >= width || v >= height ? Nearest () : grid[static_cast<std::size_t> (v * width + u)];
   }
   const auto it = std::lower_bound (keys.begin (), keys.end (), key);
-  return it == keys.end () || *it != key ? std::numeric_limits<double>::quiet_NaN ()
-                                         : double (nearest[static_cast<std::size_t> (it - keys.begin ())]);
+  return it == keys.end () || *it != key ? Nearest () : nearest[static_cast<std::size_t> (it - keys.begin ())];
 }
 
 bool
@@ -744,7 +753,7 @@ SurfaceModel::mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, d
   for (auto j = static_cast<std::int64_t> (v0); j <= static_cast<std::int64_t> (v1); ++j)
     for (auto i = static_cast<std::int64_t> (u0); i <= static_cast<std::int64_t> (u1); ++i)
     {
-      const float nearest = b.grid[static_cast<std::size_t> ((j - b.v0) * b.width + (i - b.u0))];
+      const float nearest = b.grid[static_cast<std::size_t> ((j - b.v0) * b.width + (i - b.u0))].range;
       if (farthest - double (nearest) > margin)  // false for an empty (NaN) bin
         return true;
     }
@@ -752,24 +761,33 @@ SurfaceModel::mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, d
 }
 
 double
-SurfaceModel::behindView (const Eigen::Vector3d& x) const
+SurfaceModel::behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x) const
 {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN ();
   ViewBins::Key key;
-  if (view_bins_.empty () || !view_bins_.keyOf (x, key))
+  if (view_bins_.empty () || !view_bins_.keyOf (x, key) || bvh.size () != normals_.size ())
     return kNaN;
   const double range = (x - view_bins_.view).norm ();
+  // Behind the bin's nearest sample: past its tangent plane (oriented toward the view), or,
+  // without a normal, past its range.
+  auto behind = [&] (const ViewBins::Nearest& nearest) {
+    if (nearest.index < 0)
+      return kNaN;
+    const std::size_t j = static_cast<std::size_t> (nearest.index);
+    const Eigen::Vector3d n = normals_[j].cast<double> ();
+    return n.isZero () ? range - double (nearest.range) : n.dot (bvh.means ()[j] - x);
+  };
   // x's own bin first: most points a query asks about lie in front of what the scan saw.
-  double least = range - view_bins_.nearestOf (key);
+  double least = behind (view_bins_.nearestOf (key));
   if (!(least > 0.0))
     return least;
   for (std::int64_t du = -1; du <= 1; ++du)
     for (std::int64_t dv = -1; dv <= 1; ++dv)
     {
-      const double nearest = view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv});
-      if (std::isnan (nearest))
+      const double d = behind (view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv}));
+      if (std::isnan (d))
         return kNaN;  // beside a silhouette, or where the scan saw nothing
-      least = std::min (least, range - nearest);
+      least = std::min (least, d);
     }
   return least;
 }
@@ -945,7 +963,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   std::optional<ViewBins> bins;
   auto hiddenShare = [&] {
     double share = 0.0;
-    bins = binView (points, spacing_, *in.viewpoint, lo, hi, &share);
+    bins = binView (points, spacing_, normals_, *in.viewpoint, lo, hi, &share);
     return share;
   };
   if (mode == NormalOrientation::Auto && !any_given && view_outside)
@@ -1043,7 +1061,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // Where the scan looked, and how far it saw, for the query's parts behind it.
   view_bins_ = ViewBins ();
   if (seen_from_view_)
-    view_bins_ = bins ? std::move (*bins) : binView (points, spacing_, *in.viewpoint, lo, hi, nullptr);
+    view_bins_ = bins ? std::move (*bins) : binView (points, spacing_, normals_, *in.viewpoint, lo, hi, nullptr);
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));
@@ -1346,6 +1364,6 @@ SurfaceModel::bytes () const
          open_words_.capacity () * sizeof (OpenWord) + open_values_.capacity () * sizeof (Eigen::Vector4f) +
          owned_.capacity () * sizeof (std::uint64_t) + dipoles_.capacity () * sizeof (Dipole) +
          view_bins_.keys.capacity () * sizeof (ViewBins::Key) +
-         (view_bins_.nearest.capacity () + view_bins_.grid.capacity ()) * sizeof (float);
+         (view_bins_.nearest.capacity () + view_bins_.grid.capacity ()) * sizeof (ViewBins::Nearest);
 }
 } // namespace pcl_probcollision

@@ -1322,7 +1322,7 @@ shadowedPoints (const ProbabilisticBVH& q_bvh, const ProbabilisticBVH::Node& nod
       const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (i)];
       if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0)
         continue;
-      const double behind = s.behindView (x);
+      const double behind = s.behindView (surface.hierarchy (), x);
       if (!(behind > margin))
         continue;
       if (!deep.shadowed.found)

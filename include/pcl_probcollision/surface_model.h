@@ -128,9 +128,9 @@ public:
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
   /** \brief A point lies hidden behind others from a viewpoint (hiddenFromViewpoint()), or behind
-    * the surface seen from it (behindView(), as the query asks), when it is farther than the
-    * nearest sample in its bin of directions by more than this many sample spacings: a bin two
-    * spacings wide across a surface seen at a slant spans a few spacings of range. */
+    * the surface seen from it (behindView(), as the query asks), when it lies farther than the
+    * nearest sample in its bin of directions, and off that sample's tangent plane, by more than
+    * this many sample spacings. */
   static constexpr double kHiddenSpacings = 3.0;
   /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced the
     * viewpoint (outside the cloud, or within its bounding box for Auto): the share of points
@@ -145,20 +145,24 @@ public:
     * normals lie within 78 degrees of the line of sight (toward the viewpoint or away), at most a
     * tenth of those away, and at most kMaxHiddenShare of the points hidden behind others. */
   bool seenFromViewpoint () const { return seen_from_view_; }
-  /** \brief Where seenFromViewpoint(): how far x (local frame) lies behind the surface along the
-    * viewpoint's line of sight, the least over the 3 x 3 bins of directions about x's (those of
-    * hiddenFromViewpoint(), two median spacings wide at the median depth) of x's range minus the
-    * bin's nearest sample's. Negative in front of what the scan saw; NaN where one of those bins
-    * holds no sample (no surface was seen along that line, or x lies beside a silhouette), behind
-    * the viewpoint, or for a surface not seen from one viewpoint. The space behind a scan was
-    * never observed: the query reads a part there, clear of the surface, as unknown
-    * (docs/SURFACE.md, step 6). */
-  double behindView (const Eigen::Vector3d& x) const;
+  /** \brief Where seenFromViewpoint(): how far x (local frame) lies behind the surface the
+    * viewpoint saw along x's line of sight: the least, over the 3 x 3 bins of directions about
+    * x's (those of hiddenFromViewpoint(), two median spacings wide at the median depth), of x's
+    * distance behind the tangent plane of the bin's nearest sample (its range beyond that
+    * sample's where the sample has no normal). Negative in front of what the scan saw (a point
+    * over a floor seen at a grazing angle lies farther than the floor's nearest sample in its
+    * bin, but in front of its plane); NaN where one of those bins holds no sample (no surface
+    * was seen along that line, or x lies beside a silhouette), behind the viewpoint, or for a
+    * surface not seen from one viewpoint. The space behind a scan was never observed: the
+    * query reads a part there, clear of the surface, as unknown (docs/SURFACE.md, step 6).
+    * \param[in] bvh the hierarchy this model was built over */
+  double behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x) const;
   /** \brief False when no point in the convex hull of `corners` (local frame) can lie more than
     * margin behind what the viewpoint saw (behindView() > margin): its farthest corner is nearer
-    * the viewpoint than every sample in the bins its directions span, plus margin. True where
-    * that cannot be told cheaply: more than max_bins bins spanned, a corner behind the view's
-    * plane, or a viewpoint inside the cloud's bounding box. */
+    * the viewpoint than every sample in the bins its directions span, plus margin (a point
+    * behind a sample's tangent plane along its line of sight is at least that much farther).
+    * True where that cannot be told cheaply: more than max_bins bins spanned, a corner behind
+    * the view's plane, or a viewpoint inside the cloud's bounding box. */
   bool mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, double margin, std::int64_t max_bins) const;
   /** \brief The viewpoint behindView() looks from (local frame); NaN where it has none. */
   const Eigen::Vector3d& viewpoint () const { return view_bins_.view; }
@@ -268,27 +272,36 @@ private:
     double sign = 1.0;
     bool inside = false;
     double bin = 0.0;          ///< bin width in the gnomonic coordinates
-    std::vector<Key> keys;     ///< sorted
-    std::vector<float> nearest;///< per key, the least range of its samples
-    /** \brief For a view outside: nearest as a dense grid over the keys' u, v (NaN where no
-      * sample), when that is at most kDenseCells per key; empty otherwise (keys are searched). */
-    std::vector<float> grid;
+    /** \brief A bin's nearest sample: its range from the view and its index (NaN and -1 where
+      * the bin holds none). */
+    struct Nearest
+    {
+      float range = std::numeric_limits<float>::quiet_NaN ();
+      std::int32_t index = -1;
+    };
+    std::vector<Key> keys;          ///< sorted
+    std::vector<Nearest> nearest;   ///< per key
+    /** \brief For a view outside: nearest as a dense grid over the keys' u, v, when that is at
+      * most kDenseCells per key; empty otherwise (keys are searched). */
+    std::vector<Nearest> grid;
     std::int64_t u0 = 0, v0 = 0, width = 0, height = 0;
     static constexpr std::int64_t kDenseCells = 8;
     /** \brief x's bin; false where x lies behind the view's plane (a view outside) or on it. */
     bool keyOf (const Eigen::Vector3d& x, Key& key) const;
     /** \brief True when no bin holds a sample (fewer than two points, or no view). */
     bool empty () const { return keys.empty () && grid.empty (); }
-    /** \brief The bin's nearest range; NaN where it holds no sample. */
-    double nearestOf (const Key& key) const;
+    /** \brief The bin's nearest sample (empty where it holds none). */
+    Nearest nearestOf (const Key& key) const;
   };
   /** \brief The bins of points seen from view, and (when hidden is not null) the share of the
     * points hidden from view behind others: farther than their bin's nearest point by more than
-    * kHiddenSpacings spacings (the point's and the median). Empty bins when there are fewer than
-    * two points. */
+    * kHiddenSpacings spacings (the point's and the median), and as far off that point's tangent
+    * plane (normals, unoriented; a point without one: its range alone). A floor seen at a
+    * grazing angle spans many spacings of range in one bin, all of it on one plane. Empty bins
+    * when there are fewer than two points. */
   static ViewBins binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
-                           const Eigen::Vector3d& view, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                           double* hidden);
+                           const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& view,
+                           const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double* hidden);
   /** \brief Stores the non-zero openings of open (one per point) and their bits. */
   void packOpenings (const std::vector<Eigen::Vector4f>& open);
   /** \brief Whether position j of bvh.pointIndices() is its point's owner: the first leaf
