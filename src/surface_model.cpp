@@ -63,6 +63,10 @@ constexpr float kCarryCosine = 0.9f;
   * degrees above its plane, 89, every one toward it. */
 constexpr double kMinViewSeeds = 0.01;
 
+/** \brief behindView: at most this many of the nine bins about a point may hold no sample (a
+  * single view's bins hold one to three samples where it sees a surface at a slant). */
+constexpr int kMaxEmptyBins = 2;
+
 /** \brief Samples probed by the given normals' check (SurfaceModel::givenNormalSpreadRatio),
   * evenly spread over those with a given normal. */
 constexpr std::size_t kNormalProbes = 1024;
@@ -779,15 +783,20 @@ SurfaceModel::behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
   };
   // x's own bin first: most points a query asks about lie in front of what the scan saw.
   double least = behind (view_bins_.nearestOf (key));
-  if (!(least > 0.0))
+  if (!(least > 0.0) && !std::isnan (least))
     return least;
+  // A bin of a slanted scan holds a sample or two, and one may be empty inside a surface; beside
+  // a silhouette, or where the scan saw nothing, a row of them is.
+  int empty = 0;
+  least = std::numeric_limits<double>::infinity ();
   for (std::int64_t du = -1; du <= 1; ++du)
     for (std::int64_t dv = -1; dv <= 1; ++dv)
     {
       const double d = behind (view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv}));
-      if (std::isnan (d))
-        return kNaN;  // beside a silhouette, or where the scan saw nothing
-      least = std::min (least, d);
+      if (std::isnan (d) && ++empty > kMaxEmptyBins)
+        return kNaN;
+      if (!std::isnan (d))
+        least = std::min (least, d);
     }
   return least;
 }

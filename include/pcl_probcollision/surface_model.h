@@ -151,9 +151,11 @@ public:
     * distance behind the tangent plane of the bin's nearest sample (its range beyond that
     * sample's where the sample has no normal). Negative in front of what the scan saw (a point
     * over a floor seen at a grazing angle lies farther than the floor's nearest sample in its
-    * bin, but in front of its plane); NaN where one of those bins holds no sample (no surface
-    * was seen along that line, or x lies beside a silhouette), behind the viewpoint, or for a
-    * surface not seen from one viewpoint. The space behind a scan was never observed: the
+    * bin, but in front of its plane), over those of the nine that hold a sample; NaN where
+    * more than two hold none (no surface was seen along that line, or x lies beside a
+    * silhouette: a single view's bins hold one to three samples where it sees a surface at a
+    * slant, and one may be empty), behind the viewpoint, or for a surface not seen from one
+    * viewpoint. The space behind a scan was never observed: the
     * query reads a part there, clear of the surface, as unknown (docs/SURFACE.md, step 6).
     * \param[in] bvh the hierarchy this model was built over */
   double behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x) const;
