@@ -565,20 +565,28 @@ openingOf (const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3f& no
 }
 } // namespace
 
-bool
-SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
+double
+SurfaceModel::ViewBins::depthOf (const Eigen::Vector3d& r, int& a, std::int64_t& face) const
 {
-  const Eigen::Vector3d r = x - view;
-  int a = axis;
+  a = axis;
   double s = sign;
-  std::int64_t face = 0;
+  face = 0;
   if (inside)
   {
     r.cwiseAbs ().maxCoeff (&a);
     s = r[a] < 0.0 ? -1.0 : 1.0;
     face = 2 * a + (s < 0.0 ? 1 : 0);
   }
-  const double t = s * r[a];
+  return s * r[a];
+}
+
+bool
+SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
+{
+  const Eigen::Vector3d r = x - view;
+  int a = 0;
+  std::int64_t face = 0;
+  const double t = depthOf (r, a, face);
   if (!(t > 0.0) || !(bin > 0.0))
     return false;
   const int u = (a + 1) % 3, v = (a + 2) % 3;
@@ -626,14 +634,9 @@ SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::ve
   for (std::size_t i = 0; i < n; ++i)
   {
     const Eigen::Vector3d r = points[i] - view;
-    int a = bins.axis;
-    double s = bins.sign;
-    if (bins.inside)
-    {
-      r.cwiseAbs ().maxCoeff (&a);
-      s = r[a] < 0.0 ? -1.0 : 1.0;
-    }
-    depth[i] = s * r[a];
+    int a = 0;
+    std::int64_t face = 0;
+    depth[i] = bins.depthOf (r, a, face);
     range[i] = r.norm ();
   }
   auto median = [&scratch] (auto begin, auto end) {
@@ -827,7 +830,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   const std::size_t workers = detail::threadCount (in.threads);
   // The spread of point i and its k neighbours (their covariance), or nothing for fewer than
   // three.
-  auto neighbourSpread = [&] (std::size_t i) -> std::optional<Eigen::Matrix3d> {
+  struct Spread
+  {
+    Eigen::Matrix3d covariance;
+    double count;  ///< the point and its neighbours
+  };
+  auto neighbourSpread = [&] (std::size_t i) -> std::optional<Spread> {
     Eigen::Vector3d mean = points[i];
     Eigen::Matrix3d second = points[i] * points[i].transpose ();
     double count = 1.0;
@@ -836,14 +844,15 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
       const int t = in.neighbours[i * k + j];
       if (t < 0 || static_cast<std::size_t> (t) >= n)
         continue;
-      mean += points[static_cast<std::size_t> (t)];
-      second += points[static_cast<std::size_t> (t)] * points[static_cast<std::size_t> (t)].transpose ();
+      const Eigen::Vector3d& p = points[static_cast<std::size_t> (t)];
+      mean += p;
+      second += p * p.transpose ();
       count += 1.0;
     }
     if (count < 3.0)
       return std::nullopt;
     mean /= count;
-    return Eigen::Matrix3d (second / count - mean * mean.transpose ());
+    return Spread {second / count - mean * mean.transpose (), count};
   };
   // Given normals that do not belong to their points (moved with pcl::transformPointCloud
   // rather than transformPointCloudWithNormals, or another cloud's) lie along the surface: the
@@ -862,11 +871,11 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     for (std::size_t j = 0; j < probes; ++j)
     {
       const std::size_t i = given[j * given.size () / probes];
-      const std::optional<Eigen::Matrix3d> spread = neighbourSpread (i);
+      const std::optional<Spread> spread = neighbourSpread (i);
       if (!spread)
         continue;
       const Eigen::Vector3d nd = normals_[i].cast<double> ();
-      const double along = nd.dot (*spread * nd), across = 0.5 * (spread->trace () - along);
+      const double along = nd.dot (spread->covariance * nd), across = 0.5 * (spread->covariance.trace () - along);
       if (across > 0.0)
         ratios.push_back (along / across);
     }
@@ -881,12 +890,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     {
       in.given.assign (n, 0);
       forEachPoint (n, workers, [&] (std::size_t i) {
-        const std::optional<Eigen::Matrix3d> spread = std::isfinite (in.radii[i]) ? neighbourSpread (i) : std::nullopt;
+        const std::optional<Spread> spread = std::isfinite (in.radii[i]) ? neighbourSpread (i) : std::nullopt;
         normals_[i] = Eigen::Vector3f::Zero ();
         if (spread)
         {
           Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-          solver.computeDirect (*spread, Eigen::ComputeEigenvectors);
+          solver.computeDirect (spread->covariance, Eigen::ComputeEigenvectors);
           normals_[i] = solver.eigenvectors ().col (0).cast<float> ();
         }
       });
@@ -904,33 +913,19 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // neighbours do not fill the disc of radius r_k: the area they cover is that of the ellipse
     // of their spread in the plane, 4 pi sqrt(l1 l2) (l1, l2 the two larger eigenvalues; pi r^2
     // on a uniformly filled disc), so the spacing is at most sqrt(area / (k + 1)).
-    Eigen::Vector3d mean = points[i];
-    Eigen::Matrix3d second = points[i] * points[i].transpose ();
-    std::size_t count = 1;
-    for (std::size_t j = 0; j < k; ++j)
+    const std::optional<Spread> spread = neighbourSpread (i);
+    if (spread)
     {
-      const int t = in.neighbours[i * k + j];
-      if (t < 0 || static_cast<std::size_t> (t) >= n)
-        continue;
-      const Eigen::Vector3d& p = points[static_cast<std::size_t> (t)];
-      mean += p;
-      second += p * p.transpose ();
-      ++count;
-    }
-    if (count >= 3)
-    {
-      mean /= static_cast<double> (count);
-      const Eigen::Matrix3d cov = second / static_cast<double> (count) - mean * mean.transpose ();
       // Closed form (computeDirect): the iterative solver was a fifth of the surface model's build.
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-      const Eigen::Vector3d l = solver.computeDirect (cov, Eigen::EigenvaluesOnly).eigenvalues ();
+      const Eigen::Vector3d l = solver.computeDirect (spread->covariance, Eigen::EigenvaluesOnly).eigenvalues ();
       const double area = 4.0 * kPi * std::sqrt (std::max (0.0, l[1]) * std::max (0.0, l[2]));
-      s = std::min (s, std::sqrt (area / static_cast<double> (count)));
+      s = std::min (s, std::sqrt (area / spread->count));
     }
     // The area reads the same neighbours again, in differences from the sample: the spacing
     // above keeps its own sums, so that its values (which the query's reaches were chosen with)
     // stay those it had before the areas.
-    areas_[i] = static_cast<float> (count >= 3 ? neighbourhoodArea (points, i, &in.neighbours[i * k], k, normals_[i]) : s * s);
+    areas_[i] = static_cast<float> (spread ? neighbourhoodArea (points, i, &in.neighbours[i * k], k, normals_[i]) : s * s);
     spacing_[i] = static_cast<float> (s);
     open[i] = openingOf (points, normals_[i], i, &in.neighbours[i * k], k, in.radii[i]);
   });

@@ -288,6 +288,9 @@ private:
     std::vector<Nearest> grid;
     std::int64_t u0 = 0, v0 = 0, width = 0, height = 0;
     static constexpr std::int64_t kDenseCells = 8;
+    /** \brief The depth of r (a point minus the view) along the axis its bin is on, that axis
+      * and the cube face (0 for a view outside). */
+    double depthOf (const Eigen::Vector3d& r, int& a, std::int64_t& face) const;
     /** \brief x's bin; false where x lies behind the view's plane (a view outside) or on it. */
     bool keyOf (const Eigen::Vector3d& x, Key& key) const;
     /** \brief True when no bin holds a sample (fewer than two points, or no view). */
