@@ -224,6 +224,15 @@ readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vert
     }
     return true;
   };
+  // An offset, index or point count read as any type: refused unless a whole number a long long
+  // holds (a double of 1e227 in a 5.x OFFSETS section was undefined behaviour to convert).
+  auto integer = [&] (const std::string& type, long long& i) {
+    double v = 0.0;
+    if (!value (type, v) || !(std::fabs (v) <= 9.0e15) || v != std::floor (v))
+      return false;
+    i = static_cast<long long> (v);
+    return true;
+  };
   auto count = [&] (const std::string& t, long long& n) {
     const auto r = std::from_chars (t.data (), t.data () + t.size (), n);
     return r.ec == std::errc () && r.ptr == t.data () + t.size () && n >= 0;
@@ -274,13 +283,9 @@ readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vert
       if (binary)
         line ();
       std::vector<long long> offsets (static_cast<std::size_t> (n));
-      double v = 0.0;
       for (auto& o : offsets)
-      {
-        if (!value (offset_type, v))
-          return fail (key + ": truncated offsets");
-        o = static_cast<long long> (v);
-      }
+        if (!integer (offset_type, o))
+          return fail (key + ": truncated offsets, or one not a whole number");
       if (token () != "CONNECTIVITY")
         return fail (key + ": no CONNECTIVITY after its offsets");
       const std::string index_type = token ();
@@ -288,11 +293,8 @@ readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vert
         line ();
       std::vector<long long> connectivity (static_cast<std::size_t> (size));
       for (auto& c : connectivity)
-      {
-        if (!value (index_type, v))
-          return fail (key + ": truncated connectivity");
-        c = static_cast<long long> (v);
-      }
+        if (!integer (index_type, c))
+          return fail (key + ": truncated connectivity, or an index not a whole number");
       for (std::size_t c = 0; c + 1 < offsets.size (); ++c)
       {
         if (offsets[c] < 0 || offsets[c] > offsets[c + 1] || offsets[c + 1] > size)
@@ -303,20 +305,17 @@ readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vert
     else  // up to 4.2: n cells in size integers, each its point count then its indices
     {
       at = mark;
-      double v = 0.0;
       long long used = 0;
       for (long long c = 0; c < n; ++c)
       {
-        if (!value ("int", v) || v < 0 || used + 1 + static_cast<long long> (v) > size)
+        long long points = 0;
+        if (!integer ("int", points) || points < 0 || used + 1 + points > size)
           return fail (key + ": a cell's point count beyond the declared size, or truncated");
-        used += 1 + static_cast<long long> (v);
-        cells.emplace_back (static_cast<std::size_t> (v));
+        used += 1 + points;
+        cells.emplace_back (static_cast<std::size_t> (points));
         for (long long& i : cells.back ())
-        {
-          if (!value ("int", v))
+          if (!integer ("int", i))
             return fail (key + ": truncated");
-          i = static_cast<long long> (v);
-        }
       }
       if (used != size)
         return fail (key + ": its cells do not fill the declared size");

@@ -180,6 +180,10 @@ TEST_F (MeshInput, MalformedObjPlyAndVtkFilesAreRefusedNotCrashedOn)
       {"ascii51.vtk", "# vtk DataFile Version 5.1\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
                       "METADATA\nINFORMATION 0\n\nPOLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 2\n",
        nullptr},
+      // Found by fuzzing: an offset of 1e227 was converted to an integer unchecked.
+      {"huge_offset.vtk", "# vtk DataFile Version 5.1\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                          "POLYGONS 2 3\nOFFSETS double\n0 1e227\nCONNECTIVITY vtktypeint64\n0 1 2\n",
+       "is not a readable vtk mesh (POLYGONS: truncated offsets, or one not a whole number)"},
       {"binary.vtk", bin + "POLYGONS 1 4\n" + big_endian ({3, 0, 1, 2}) + "\n", nullptr},
       {"truncated_cells.vtk", ascii + "POLYGONS 1 4\n3 0 1\n", "is not a readable vtk mesh (POLYGONS: truncated)"},
       {"truncated_binary.vtk", bin + "POLYGONS 1 4\n" + big_endian ({3, 0}), "is not a readable vtk mesh (POLYGONS: truncated)"},
