@@ -53,6 +53,7 @@ constexpr double kCorroborationGaps = 3.0;
 /** \brief Behind the local plane by more than this many of its deviations, a point is inside
   * only if the winding number agrees. */
 constexpr double kDeepSigmas = 2.0;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN ();
 /** \brief A deep point is behind an open surface (a scan, a sheet) when its winding number
   * exceeds this: about 1/2 behind an open sheet (space behind a sheet is occupied), 0 beside or
   * in front of it. Behind a closed surface (closedSurface) it is inside above kInsideWinding:
@@ -1011,6 +1012,22 @@ behindThreshold (const SurfaceModel& s)
   return s.orientation () == NormalOrientation::Viewpoint || !closedSurface (s) ? kBehindWinding : kInsideWinding;
 }
 
+/** \brief How far x (in `surface`'s local frame) lies behind what `surface`'s viewpoint saw
+  * along its line of sight (SurfaceModel::behindView), where that is more than margin and x lies
+  * within the scan's bounding box: space the sensor never observed, which the scan's object may
+  * or may not fill (the occupied space behind a scan ends at its bounding box). NaN elsewhere,
+  * and for a surface not seen from one viewpoint. */
+double
+shadowDepth (const CloudModel& surface, const Eigen::Vector3d& x, double margin)
+{
+  const SurfaceModel& s = surface.surface ();
+  const OrientedBox& bound = surface.hierarchy ().node (ProbabilisticBVH::rootId ()).box;
+  if (!s.seenFromViewpoint () || (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0)
+    return kNaN;
+  const double behind = s.behindView (surface.hierarchy (), x);
+  return behind > margin ? behind : kNaN;
+}
+
 /** \brief The points of `query` (mapped by T_q into A's frame) against `surface` (mapped by
   * T_s), leaf by leaf: groups[i] = (query leaf, surface leaf) sorted by query leaf. */
 void
@@ -1146,25 +1163,49 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       }
       const bool matters = per_point || e.distance / std::max (e.sigma, 1e-300) < best_z;
       bool confirmed = false;
+      // How far x lies behind what the surface's viewpoint saw, where the scan cannot tell
+      // whether its object reaches x (shadowDepth); NaN elsewhere.
+      double shadow = kNaN;
       if (matters && deep)
       {
-        const double winding = s_model.windingNumber (s_bvh, T_s_inverse * x);
-        if (winding < behind_threshold)
+        const Eigen::Vector3d x_s = T_s_inverse * x;
+        const double winding = s_model.windingNumber (s_bvh, x_s);
+        // Behind one scanned view, the sheets it saw may cancel: a box's top seen from straight
+        // above and the table around it put 1-2 cm under the top at a winding number near 0.1,
+        // and a 1 cm cube there read free (d = +5 mm).
+        if (winding < behind_threshold && behind_unseen)
+          shadow = shadowDepth (surface, x_s, std::min (kDeepSigmas * e.plane_sigma, SurfaceModel::kHiddenSpacings * s_model.medianSpacing ()));
+        if (winding < behind_threshold && std::isnan (shadow))
         {
           e.distance = e.nearest;
           e.normal = Eigen::Vector3d::Zero ();
         }
-        else
+        else if (winding >= behind_threshold)
           confirmed = inside_known && winding > kInsideWinding;
       }
-      // Over a bridged hole, or clearly behind a surface seen from one viewpoint (whose far
-      // side no sample shows), the answer rests on surface the samples do not show.
-      const bool unobserved = e.bridged || (behind_unseen && deep && e.distance < 0.0);
+      // Outside the surface near x, yet behind what the sensor saw along its line of sight: past
+      // the edge of the table a box seen from above hides, a cube 1 cm into the box's unseen
+      // side read free. The shadow rule's answer, as out of reach.
+      else if (behind_unseen && e.distance > 0.0 && matters)
+        shadow = shadowDepth (surface, T_s_inverse * x, SurfaceModel::kHiddenSpacings * s_model.medianSpacing ());
+      const bool hidden = !std::isnan (shadow);
+      // Over a bridged hole, clearly behind a surface seen from one viewpoint (whose far side no
+      // sample shows), or hidden from it, the answer rests on surface the samples do not show.
+      const bool unobserved = e.bridged || hidden || (behind_unseen && deep && e.distance < 0.0);
+      // The crossing test reads the local answer; a hidden point is unknown (P = 1/2) to the
+      // pair, its way out toward the sensor.
+      if (e.distance > 0.0 && !e.normal.isZero ())
+        scratch.outside.push_back ({i, x, e.normal, R_q * q_model.normals ()[qi].cast<double> (), e.distance,
+                                    std::max (e.sigma, 1e-300), static_cast<double> (q_model.spacing ()[qi]), e.normal_spread});
+      if (hidden)
+      {
+        e.distance = 0.0;
+        e.sigma = shadow;
+        e.normal = R_s * (s_model.viewpoint () - T_s_inverse * x).normalized ();
+        confirmed = false;
+      }
       const double sigma = std::max (e.sigma, 1e-300);
       const double z = e.distance / sigma;
-      if (e.distance > 0.0 && !e.normal.isZero ())
-        scratch.outside.push_back ({i, x, e.normal, R_q * q_model.normals ()[qi].cast<double> (), e.distance, sigma,
-                                    static_cast<double> (q_model.spacing ()[qi]), e.normal_spread});
       if (per_point)
       {
         float& slot = (*per_point)[qi];
@@ -1291,7 +1332,6 @@ shadowedPoints (const ProbabilisticBVH& q_bvh, const ProbabilisticBVH::Node& nod
   const SurfaceModel& s = surface.surface ();
   if (!s.seenFromViewpoint ())
     return;
-  const OrientedBox& bound = surface.hierarchy ().node (ProbabilisticBVH::rootId ()).box;
   const double margin = SurfaceModel::kHiddenSpacings * s.medianSpacing ();
   // Whole nodes in front of what the sensor saw are passed over (a gripper above a scanned
   // table, most of a query's points): the points of a node are read only where its box may
@@ -1320,10 +1360,8 @@ shadowedPoints (const ProbabilisticBVH& q_bvh, const ProbabilisticBVH::Node& nod
     for (const int i : q_bvh.indices (n))
     {
       const Eigen::Vector3d x = T_s_q * q_bvh.means ()[static_cast<std::size_t> (i)];
-      if ((bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () > 0.0)
-        continue;
-      const double behind = s.behindView (surface.hierarchy (), x);
-      if (!(behind > margin))
+      const double behind = shadowDepth (surface, x, margin);
+      if (std::isnan (behind))
         continue;
       if (!deep.shadowed.found)
         deep.shadowed = {true, deep.shadowed.side, i, T_s * x, T_s.linear () * (s.viewpoint () - x).normalized (), behind};
