@@ -1532,12 +1532,11 @@ PYBIND11_MODULE (_core, m)
   m.def ("build_model",
          [] (const py::object& points, const py::object& covariances, const py::object& params, const std::string& name,
              const py::object& viewpoint, const py::object& normals, bool any_length_normals, bool warn) {
-           if (warn)
-             return warnedModel (buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
-           // Nor on PCL's console, where the library prints it too (as pcd_collision keeps it quiet).
+           // Not on PCL's console, where the library prints it too: the RuntimeWarning says it
+           // once (warn), or CloudModel.warning alone (as pcd_collision keeps the console quiet).
            const pcl_probcollision::io::QuietPclConsole quiet;
-           return std::const_pointer_cast<CloudModel> (
-               buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals));
+           const CloudModel::ConstPtr model = buildModel (points, covariances, params, name, viewpoint, normals, any_length_normals);
+           return warn ? warnedModel (model) : std::const_pointer_cast<CloudModel> (model);
          },
          py::arg ("points"), py::arg ("covariances") = py::none (), py::arg ("params") = py::none (),
          py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
@@ -1554,15 +1553,16 @@ PYBIND11_MODULE (_core, m)
          "    none. The points' model is the same with or without them (pcl::PointNormal instead of pcl::PointXYZ).\n"
          "any_length_normals: keyword only; True takes the normals of any length, as a file stores them (read_cloud_with_normals)\n"
          "    and as pcd_collision -surface reads them: the surface model normalizes them. False: not unit length is a ValueError.\n"
-         "A RuntimeWarning carries CloudModel.warning when the points, held in float, lost precision far from the origin;\n"
-         "    warn=False (keyword only) leaves it in CloudModel.warning alone, PCL's console quiet during the build (for a\n"
-         "    caller that reports it itself, as pcl_probcollision.dask does).\n"
+         "A RuntimeWarning carries CloudModel.warning when the points, held in float, lost precision far from the origin,\n"
+         "    or given normals do not belong to them; warn=False (keyword only) leaves it in CloudModel.warning alone (for\n"
+         "    a caller that reports it itself, as pcl_probcollision.dask does). PCL's console stays quiet during the build.\n"
          "Releases the GIL while building.");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
            // The file's rounding to float, when it matters, says more than the model's own
            // precision warning (which then is not repeated), as pcd_collision's warnings do.
            std::string file_warning;
+           const pcl_probcollision::io::QuietPclConsole quiet;  // the RuntimeWarning says it once
            const CloudModel::ConstPtr model = loadModel (path, params, name, file_warning);
            if (file_warning.empty ())
              return warnedModel (model);

@@ -629,7 +629,7 @@ def test_normals_turned_toward_a_viewpoint_beside_a_solid_are_set_aside():
     assert inside.verdict == pc.Verdict.InCollision, inside
 
 
-def test_normals_not_moved_with_their_points_are_set_aside():
+def test_normals_not_moved_with_their_points_are_set_aside(capfd):
     # A box's samples rotated 90 degrees about x, their face normals not (as transformPointCloud
     # leaves them): Auto sets them aside with a RuntimeWarning, asked for by name they are taken.
     g = np.linspace(-0.1, 0.1, 21)
@@ -648,6 +648,7 @@ def test_normals_not_moved_with_their_points_are_set_aside():
     params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001), surface=True, closed_objects=True)
     with pytest.warns(RuntimeWarning, match="lie along its surface"):
         aside = pc.build_model(rotated, params=params, normals=normals)
+    assert "lie along its surface" not in capfd.readouterr().err  # said once, not on PCL's console too
     assert aside.surface_normals_off_surface is True
     assert aside.surface_given_normal_spread_ratio > 1.2
     assert aside.surface_orientation == pc.NormalOrientation.Propagate and aside.surface_inside_known is True
