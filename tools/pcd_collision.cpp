@@ -319,13 +319,15 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
     case pcl_probcollision::NormalOrientation::Viewpoint:
     {
       // Named, because a cloud moved into another frame keeps the VIEWPOINT it was saved with
-      // (PCL's default 0 0 0): a table in a robot's base frame, oriented toward the base under
-      // it, reads everything above it as behind the table.
+      // (PCL's default 0 0 0; pcl::transformPointCloud leaves sensor_origin_): a table in a
+      // robot's base frame, oriented toward the base under it, reads everything above it as
+      // behind the table. Propagating instead loses what lies behind a scan (a part deep in a
+      // box seen from one side reads free): the VIEWPOINT should move with the points.
       const Eigen::Vector4f& o = in.cloud->sensor_origin_;
-      char text[200];
+      char text[240];
       std::snprintf (text, sizeof text,
-                     "toward the sensor origin, VIEWPOINT %.6g %.6g %.6g (-orientation propagate if the cloud was "
-                     "moved after it was scanned)",
+                     "toward the sensor origin, VIEWPOINT %.6g %.6g %.6g (a cloud moved after it was scanned must "
+                     "bring its VIEWPOINT along; -orientation propagate leaves it out)",
                      static_cast<double> (o.x ()), static_cast<double> (o.y ()), static_cast<double> (o.z ()));
       how = text;
       break;
