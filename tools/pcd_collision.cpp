@@ -323,12 +323,15 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
       // robot's base frame, oriented toward the base under it, reads everything above it as
       // behind the table. Propagating instead loses what lies behind a scan (a part deep in a
       // box seen from one side reads free): the VIEWPOINT should move with the points.
-      const Eigen::Vector4f& o = in.cloud->sensor_origin_;
+      // The model's own (an organized cloud's rows and columns may have put it elsewhere than
+      // the file's VIEWPOINT: CloudModel::kStaleViewpointShare), else the file's.
+      const Eigen::Vector3d used = model.surface ().viewpoint () + model.origin ();
+      const Eigen::Vector3d o = used.allFinite () ? used : in.cloud->sensor_origin_.head<3> ().cast<double> ();
       char text[240];
       std::snprintf (text, sizeof text,
                      "toward the sensor origin, VIEWPOINT %.6g %.6g %.6g (a cloud moved after it was scanned must "
                      "bring its VIEWPOINT along; -orientation propagate leaves it out)",
-                     static_cast<double> (o.x ()), static_cast<double> (o.y ()), static_cast<double> (o.z ()));
+                     o.x (), o.y (), o.z ());
       how = text;
       break;
     }

@@ -151,6 +151,14 @@ public:
   /** \brief The ratio above which warning() is set: the input's float spacing above a tenth of
     * the points' standard deviation. */
   static constexpr double kPrecisionWarningRatio = 0.1;
+  /** \brief An organized cloud's VIEWPOINT farther than this share of the points' mean distance
+    * from where its rows and columns say its sensor was (organizedSensorPose), or (for a noise
+    * model that reads the sensor's pose) its optical axis off by more than 2 degrees (the cosine
+    * below), was left behind when the cloud moved: the model takes the sensor's pose, and
+    * warning() says so. The estimate is exact to float rounding on a pinhole image (within 0.2 and 5
+    * micrometres on the real Kinect and stereo scans of ../shared/data). */
+  static constexpr double kStaleViewpointShare = 0.01;
+  static constexpr double kStaleAxisCosine = 0.99939;  ///< cos 2 degrees
 
 private:
   CloudModel () = default;

@@ -7,6 +7,7 @@
 #include <pcl_probcollision/detail/parallel.h>
 #include <pcl_probcollision/detail/sample_spacing.h>
 #include <pcl_probcollision/impl/resolution.hpp>
+#include <pcl_probcollision/organized_sensor_pose.h>
 
 #include <pcl/common/point_tests.h>
 #include <pcl/point_types.h>
@@ -90,6 +91,46 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   {
     err << name << " has no finite point (" << n << " given, " << n << " non-finite)";
     throw pcl::BadArgumentException (err.str (), nullptr, kFunction);
+  }
+
+  // An organized cloud says where its sensor was (organizedSensorPose). A VIEWPOINT elsewhere was
+  // left behind when the cloud moved (pcl::transformPointCloud keeps sensor_origin_ and
+  // sensor_orientation_): it would put every depth model's ray and the surface layer's shadows
+  // in the wrong place (a stale VIEWPOINT refused left a single view two-sided, and 54 of 77
+  // collisions inside it read free). The model is the cloud's with its sensor's pose, and says so.
+  if (const std::optional<SensorPose> sensor = organizedSensorPose (cloud))
+  {
+    const SensorPose given = SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_);
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
+    std::size_t finite = 0;
+    for (const PointT& p : cloud)
+      if (pcl::isXYZFinite (p))
+      {
+        centroid += p.getVector3fMap ().template cast<double> () - sensor->origin;
+        ++finite;
+      }
+    const double distance = centroid.norm () / double (std::max<std::size_t> (finite, 1));
+    const bool moved = !((given.origin - sensor->origin).norm () <= CloudModel::kStaleViewpointShare * distance);
+    const bool turned = params.noise.usesSensorPose () && !(std::abs (given.axis.dot (sensor->axis)) >= CloudModel::kStaleAxisCosine);
+    if (moved || turned)
+    {
+      pcl::PointCloud<PointT> posed = cloud;
+      posed.sensor_origin_ = Eigen::Vector4f (float (sensor->origin.x ()), float (sensor->origin.y ()), float (sensor->origin.z ()), 0.0f);
+      posed.sensor_orientation_ = Eigen::Quaternionf::FromTwoVectors (Eigen::Vector3f::UnitZ (), sensor->axis.cast<float> ());
+      const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (posed, params, indices, covariances, name));
+      std::ostringstream out;
+      out.precision (4);
+      out << name << ": its sensor was at (" << sensor->origin.x () << ", " << sensor->origin.y () << ", " << sensor->origin.z ()
+          << ") looking along (" << sensor->axis.x () << ", " << sensor->axis.y () << ", " << sensor->axis.z ()
+          << "), where the planes of its rows and columns of points meet, not at its VIEWPOINT (" << given.origin.x () << ", "
+          << given.origin.y () << ", " << given.origin.z () << ") looking along (" << given.axis.x () << ", " << given.axis.y ()
+          << ", " << given.axis.z ()
+          << "): the cloud was moved without it (pcl::transformPointCloud leaves sensor_origin_ and sensor_orientation_); "
+             "the model takes its sensor's pose";
+      model->warning_ = model->warning_.empty () ? out.str () : model->warning_ + "; " + out.str ();
+      PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", out.str ().c_str ());
+      return model;
+    }
   }
 
   // A depth noise model needs the sensor's position (it would make every covariance NaN, and the
