@@ -16,6 +16,7 @@
 #include <pcl_probcollision/collision_request.h>
 #include <pcl_probcollision/collision_result.h>
 #include <pcl_probcollision/error_message.h>
+#include <pcl_probcollision/organized_sensor_pose.h>
 #include <pcl_probcollision/sensor_noise.h>
 #include <pcl_probcollision/detail/input_checks.h>
 #include <pcl_probcollision/detail/parallel.h>
@@ -1557,6 +1558,42 @@ PYBIND11_MODULE (_core, m)
          "    or given normals do not belong to them; warn=False (keyword only) leaves it in CloudModel.warning alone (for\n"
          "    a caller that reports it itself, as pcl_probcollision.dask does). PCL's console stays quiet during the build.\n"
          "Releases the GIL while building.");
+  m.def ("organized_sensor_pose",
+         [] (const py::object& points) -> py::object {
+           if (!py::isinstance<py::array> (points))
+             throw py::type_error ("points: expected a numpy array of shape (H, W, 3), float32 or float64, got " + typeName (points));
+           const py::array a = py::reinterpret_borrow<py::array> (points);
+           if (!py::isinstance<py::array_t<float>> (a) && !py::isinstance<py::array_t<double>> (a))
+             throw py::type_error ("points: expected dtype float32 or float64 (native byte order), got " + std::string (py::str (a.dtype ())));
+           if (a.ndim () != 3 || a.shape (2) != 3)
+             throw py::value_error ("points: expected shape (H, W, 3) (an organized cloud's image), got " + shapeOf (a));
+           const auto image = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (a);
+           const auto v = image.unchecked<3> ();
+           const std::size_t height = static_cast<std::size_t> (a.shape (0)), width = static_cast<std::size_t> (a.shape (1));
+           std::vector<Eigen::Vector3f> grid (height * width);
+           for (std::size_t r = 0; r < height; ++r)
+             for (std::size_t c = 0; c < width; ++c)
+               grid[r * width + c] = Eigen::Vector3d (v (py::ssize_t (r), py::ssize_t (c), 0), v (py::ssize_t (r), py::ssize_t (c), 1),
+                                                      v (py::ssize_t (r), py::ssize_t (c), 2)).cast<float> ();
+           std::optional<SensorPose> pose;
+           {
+             py::gil_scoped_release release;
+             pose = organizedSensorPose (grid, width, height);
+           }
+           if (!pose)
+             return py::none ();
+           return py::make_tuple (py::array_t<double> (3, pose->origin.data ()), py::array_t<double> (3, pose->axis.data ()));
+         },
+         py::arg ("points"),
+         "Where the pinhole sensor (a depth camera, a rectified stereo pair) that captured an organized cloud was:\n"
+         "    (origin, axis), two float64 arrays of 3 (the optical centre and the unit optical axis, toward the\n"
+         "    points), or None where its rows and columns do not say it (a lidar's rings, an image of one plane\n"
+         "    without noise, fewer than 3 rows or columns that span a plane).\n"
+         "points: (H, W, 3) float32/float64, the image's points, NaN where a pixel has none. The planes of its rows\n"
+         "    and of its columns meet at the optical centre, so the pose moves with the points: after a rigid\n"
+         "    transform it is where the sensor now is. As build_model(viewpoint=) takes a pose: (*origin, 1, 0, 0, 0)\n"
+         "    places it (the axis matters only to the depth noise models). load_model and pcd_collision do this\n"
+         "    themselves for an organized file whose VIEWPOINT lies elsewhere (with a warning).");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
            // The file's rounding to float, when it matters, says more than the model's own

@@ -1364,3 +1364,53 @@ def test_mesh_signed_volume_tells_a_solid_from_one_inside_out():
     assert pc.mesh_signed_volume(V, box) == pytest.approx(2.0, rel=1e-9)
     assert pc.mesh_signed_volume(V, box[:, ::-1]) == pytest.approx(-2.0, rel=1e-9)
     assert pc.is_closed_mesh(V, box[:, ::-1])
+
+
+def _pinhole_image(sensor, target, noise=0.002, box=True, seed=3):
+    # A 48 x 64 pinhole depth image (60 px focal length) of a 20 cm box on an 80 cm table, with
+    # range noise along each ray; NaN where a ray meets nothing.
+    f = (target - sensor) / np.linalg.norm(target - sensor)
+    r = np.cross(f, [0.0, 0.0, 1.0])
+    r /= np.linalg.norm(r)
+    d = np.cross(f, r)
+    u, v = np.meshgrid((np.arange(64) - 31.5) / 60.0, (np.arange(48) - 23.5) / 60.0)
+    rays = f + u[..., None] * r + v[..., None] * d
+    rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = -sensor[2] / rays[..., 2]
+        p = sensor + t[..., None] * rays
+        t = np.where((t > 0) & (np.abs(p[..., 0]) < 0.4) & (np.abs(p[..., 1]) < 0.4), t, np.inf)
+        if box:
+            lo, hi = np.array([-0.1, -0.1, 0.0]), np.array([0.1, 0.1, 0.2])
+            t0, t1 = (lo - sensor) / rays, (hi - sensor) / rays
+            enter, leave = np.minimum(t0, t1).max(axis=-1), np.maximum(t0, t1).min(axis=-1)
+            t = np.where((enter < leave) & (enter > 0) & (enter < t), enter, t)
+    t = t + np.random.default_rng(seed).normal(0.0, noise, t.shape)
+    return np.where(np.isfinite(t)[..., None], sensor + t[..., None] * rays, np.nan)
+
+
+def test_organized_sensor_pose_finds_the_sensor_of_a_moved_image(tmp_path):
+    sensor, target = np.array([0.6, -0.6, 0.7]), np.array([0.0, 0.0, 0.1])
+    image = _pinhole_image(sensor, target)
+    origin, axis = pc.organized_sensor_pose(image)
+    assert np.linalg.norm(origin - sensor) < 1e-4
+    assert axis @ (target - sensor) / np.linalg.norm(target - sensor) > 0.9999
+    # Moved into a robot's frame, as pcl::transformPointCloud moves a cloud: the pose moves along.
+    c, s = np.cos(2.0), np.sin(2.0)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    t = np.array([0.3, -1.2, 0.8])
+    moved = image @ R.T + t
+    origin, axis = pc.organized_sensor_pose(moved.astype(np.float32))
+    assert np.linalg.norm(origin - (R @ sensor + t)) < 1e-4
+    assert pc.organized_sensor_pose(_pinhole_image(sensor, target, noise=0.0, box=False)) is None  # rows are lines
+    with pytest.raises(ValueError, match=r"expected shape \(H, W, 3\)"):
+        pc.organized_sensor_pose(image.reshape(-1, 3))
+    # An organized file moved without its VIEWPOINT: load_model takes the sensor's pose and warns.
+    path = tmp_path / "moved.pcd"
+    rows = "\n".join(" ".join("nan" if not np.isfinite(x) else "%.6f" % x for x in p) for p in moved.reshape(-1, 3))
+    path.write_text("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 64\nHEIGHT 48\n"
+                    "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3072\nDATA ascii\n" + rows + "\n")
+    params = pc.CloudModelParams(surface=True)
+    with pytest.warns(RuntimeWarning, match="where the planes of its rows and columns of points meet"):
+        model = pc.load_model(path, params=params)
+    assert model.surface_orientation == pc.NormalOrientation.Viewpoint
