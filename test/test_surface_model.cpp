@@ -1346,15 +1346,16 @@ TEST (SurfaceLayer, AClosedObjectsInsideIsKnown)
 // 1/2 (three faces of six), and under 1/2 such a part read free, unmarked (a probe, 2026-12-04).
 namespace
 {
-/** \brief One scanned view of a 20 cm box standing on z = 0, seen from (0.6, -0.6, 0.7): its top
-  * and the two sides facing +x and -y, sampled every 1 cm with 1 mm noise; with_table, the table
-  * it stands on (60 cm square) where the sensor sees it, not under the box or in its shadow, and
-  * not within 1.5 cm of its sides (with the table's grid touching them the viewpoint is refused:
-  * over a tenth of the points disagree with their part's side there). */
+/** \brief One scanned view of a 20 cm box standing on z = 0, seen from sensor (by default
+  * (0.6, -0.6, 0.7)): its top and the sides facing +x and -y where the sensor sees them, sampled
+  * every 1 cm with 1 mm noise; with_table, the table it stands on (60 cm square) where the
+  * sensor sees it, not under the box or in its shadow, and not within 1.5 cm of its sides (with
+  * the table's grid touching them the viewpoint is refused: over a tenth of the points disagree
+  * with their part's side there). Modelled with model_sigma of isotropic noise. */
 std::shared_ptr<const CloudModel>
-oneScannedViewOfABox (bool with_table = false)
+oneScannedViewOfABox (bool with_table = false, const Eigen::Vector3d& sensor = Eigen::Vector3d (0.6, -0.6, 0.7),
+                      double model_sigma = 0.001)
 {
-  const Eigen::Vector3d sensor (0.6, -0.6, 0.7);
   pcl::PointCloud<pcl::PointXYZ> view;
   std::mt19937 rng (5);
   std::normal_distribution<double> noise (0.0, 0.001);
@@ -1366,8 +1367,10 @@ oneScannedViewOfABox (bool with_table = false)
     for (int j = 0; j <= 20; ++j)
     {
       add (-0.1 + 0.01 * i, -0.1 + 0.01 * j, 0.2);  // top
-      add (0.1, -0.1 + 0.01 * i, 0.01 * j);         // the side facing +x
-      add (-0.1 + 0.01 * i, -0.1, 0.01 * j);        // the side facing -y
+      if (sensor.x () > 0.1)
+        add (0.1, -0.1 + 0.01 * i, 0.01 * j);  // the side facing +x
+      if (sensor.y () < -0.1)
+        add (-0.1 + 0.01 * i, -0.1, 0.01 * j);  // the side facing -y
     }
   // The line of sight from the sensor to p meets the box (a slab test) before p.
   auto hidden = [&] (const Eigen::Vector3d& p) {
@@ -1390,7 +1393,7 @@ oneScannedViewOfABox (bool with_table = false)
         add (x, y, 0.0);
     }
   view.sensor_origin_ = Eigen::Vector4f (sensor.x (), sensor.y (), sensor.z (), 0.0).cast<float> ();
-  return buildCloudModel (view, noisy (0.001));
+  return buildCloudModel (view, noisy (model_sigma));
 }
 } // namespace
 
@@ -1465,27 +1468,7 @@ TEST (SurfaceLayer, BehindOneScannedViewOutOfTheOccupiedIsUnknown)
 TEST (SurfaceLayer, BehindTheTopOfABoxSeenFromAboveIsNotFree)
 {
   const Eigen::Vector3d sensor (0.0, 0.0, 1.0);
-  pcl::PointCloud<pcl::PointXYZ> view;
-  std::mt19937 rng (5);
-  std::normal_distribution<double> noise (0.0, 0.001);
-  auto add = [&] (double x, double y, double z) {
-    view.push_back (pcl::PointXYZ (static_cast<float> (x + noise (rng)), static_cast<float> (y + noise (rng)),
-                                   static_cast<float> (z + noise (rng))));
-  };
-  for (int i = 0; i <= 20; ++i)
-    for (int j = 0; j <= 20; ++j)
-      add (-0.1 + 0.01 * i, -0.1 + 0.01 * j, 0.2);  // the top
-  // The table, where the line of sight to it passes beside the box (its top's shadow reaches
-  // 12.5 cm from the centre).
-  for (int i = 0; i <= 60; ++i)
-    for (int j = 0; j <= 60; ++j)
-    {
-      const double x = -0.3 + 0.01 * i, y = -0.3 + 0.01 * j;
-      if (std::max (std::abs (x), std::abs (y)) > 0.125)
-        add (x, y, 0.0);
-    }
-  view.sensor_origin_ = Eigen::Vector4f (0.0f, 0.0f, 1.0f, 0.0f);
-  const auto scan = buildCloudModel (view, noisy (0.005));
+  const auto scan = oneScannedViewOfABox (true, sensor, 0.005);  // the top and the table around it
   ASSERT_EQ (scan->surface ().orientation (), NormalOrientation::Viewpoint);
   ASSERT_TRUE (scan->surface ().seenFromViewpoint ());
   const auto ball = buildCloudModel (xyz (sphere (300, 0.005, Eigen::Vector3d::Zero ())), noisy (0.005));
