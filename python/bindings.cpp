@@ -186,18 +186,49 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
             const std::string& name, const py::object& viewpoint = py::none (),
             const py::object& normals = py::none (), bool any_length_normals = false)
 {
-  const py::array pts = floatArray (points, "points", 2, "(N, 3)");
+  // An (H, W, 3) image of points is an organized cloud, W x H: its rows and columns say where its
+  // sensor was (organizedSensorPose), as a file's WIDTH and HEIGHT do for load_model. Its
+  // covariances and normals come per pixel, (H, W, 3, 3) and (H, W, 3), or flattened.
+  std::size_t image_width = 0, image_height = 0;
+  const auto flattened = [] (const py::object& obj, int image_ndim, py::ssize_t rows, py::ssize_t columns) {
+    if (!py::isinstance<py::array> (obj) || py::reinterpret_borrow<py::array> (obj).ndim () != image_ndim)
+      return obj;
+    const py::array a = py::reinterpret_borrow<py::array> (obj);
+    if (a.shape (0) != rows || a.shape (1) != columns)
+      return obj;  // refused below by its shape
+    py::list shape;
+    shape.append (-1);
+    for (int d = 2; d < image_ndim; ++d)
+      shape.append (a.shape (d));
+    return py::object (a.attr ("reshape") (py::tuple (shape)));
+  };
+  py::object point_rows = points;
+  if (py::isinstance<py::array> (points) && py::reinterpret_borrow<py::array> (points).ndim () == 3)
+  {
+    const py::array a = py::reinterpret_borrow<py::array> (points);
+    image_height = static_cast<std::size_t> (a.shape (0));
+    image_width = static_cast<std::size_t> (a.shape (1));
+    point_rows = flattened (points, 3, a.shape (0), a.shape (1));
+  }
+  const py::array pts = floatArray (point_rows, "points", 2, image_width > 0 ? "(H, W, 3)" : "(N, 3) or (H, W, 3)");
   pcl::PointCloud<pcl::PointXYZ> cloud;
   if (py::isinstance<py::array_t<float>> (pts))
     fillPoints<float> (pts, cloud);
   else
     fillPoints<double> (pts, cloud);
+  if (image_width > 0)
+  {
+    cloud.width = static_cast<std::uint32_t> (image_width);
+    cloud.height = static_cast<std::uint32_t> (image_height);
+  }
+  const py::object covariance_rows = image_width > 0 ? flattened (covariances, 4, py::ssize_t (image_height), py::ssize_t (image_width)) : covariances;
+  const py::object normal_rows = image_width > 0 ? flattened (normals, 3, py::ssize_t (image_height), py::ssize_t (image_width)) : normals;
 
   pcl::PointCloud<Covariance> covs;
   const bool have_covs = !covariances.is_none ();
   if (have_covs)
   {
-    const py::array c = floatArray (covariances, "covariances", 3, "(N, 3, 3)");
+    const py::array c = floatArray (covariance_rows, "covariances", 3, "(N, 3, 3) or (H, W, 3, 3)");
     if (c.shape (0) != pts.shape (0))
       throw py::value_error ("covariances: " + std::to_string (c.shape (0)) + " matrices for " +
                              std::to_string (pts.shape (0)) + " points");
@@ -229,7 +260,7 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
   {
     // pcl::PointNormal: the same x y z (the same model) plus the normals the surface layer's Auto
     // and PointNormals orientations take, as pcd_collision builds a mesh's model.
-    const py::array nrm = floatArray (normals, "normals", 2, "(N, 3)");
+    const py::array nrm = floatArray (normal_rows, "normals", 2, "(N, 3) or (H, W, 3)");
     if (nrm.shape (0) != pts.shape (0))
       throw py::value_error ("normals: " + std::to_string (nrm.shape (0)) + " normals for " +
                              std::to_string (pts.shape (0)) + " points");
@@ -1544,7 +1575,11 @@ PYBIND11_MODULE (_core, m)
          py::kw_only (), py::arg ("any_length_normals") = false, py::arg ("warn") = true,
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
          "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
-         "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0.\n"
+         "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0. An (H, W, 3)\n"
+         "    image of points (a depth camera's, NaN where a pixel has none) is an organized cloud: where its\n"
+         "    VIEWPOINT is not the sensor its rows and columns meet at (organized_sensor_pose), the model takes that\n"
+         "    sensor's pose, with a RuntimeWarning. Its covariances and normals are then (H, W, 3, 3) and (H, W, 3),\n"
+         "    or flattened in row order.\n"
          "covariances: optional (N, 3, 3) float32/float64, symmetric; estimated from the k nearest neighbours when None.\n"
          "params: CloudModelParams (None = CloudModelParams()).\n"
          "name: what error messages call the cloud.\n"
@@ -1592,8 +1627,9 @@ PYBIND11_MODULE (_core, m)
          "points: (H, W, 3) float32/float64, the image's points, NaN where a pixel has none. The planes of its rows\n"
          "    and of its columns meet at the optical centre, so the pose moves with the points: after a rigid\n"
          "    transform it is where the sensor now is. As build_model(viewpoint=) takes a pose: (*origin, 1, 0, 0, 0)\n"
-         "    places it (the axis matters only to the depth noise models). load_model and pcd_collision do this\n"
-         "    themselves for an organized file whose VIEWPOINT lies elsewhere (with a warning).");
+         "    places it (the axis matters only to the depth noise models). build_model (given an (H, W, 3) image),\n"
+         "    load_model and pcd_collision do this themselves for an organized cloud whose VIEWPOINT lies elsewhere\n"
+         "    (with a warning).");
   m.def ("load_model",
          [] (const std::filesystem::path& path, const py::object& params, const py::object& name) {
            // The file's rounding to float, when it matters, says more than the model's own

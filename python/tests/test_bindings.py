@@ -1414,3 +1414,17 @@ def test_organized_sensor_pose_finds_the_sensor_of_a_moved_image(tmp_path):
     with pytest.warns(RuntimeWarning, match="where the planes of its rows and columns of points meet"):
         model = pc.load_model(path, params=params)
     assert model.surface_orientation == pc.NormalOrientation.Viewpoint
+    # build_model takes the image as an organized cloud too; its rows flattened, it cannot tell.
+    with pytest.warns(RuntimeWarning, match="where the planes of its rows and columns of points meet"):
+        image_model = pc.build_model(moved, params=params)
+    assert image_model.size == model.size and image_model.surface_orientation == pc.NormalOrientation.Viewpoint
+    with pytest.warns(RuntimeWarning, match="rows and columns"):  # covariances per pixel, as the points
+        given = pc.build_model(moved, covariances=np.tile(1e-6 * np.eye(3), (48, 64, 1, 1)))
+    assert given.size == model.size
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pc.build_model(moved.reshape(-1, 3), params=params)
+    with pytest.raises(ValueError, match=r"expected shape \(H, W, 3\)"):
+        pc.build_model(np.zeros((4, 5, 4)))
+    with pytest.raises(ValueError, match=r"normals: expected shape"):
+        pc.build_model(moved, params=params, normals=np.zeros((48, 64, 2)))
