@@ -81,10 +81,10 @@ castArgument (const py::object& obj, const char* name, const char* type)
   }
 }
 
-/** The array behind a float32 / float64 argument of the given rank and trailing dims, or
-  * TypeError / ValueError naming the argument. */
+/** The array behind a float32 / float64 argument of the given rank, its dims from free_dims on
+  * each 3, or TypeError / ValueError naming the argument. */
 py::array
-floatArray (const py::object& obj, const char* arg, int ndim, const char* expected)
+floatArray (const py::object& obj, const char* arg, int ndim, const char* expected, int free_dims = 1)
 {
   if (!py::isinstance<py::array> (obj))
     throw py::type_error (std::string (arg) + ": expected a numpy array of shape " + expected +
@@ -94,7 +94,7 @@ floatArray (const py::object& obj, const char* arg, int ndim, const char* expect
     throw py::type_error (std::string (arg) + ": expected dtype float32 or float64 (native byte order), got " +
                           std::string (py::str (a.dtype ())));
   bool ok = a.ndim () == ndim;
-  for (int d = 1; ok && d < ndim; ++d)
+  for (int d = free_dims; ok && d < ndim; ++d)
     ok = a.shape (d) == 3;
   if (!ok)
     throw py::value_error (std::string (arg) + ": expected shape " + expected + ", got " + shapeOf (a));
@@ -168,16 +168,23 @@ fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud, boo
   }
 }
 
-/** An (N, 3) float32 / float64 array as pcl::PointXYZ (fillPoints), arg naming it in errors. */
+/** An (N, 3) float32 / float64 array as pcl::PointXYZ (fillPoints), arg naming it in errors; with
+  * image, an (H, W, 3) image of points as an organized cloud, W x H (its rows in order). */
 pcl::PointCloud<pcl::PointXYZ>
-cloudOf (const py::object& points, const char* arg)
+cloudOf (const py::object& points, const char* arg, bool image = false)
 {
-  const py::array pts = floatArray (points, arg, 2, "(N, 3)");
+  const py::array given = image ? floatArray (points, arg, 3, "(H, W, 3)", 2) : floatArray (points, arg, 2, "(N, 3)");
+  const py::array pts = image ? py::array (given.attr ("reshape") (py::make_tuple (-1, 3))) : given;
   pcl::PointCloud<pcl::PointXYZ> cloud;
   if (py::isinstance<py::array_t<float>> (pts))
     fillPoints<float> (pts, cloud);
   else
     fillPoints<double> (pts, cloud);
+  if (image)
+  {
+    cloud.width = static_cast<std::uint32_t> (given.shape (1));
+    cloud.height = static_cast<std::uint32_t> (given.shape (0));
+  }
   return cloud;
 }
 
@@ -189,12 +196,13 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
   // An (H, W, 3) image of points is an organized cloud, W x H: its rows and columns say where its
   // sensor was (organizedSensorPose), as a file's WIDTH and HEIGHT do for load_model. Its
   // covariances and normals come per pixel, (H, W, 3, 3) and (H, W, 3), or flattened.
-  std::size_t image_width = 0, image_height = 0;
-  const auto flattened = [] (const py::object& obj, int image_ndim, py::ssize_t rows, py::ssize_t columns) {
-    if (!py::isinstance<py::array> (obj) || py::reinterpret_borrow<py::array> (obj).ndim () != image_ndim)
+  const bool image = py::isinstance<py::array> (points) && py::reinterpret_borrow<py::array> (points).ndim () == 3;
+  pcl::PointCloud<pcl::PointXYZ> cloud = cloudOf (points, "points", image);
+  const auto flattened = [&] (const py::object& obj, int image_ndim) {
+    if (!image || !py::isinstance<py::array> (obj) || py::reinterpret_borrow<py::array> (obj).ndim () != image_ndim)
       return obj;
     const py::array a = py::reinterpret_borrow<py::array> (obj);
-    if (a.shape (0) != rows || a.shape (1) != columns)
+    if (a.shape (0) != py::ssize_t (cloud.height) || a.shape (1) != py::ssize_t (cloud.width))
       return obj;  // refused below by its shape
     py::list shape;
     shape.append (-1);
@@ -202,36 +210,15 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
       shape.append (a.shape (d));
     return py::object (a.attr ("reshape") (py::tuple (shape)));
   };
-  py::object point_rows = points;
-  if (py::isinstance<py::array> (points) && py::reinterpret_borrow<py::array> (points).ndim () == 3)
-  {
-    const py::array a = py::reinterpret_borrow<py::array> (points);
-    image_height = static_cast<std::size_t> (a.shape (0));
-    image_width = static_cast<std::size_t> (a.shape (1));
-    point_rows = flattened (points, 3, a.shape (0), a.shape (1));
-  }
-  const py::array pts = floatArray (point_rows, "points", 2, image_width > 0 ? "(H, W, 3)" : "(N, 3) or (H, W, 3)");
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  if (py::isinstance<py::array_t<float>> (pts))
-    fillPoints<float> (pts, cloud);
-  else
-    fillPoints<double> (pts, cloud);
-  if (image_width > 0)
-  {
-    cloud.width = static_cast<std::uint32_t> (image_width);
-    cloud.height = static_cast<std::uint32_t> (image_height);
-  }
-  const py::object covariance_rows = image_width > 0 ? flattened (covariances, 4, py::ssize_t (image_height), py::ssize_t (image_width)) : covariances;
-  const py::object normal_rows = image_width > 0 ? flattened (normals, 3, py::ssize_t (image_height), py::ssize_t (image_width)) : normals;
+  const std::string points_count = std::to_string (cloud.size ());
 
   pcl::PointCloud<Covariance> covs;
   const bool have_covs = !covariances.is_none ();
   if (have_covs)
   {
-    const py::array c = floatArray (covariance_rows, "covariances", 3, "(N, 3, 3) or (H, W, 3, 3)");
-    if (c.shape (0) != pts.shape (0))
-      throw py::value_error ("covariances: " + std::to_string (c.shape (0)) + " matrices for " +
-                             std::to_string (pts.shape (0)) + " points");
+    const py::array c = floatArray (flattened (covariances, 4), "covariances", 3, "(N, 3, 3) or (H, W, 3, 3)");
+    if (std::size_t (c.shape (0)) != cloud.size ())
+      throw py::value_error ("covariances: " + std::to_string (c.shape (0)) + " matrices for " + points_count + " points");
     if (py::isinstance<py::array_t<float>> (c))
       fillCovariances<float> (c, covs);
     else
@@ -260,10 +247,9 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
   {
     // pcl::PointNormal: the same x y z (the same model) plus the normals the surface layer's Auto
     // and PointNormals orientations take, as pcd_collision builds a mesh's model.
-    const py::array nrm = floatArray (normal_rows, "normals", 2, "(N, 3) or (H, W, 3)");
-    if (nrm.shape (0) != pts.shape (0))
-      throw py::value_error ("normals: " + std::to_string (nrm.shape (0)) + " normals for " +
-                             std::to_string (pts.shape (0)) + " points");
+    const py::array nrm = floatArray (flattened (normals, 3), "normals", 2, "(N, 3) or (H, W, 3)");
+    if (std::size_t (nrm.shape (0)) != cloud.size ())
+      throw py::value_error ("normals: " + std::to_string (nrm.shape (0)) + " normals for " + points_count + " points");
     pcl::PointCloud<pcl::PointNormal> oriented;
     oriented.resize (cloud.size ());
     oriented.width = cloud.width;
@@ -1595,25 +1581,11 @@ PYBIND11_MODULE (_core, m)
          "Releases the GIL while building.");
   m.def ("organized_sensor_pose",
          [] (const py::object& points) -> py::object {
-           if (!py::isinstance<py::array> (points))
-             throw py::type_error ("points: expected a numpy array of shape (H, W, 3), float32 or float64, got " + typeName (points));
-           const py::array a = py::reinterpret_borrow<py::array> (points);
-           if (!py::isinstance<py::array_t<float>> (a) && !py::isinstance<py::array_t<double>> (a))
-             throw py::type_error ("points: expected dtype float32 or float64 (native byte order), got " + std::string (py::str (a.dtype ())));
-           if (a.ndim () != 3 || a.shape (2) != 3)
-             throw py::value_error ("points: expected shape (H, W, 3) (an organized cloud's image), got " + shapeOf (a));
-           const auto image = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (a);
-           const auto v = image.unchecked<3> ();
-           const std::size_t height = static_cast<std::size_t> (a.shape (0)), width = static_cast<std::size_t> (a.shape (1));
-           std::vector<Eigen::Vector3f> grid (height * width);
-           for (std::size_t r = 0; r < height; ++r)
-             for (std::size_t c = 0; c < width; ++c)
-               grid[r * width + c] = Eigen::Vector3d (v (py::ssize_t (r), py::ssize_t (c), 0), v (py::ssize_t (r), py::ssize_t (c), 1),
-                                                      v (py::ssize_t (r), py::ssize_t (c), 2)).cast<float> ();
+           const pcl::PointCloud<pcl::PointXYZ> cloud = cloudOf (points, "points", true);
            std::optional<SensorPose> pose;
            {
              py::gil_scoped_release release;
-             pose = organizedSensorPose (grid, width, height);
+             pose = organizedSensorPose (cloud);
            }
            if (!pose)
              return py::none ();
