@@ -416,7 +416,9 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
     }
   }
   result.answered_by = !from_surface ? AnsweredBy::Separators : pooled ? AnsweredBy::Pooled : AnsweredBy::SurfaceLayer;
-  if (from_surface && request.surface_calibrated)
+  // The maps were fitted on answers the samples show; an unobserved one (the shadow rule's
+  // unknown 1/2, a bridged hole) is not what they describe, and keeps its P.
+  if (from_surface && request.surface_calibrated && !result.unobserved)
   {
     result.probability = detail::calibratedSurfaceProbability (
         result.probability, pooled ? detail::SurfaceCalibration::Pooled : detail::SurfaceCalibration::SurfaceLayer);
