@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -132,6 +133,13 @@ public:
     * nearest sample in its bin of directions, and off that sample's tangent plane, by more than
     * this many sample spacings. */
   static constexpr double kHiddenSpacings = 3.0;
+  /** \brief A sample's k neighbours spread across a patch, not along a row, when their scatter's
+    * middle eigenvalue is at least this share of its largest (a fifth as wide one way as the other):
+    * the plane behindView() takes from them about their centroid where the sample's normal lies
+    * more than 45 degrees off it (kStrayNormalCosine). */
+  static constexpr double kPatchSpread = 0.05;
+  /** \brief cos 45 degrees: a normal further off its neighbours' plane is a stray's (behindView()). */
+  static constexpr float kStrayNormalCosine = 0.70710678f;
   /** \brief Where Auto weighed a viewpoint outside the cloud, or given normals faced the
     * viewpoint (outside the cloud, or within its bounding box for Auto): the share of points
     * hidden from it behind others (a scan from there hides none). Above kMaxHiddenShare the
@@ -274,12 +282,14 @@ private:
     double sign = 1.0;
     bool inside = false;
     double bin = 0.0;          ///< bin width in the gnomonic coordinates
-    /** \brief A bin's nearest sample: its range from the view and its index (NaN and -1 where
-      * the bin holds none). */
+    /** \brief A bin's nearest sample: its range from the view, its index (NaN and -1 where
+      * the bin holds none) and the normal of the plane behindView() takes there, toward the view
+      * (zero where the sample has none), set once the model's normals are final. */
     struct Nearest
     {
       float range = std::numeric_limits<float>::quiet_NaN ();
       std::int32_t index = -1;
+      Eigen::Vector3f normal = Eigen::Vector3f::Zero ();
     };
     std::vector<Key> keys;          ///< sorted
     std::vector<Nearest> nearest;   ///< per key
@@ -301,11 +311,12 @@ private:
   /** \brief The bins of points seen from view, and (when hidden is not null) the share of the
     * points hidden from view behind others: farther than their bin's nearest point by more than
     * kHiddenSpacings spacings (the point's and the median), and as far off that point's tangent
-    * plane (normals, unoriented; a point without one: its range alone). A floor seen at a
-    * grazing angle spans many spacings of range in one bin, all of it on one plane. Empty bins
-    * when there are fewer than two points. */
+    * plane (plane(i): the normal of the plane through sample i's neighbours about their
+    * centroid, any sign, zero where they fix none; a point without one: its range alone). A
+    * floor seen at a grazing angle spans many spacings of range in one bin, all of it on one
+    * plane. Empty bins when there are fewer than two points. */
   static ViewBins binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
-                           const std::vector<Eigen::Vector3f>& normals, const Eigen::Vector3d& view,
+                           const std::function<Eigen::Vector3f (std::size_t)>& plane, const Eigen::Vector3d& view,
                            const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double* hidden);
   /** \brief Stores the non-zero openings of open (one per point) and their bits. */
   void packOpenings (const std::vector<Eigen::Vector4f>& open);
