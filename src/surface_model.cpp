@@ -962,6 +962,21 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   centroid /= std::max<std::size_t> (n, 1);
   const bool view_outside = in.viewpoint && in.viewpoint->allFinite () &&
                             ((in.viewpoint->array () < lo.array ()).any () || (in.viewpoint->array () > hi.array ()).any ());
+  // A sensor sees its samples from many spacings away (a depth camera at its 0.5 m minimum range,
+  // hundreds); a viewpoint within a few spacings of the nearest sample is none's. PCL's default
+  // origin 3 mm under a cylinder sampled all round "hid" 4 % of it, its bins too wide for the
+  // samples near it, and Auto oriented the solid toward it (W2's cylinder on a plane, 4 and 6
+  // sigma_eff clear, read contact).
+  bool view_far = false;
+  if (view_outside)
+  {
+    if (statistics.valid ())
+      statistics.get ();
+    double nearest = std::numeric_limits<double>::infinity ();
+    for (const Eigen::Vector3d& p : points)
+      nearest = std::min (nearest, (p - *in.viewpoint).squaredNorm ());
+    view_far = std::sqrt (nearest) > kMinViewSpacings * median_spacing_;
+  }
   hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
   // The viewpoint's bins, built once: for the hidden share, and kept for behindView.
   std::optional<ViewBins> bins;
@@ -990,7 +1005,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     bins = binView (points, spacing_, planeOf, *in.viewpoint, lo, hi, &share);
     return share;
   };
-  if (mode == NormalOrientation::Auto && !any_given && view_outside)
+  if (mode == NormalOrientation::Auto && !any_given && view_outside && view_far)
     hidden_from_view_ = hiddenShare ();
   // Given normals that face the viewpoint as a scan's do: enough of them facing it, few away
   // (PCL's normal estimation turns every normal toward its viewpoint). Outward normals of a
@@ -1029,7 +1044,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
                             hidden_from_view_ > SurfaceModel::kMaxHiddenShare;
   if (mode == NormalOrientation::Auto)
     mode = any_given && !normals_turned_to_view_ ? NormalOrientation::PointNormals
-           : view_outside && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
+           : view_outside && view_far && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
                                                                               : NormalOrientation::Propagate;
   if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
     mode = NormalOrientation::Propagate;

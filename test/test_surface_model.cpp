@@ -1101,6 +1101,30 @@ TEST (SurfaceModel, NormalsTurnedTowardAViewpointBesideAClosedObjectAreNotOutwar
 // shared Kinect scan after a 5 mm VoxelGrid. Hidden now means off the nearest sample's plane too
 // (0.4 %), and a ball 2-9 cm over the floor, in front of what the sensor saw, reads free (over
 // the sparser far floor some answers are `unobserved`: over a bridged gap between its rows).
+// PCL's default origin a few millimetres from a solid sampled all round (W2's cylinder on a
+// plane, its base 3 mm above the origin) is no sensor's: from so near, the bins of directions
+// are too wide for the samples in front, the hidden share read 4 %, and Auto oriented the solid
+// toward it (4 and 6 sigma_eff clear read contact). A sensor's samples lie many spacings away.
+TEST (SurfaceModel, AViewpointBesideTheSamplesIsNoSensors)
+{
+  for (const double gap : {0.003, 0.5})
+  {
+    SCOPED_TRACE (gap);
+    const auto solid = buildCloudModel (xyz (sphere (4000, 0.05, Eigen::Vector3d (0.0, 0.0, 0.05 + gap))), withSurface ());
+    const SurfaceModel& s = solid->surface ();
+    if (gap < 0.01)
+    {
+      EXPECT_EQ (s.orientation (), NormalOrientation::Propagate);
+      EXPECT_FALSE (s.seenFromViewpoint ());
+    }
+    else  // half a metre away the origin sees the sphere's far half hidden, as before
+    {
+      EXPECT_GT (s.hiddenFromViewpoint (), SurfaceModel::kMaxHiddenShare);
+      EXPECT_EQ (s.orientation (), NormalOrientation::Propagate);
+    }
+  }
+}
+
 TEST (SurfaceModel, AFloorSeenAtAGrazingAngleKeepsItsViewpoint)
 {
   const Eigen::Vector3d sensor (0.0, 0.0, 0.3);

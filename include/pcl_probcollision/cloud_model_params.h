@@ -26,8 +26,9 @@ enum class NormalOrientation
     * unless they all face the viewpoint while it does not see the cloud as one scan (PCL's normal
     * estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint) or lie along the
     * surface (not moved with their points: SurfaceModel::normalsOffSurface), else the
-    * viewpoint when the cloud's sensor_origin_ lies outside its bounding box and sees
-    * it as one scan does (at most 10 % of the points hidden behind others from there:
+    * viewpoint when the cloud's sensor_origin_ lies outside its bounding box, more than 10
+    * median spacings from its nearest sample (SurfaceModel::kMinViewSpacings), and sees it as
+    * one scan does (at most 10 % of the points hidden behind others from there:
     * SurfaceModel::hiddenFromViewpoint), else propagation. */
   Auto,
   /** \brief The normals the points carry (PointNormal and the other *Normal types), taken as

@@ -128,6 +128,10 @@ public:
     * few); a closed object sampled all round, seen from a point outside it, about half (its far
     * side): PCL's default sensor_origin_ (0, 0, 0) is no viewpoint for a mesh's samples. */
   static constexpr double kMaxHiddenShare = 0.1;
+  /** \brief Auto takes a viewpoint for a scan's only if the cloud's nearest sample lies farther
+    * from it than this many median spacings: a sensor's samples lie hundreds of spacings away,
+    * and PCL's default origin beside a sampled solid is no sensor. */
+  static constexpr double kMinViewSpacings = 10.0;
   /** \brief A point lies hidden behind others from a viewpoint (hiddenFromViewpoint()), or behind
     * the surface seen from it (behindView(), as the query asks), when it lies farther than the
     * nearest sample in its bin of directions, and off that sample's tangent plane, by more than
