@@ -1278,8 +1278,6 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   }
   area_ = sums[static_cast<std::size_t> (ProbabilisticBVH::rootId ())].area;
 
-  // Closed objects: whether the propagated orientation reads as a closed surface oriented
-  // outward, by the winding number just behind and in front of evenly spread samples.
   // Each bin's plane for behindView, from the normals as they now are (repaired, smoothed),
   // turned toward the view.
   for (std::vector<ViewBins::Nearest>* cells : {&view_bins_.grid, &view_bins_.nearest})
@@ -1290,6 +1288,9 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
         const Eigen::Vector3f plane = planeOf (i);
         cell.normal = plane.dot ((view_bins_.view - points[i]).cast<float> ()) < 0.0f ? Eigen::Vector3f (-plane) : plane;
       }
+
+  // Closed objects: whether the propagated orientation reads as a closed surface oriented
+  // outward, by the winding number just behind and in front of evenly spread samples.
   closed_share_ = std::numeric_limits<double>::quiet_NaN ();
   solid_share_ = std::numeric_limits<double>::quiet_NaN ();
   if (in.closed_objects && orientation_ == NormalOrientation::Propagate && area_ > 0.0)

@@ -117,8 +117,9 @@ struct CollisionRequest
     * (docs/SURFACE.md, "Calibration"). No map fitted apart from those scenes helps them, so the
     * default is the model's raw P, P = Phi(-signed_distance / signed_distance_std). Per-point
     * values, signed_distance and its std are never mapped, nor is an answer resting on surface
-    * the samples do not show (CollisionResult::unobserved: the maps were not fitted on those). Refused by validate() without surface,
-    * as surface_pooled (pcd_collision's -surface_calibrated needs -surface or a flag implying it). */
+    * the samples do not show (CollisionResult::unobserved: the maps were not fitted on those).
+    * Refused by validate() without surface, as surface_pooled (pcd_collision's
+    * -surface_calibrated needs -surface or a flag implying it). */
   bool surface_calibrated = false;
   /** \brief A distance at any separation, as FCL's distance request gives: beyond the reach of
     * the surface layer where it runs (alone, pooled or as the ladder's rung: no leaf pair within

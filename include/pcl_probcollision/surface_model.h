@@ -315,10 +315,10 @@ private:
   /** \brief The bins of points seen from view, and (when hidden is not null) the share of the
     * points hidden from view behind others: farther than their bin's nearest point by more than
     * kHiddenSpacings spacings (the point's and the median), and as far off that point's tangent
-    * plane (plane(i): the normal of the plane through sample i's neighbours about their
-    * centroid, any sign, zero where they fix none; a point without one: its range alone). A
-    * floor seen at a grazing angle spans many spacings of range in one bin, all of it on one
-    * plane. Empty bins when there are fewer than two points. */
+    * plane (plane(i): sample i's tangent plane's normal as behindView() takes it, any sign;
+    * a point without one: its range alone). A floor seen at a grazing angle spans many
+    * spacings of range in one bin, all of it on one plane. Empty bins when there are fewer
+    * than two points. */
   static ViewBins binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
                            const std::function<Eigen::Vector3f (std::size_t)>& plane, const Eigen::Vector3d& view,
                            const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double* hidden);
