@@ -406,6 +406,22 @@ struct SharedBuild
   std::vector<OursSetting> settings;
 };
 
+/** \brief The settings the stability runs answer on the shared build: those whose own model
+  * equals it but for the surface model (a request without the surface layer ignores it). The
+  * merge radius is compared as each model applies it (CloudModelParams::noiseResolution()):
+  * without the surface model the default merges, with it not, so "default" and "classifier"
+  * build on their own. */
+bool
+answersOnSharedBuild (const OursSetting& s, const pcl_probcollision::CloudModelParams& shared)
+{
+  const pcl_probcollision::CloudModelParams& m = s.model;
+  return (s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
+          s.name == "ladder" || s.name == "ladder-distance") &&
+         m.surface_projection == shared.surface_projection && m.k == shared.k &&
+         m.noiseResolution () == shared.noiseResolution () &&
+         (m.noiseResolution () == 0.0 || m.noise_resolution_gate == shared.noise_resolution_gate);
+}
+
 SharedBuild
 sharedBuild (const Options& o)
 {
@@ -413,30 +429,25 @@ sharedBuild (const Options& o)
   b.model = OursSetting ().model;
   b.model.surface = true;
   for (const OursSetting& s : oursSettings (false))
-    if ((s.name == "default" || s.name == "classifier" || s.name == "surface" || s.name == "pooled" ||
-         s.name == "ladder" || s.name == "ladder-distance") && o.keeps (s.name))
-    {
-      pcl_probcollision::CloudModelParams m = s.model;
-      m.surface = true;
-      if (!(m.surface_projection == b.model.surface_projection && m.k == b.model.k &&
-            m.noise_resolution == b.model.noise_resolution && m.noise_resolution_gate == b.model.noise_resolution_gate))
-        throw std::logic_error ("sharedBuild: setting " + s.name + " needs its own model");
+    if (answersOnSharedBuild (s, b.model) && o.keeps (s.name))
       b.settings.push_back (s);
-    }
   if (o.surface_calibrated)
     calibratedSurface (b.settings);
   return b;
 }
 
 /** \brief The settings of ours the stability runs build on their own, as --only keeps them:
-  * the paper's model ("max") and the whole-cloud merges ("cloudmerge<c>", "surface-cloudmerge<c>"
-  * of --cloud-merge), whose models differ from the shared one. */
+  * the library's default and the separators alone where their model differs from the shared
+  * one (answersOnSharedBuild), the paper's model ("max") and the whole-cloud merges
+  * ("cloudmerge<c>", "surface-cloudmerge<c>" of --cloud-merge). */
 std::vector<OursSetting>
 ownBuildSettings (const Options& o)
 {
   std::vector<OursSetting> out;
+  const SharedBuild shared = sharedBuild (o);
   for (const OursSetting& s : oursSettings (false, {}, {}, {}, {}, o.cloud_merge))
-    if ((s.name == "max" || s.name.rfind ("cloudmerge", 0) == 0 || s.name.rfind ("surface-cloudmerge", 0) == 0) &&
+    if ((((s.name == "default" || s.name == "classifier") && !answersOnSharedBuild (s, shared.model)) || s.name == "max" ||
+         s.name.rfind ("cloudmerge", 0) == 0 || s.name.rfind ("surface-cloudmerge", 0) == 0) &&
         o.keeps (s.name))
       out.push_back (s);
   if (o.surface_calibrated)
@@ -660,8 +671,8 @@ evaluateCell (const Options& o, const PianoRoom& w, std::size_t density, double 
       const std::uint64_t seed = noise_seed + 7919 * (r + 1);
       const CloudXYZ::ConstPtr rob_r = addNoise (*den.rob_clean, sigma, seed);
       const CloudXYZ::ConstPtr env_r = addNoise (*den.env_clean, sigma, seed + 1);
-      // default, classifier and surface on one build (the model with its surface built; a
-      // request without the surface layer ignores it); max and the whole-cloud merges on their own.
+      // The shared build's settings on one model (its surface built; a request without the
+      // surface layer ignores it); the rest on their own (ownBuildSettings).
       const SharedBuild shared = sharedBuild (o);
       BuildRow unused;
       if (!shared.settings.empty ())

@@ -1053,7 +1053,7 @@ PYBIND11_MODULE (_core, m)
       "so a propagated orientation, once checked by the winding number, says where the inside is.")
       .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, std::optional<int> n_min,
                           double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation,
-                          bool closed_objects, int threads, double noise_resolution, const std::string& noise_resolution_gate,
+                          bool closed_objects, int threads, std::optional<double> noise_resolution, const std::string& noise_resolution_gate,
                           bool keep_full_resolution, double noise_stop, const std::string& split, int n_noise_max,
                           const std::string& leakage_bound) {
               CloudModelParams p;
@@ -1087,7 +1087,7 @@ PYBIND11_MODULE (_core, m)
             py::arg ("epsilon") = dp.hierarchy.epsilon, py::arg ("k_sigma") = dp.hierarchy.k_sigma,
             py::arg ("surface") = dp.surface, py::arg ("orientation") = dp.orientation,
             py::arg ("closed_objects") = dp.closed_objects, py::arg ("threads") = dp.threads,
-            py::arg ("noise_resolution") = dp.noise_resolution,
+            py::arg_v ("noise_resolution", dp.noise_resolution, "None"),
             py::arg ("noise_resolution_gate") = std::string (CloudModelParams::resolutionGateName (dp.noise_resolution_gate)),
             py::arg ("keep_full_resolution") = dp.keep_full_resolution, py::arg ("noise_stop") = dp.hierarchy.noise_stop,
             py::arg ("split") = splitName (dp), py::arg ("n_noise_max") = dp.hierarchy.n_noise_max,
@@ -1108,7 +1108,11 @@ PYBIND11_MODULE (_core, m)
                       "is two-sided.")
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
                       "Merge samples closer than this many sensor-noise sigmas into one (issue #17), where\n"
-                      "noise_resolution_gate lets them; 0 (default): never.")
+                      "noise_resolution_gate lets them; 0: never. None (default): 2 without the surface model, 0\n"
+                      "with it (noise_resolution_applied).")
+      .def_property_readonly ("noise_resolution_applied", &CloudModelParams::noiseResolution,
+                              "The merge radius the build applies (C++ noiseResolution()): noise_resolution when set,\n"
+                              "else 2 without the surface model and 0 with it.")
       .def_property (
         "noise_resolution_gate",
         [] (const CloudModelParams& p) { return std::string (CloudModelParams::resolutionGateName (p.noise_resolution_gate)); },
@@ -1183,7 +1187,8 @@ PYBIND11_MODULE (_core, m)
                ", k_sigma=" + num (p.hierarchy.k_sigma) + ", surface=" + (p.surface ? "True" : "False") +
                ", orientation=NormalOrientation." + enumName (p.orientation) +
                ", closed_objects=" + (p.closed_objects ? "True" : "False") + ", threads=" + std::to_string (p.threads) +
-               ", noise_resolution=" + num (p.noise_resolution) + ", noise_resolution_gate='" +
+               ", noise_resolution=" + (p.noise_resolution ? num (*p.noise_resolution) : std::string ("None")) +
+               ", noise_resolution_gate='" +
                CloudModelParams::resolutionGateName (p.noise_resolution_gate) + "', keep_full_resolution=" +
                (p.keep_full_resolution ? "True" : "False") + ", noise_stop=" + num (p.hierarchy.noise_stop) +
                ", split='" + splitName (p) + "', n_noise_max=" + std::to_string (p.hierarchy.n_noise_max) +

@@ -25,9 +25,9 @@ CloudModelParams::validate () const
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                          "[pcl_probcollision::CloudModelParams::validate] threads = "
                              << threads << " must be >= 0 (0: one per hardware thread)");
-  if (!(noise_resolution >= 0.0 && std::isfinite (noise_resolution)))
+  if (noise_resolution && !(*noise_resolution >= 0.0 && std::isfinite (*noise_resolution)))
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::CloudModelParams::validate] noise_resolution = "
-                                                         << noise_resolution << " must be finite and >= 0");
+                                                         << *noise_resolution << " must be finite and >= 0");
   hierarchy.validate ();
 }
 
@@ -141,7 +141,7 @@ CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size,
   if (merged_samples_ > 0 && bvh_.size () <= static_cast<std::size_t> (std::max (params.k, 1)))
   {
     std::ostringstream out;
-    out << name << ": noise_resolution " << params.noise_resolution << " merged its " << mapped << " samples into "
+    out << name << ": noise_resolution " << params.noiseResolution () << " merged its " << mapped << " samples into "
         << bvh_.size () << " point" << (bvh_.size () == 1 ? "" : "s") << ", no more than the covariance estimation's k = "
         << params.k << ": the model no longer resolves the object's shape (lower noise_resolution; 2 is the evaluated choice)";
     warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();

@@ -461,10 +461,23 @@ merging (double sigma, double factor)
 
 TEST (NoiseResolution, OffByDefaultAndValidatedByName)
 {
-  // Off by default (deep collisions lose confidence when merged, docs/PERFORMANCE.md); when it
-  // is set, the whole-cloud gate decides by default, the other gates are options.
-  EXPECT_EQ (CloudModelParams ().noise_resolution, 0.0);
+  // Unset by default: 2 without the surface model (the separators' merged answers, with the
+  // full-resolution rung, gain at 2-4 % noise), 0 with it (the surface layer on merged models
+  // loses easy answers; docs/PERFORMANCE.md); a radius given holds either way. The whole-cloud
+  // gate decides by default, the other gates are options.
+  CloudModelParams defaults;
+  EXPECT_FALSE (defaults.noise_resolution.has_value ());
+  EXPECT_EQ (defaults.noiseResolution (), CloudModelParams::kDefaultNoiseResolution);
+  EXPECT_EQ (CloudModelParams::kDefaultNoiseResolution, 2.0);
+  defaults.surface = true;
+  EXPECT_EQ (defaults.noiseResolution (), 0.0);
+  defaults.noise_resolution = 1.5;
+  EXPECT_EQ (defaults.noiseResolution (), 1.5);
+  defaults.surface = false;
+  defaults.noise_resolution = 0.0;
+  EXPECT_EQ (defaults.noiseResolution (), 0.0);
   EXPECT_EQ (CloudModelParams ().noise_resolution_gate, CloudModelParams::ResolutionGate::WholeCloud);
+  EXPECT_TRUE (CloudModelParams ().keep_full_resolution);
   for (const double bad : {-1.0, static_cast<double> (NAN), static_cast<double> (INFINITY)})
   {
     CloudModelParams params;
@@ -897,11 +910,22 @@ TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
   EXPECT_LT (high->size (), a->size () / 4);
   EXPECT_EQ (high->pointOfSource (), all->pointOfSource ());
   EXPECT_EQ (high->hierarchy ().means (), all->hierarchy ().means ());
-  // It is the default gate: a cloud given only its noise and noise_resolution models as
-  // wholeCloud (sigma, 2) does, and without noise_resolution nothing merges.
+  // It is the default: a cloud given only its noise models as wholeCloud (sigma, 2) does,
+  // keeping its unmerged model for the full-resolution rung; with the surface model, or with
+  // noise_resolution 0, nothing merges.
   CloudModelParams defaults;
   defaults.noise = SensorNoiseModel::isotropic (0.01);
+  const CloudModel::ConstPtr by_default = buildCloudModel (*a, defaults);
+  EXPECT_EQ (by_default->hierarchy ().means (), high->hierarchy ().means ());
+  EXPECT_EQ (by_default->mergedSamples (), high->mergedSamples ());
+  ASSERT_NE (by_default->fullResolution (), nullptr);
+  EXPECT_EQ (by_default->fullResolution ()->size (), a->size ());
+  defaults.noise_resolution = 0.0;
   EXPECT_EQ (buildCloudModel (*a, defaults)->mergedSamples (), 0u);
+  defaults.noise_resolution.reset ();
+  defaults.surface = true;
+  EXPECT_EQ (buildCloudModel (*a, defaults)->mergedSamples (), 0u);
+  defaults.surface = false;
   defaults.noise_resolution = 2.0;
   EXPECT_EQ (buildCloudModel (*a, defaults)->hierarchy ().means (), high->hierarchy ().means ());
   defaults.noise = SensorNoiseModel::isotropic (0.002);
@@ -914,6 +938,31 @@ TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
   EXPECT_TRUE (low->pointOfSource ().empty ());
   EXPECT_EQ (low->hierarchy ().means (), plain->hierarchy ().means ());
   EXPECT_EQ (low->hierarchy ().covariances ().size (), plain->hierarchy ().covariances ().size ());
+}
+
+TEST (NoiseResolutionWholeCloud, TheDefaultLeavesAnObjectSmallerThanItsNoiseUnmerged)
+{
+  // A 10 cm sheet of 441 samples under 10 cm noise: the whole cloud is finer than its noise, and
+  // merged within 2 sigmas it would keep no more points than k. The default radius leaves it
+  // whole, without a warning; the same radius given merges it and says the shape is lost.
+  const Cloud::Ptr a = sheet (0.1, 0.005, 0.0, 21);
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.1);
+  const CloudModel::ConstPtr kept = buildCloudModel (*a, params);
+  EXPECT_EQ (kept->mergedSamples (), 0u);
+  EXPECT_EQ (kept->size (), a->size ());
+  EXPECT_TRUE (kept->warning ().empty ()) << kept->warning ();
+  params.noise_resolution = 2.0;
+  const CloudModel::ConstPtr merged = buildCloudModel (*a, params);
+  EXPECT_LE (merged->size (), static_cast<std::size_t> (params.k));
+  EXPECT_EQ (merged->mergedSamples () + merged->size (), a->size ());
+  EXPECT_NE (merged->warning ().find ("no longer resolves the object's shape"), std::string::npos) << merged->warning ();
+  // At 1 cm noise the same sheet merges by default into more than k points.
+  params.noise_resolution.reset ();
+  params.noise = SensorNoiseModel::isotropic (0.01);
+  const CloudModel::ConstPtr finer = buildCloudModel (*a, params);
+  EXPECT_GT (finer->mergedSamples (), 0u);
+  EXPECT_GT (finer->size (), static_cast<std::size_t> (params.k));
 }
 
 TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotTriggerIt)

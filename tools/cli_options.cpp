@@ -530,10 +530,12 @@ parseCommandLine (const std::vector<std::string>& args)
     }
     else if (a == "-noise_resolution")
     {
-      if (!parseDouble (v, o.noise_resolution))
+      double radius = 0.0;
+      if (!parseDouble (v, radius))
         return usage (bad + notANumber (v));
-      if (!(o.noise_resolution >= 0.0) || !std::isfinite (o.noise_resolution))
+      if (!(radius >= 0.0) || !std::isfinite (radius))
         return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging)");
+      o.noise_resolution = radius;
     }
     else if (a == "-noise_resolution_gate")
     {
@@ -615,9 +617,9 @@ parseCommandLine (const std::vector<std::string>& args)
                   "surface layer's probability");
   // Without merging the gate has nothing to let through: accepted, it changed nothing (found by
   // a probe); -noise_resolution 0 is "never merge" too.
-  if (seen.count ("-noise_resolution_gate") && !(o.noise_resolution > 0.0))
+  if (seen.count ("-noise_resolution_gate") && !(modelParamsFor (o, true).noiseResolution () > 0.0))
     return usage ("option -noise_resolution_gate needs -noise_resolution C > 0: it says where merging applies, and "
-                  "without -noise_resolution nothing is merged");
+                  "nothing is merged without it (by default with -surface, or with 0)");
   if ((orientation || orientation_a || orientation_b) && !o.surface)
     return usage ("options -orientation, -orientation_a and -orientation_b need -surface (or -surface_pooled, "
                   "-surface_ladder): they orient the surface layer's surfaces");
@@ -709,16 +711,16 @@ helpText ()
        "  -k K            = "
     << D::k
     << "      neighbours of the covariance estimation\n"
-       "  -noise_resolution C   = "
-    << fmt (D::noise_resolution)
-    << "   merge samples closer than C noise sigmas into one, where the gate lets\n"
-       "                  them (0: never)\n"
+       "  -noise_resolution C   = auto   merge samples closer than C noise sigmas into one,\n"
+       "                  where the gate lets them (0: never; auto: "
+    << fmt (pcl_probcollision::CloudModelParams::kDefaultNoiseResolution)
+    << " without -surface, 0 with it)\n"
        "  -noise_resolution_gate everywhere|spacing|cloud   = "
     << pcl_probcollision::CloudModelParams::resolutionGateName (D::noise_resolution_gate)
     << "\n                  where -noise_resolution merges: every sample; only samples spaced\n"
        "                  closer than their noise; or a whole cloud sampled finer than its noise\n"
        "                  (its median noise sigma at least its area-weighted spacing), else none;\n"
-       "                  needs -noise_resolution C > 0\n"
+       "                  needs a radius C > 0 (with -surface: -noise_resolution C)\n"
        "  -noise_stop C   = "
     << fmt (D::noise_stop)
     << "      do not split a hierarchy node of at most "

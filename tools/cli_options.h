@@ -48,7 +48,7 @@ struct Defaults
   static inline const bool exhaustive = request.exhaustive;
   static inline const bool defer_kernel_fits = request.defer_kernel_fits;
   static inline const std::size_t max_leaf_fits = request.max_leaf_fits;
-  static inline const double noise_resolution = model.noise_resolution;
+  static inline const std::optional<double> noise_resolution = model.noise_resolution;
   static inline const pcl_probcollision::CloudModelParams::ResolutionGate noise_resolution_gate = model.noise_resolution_gate;
   static inline const double noise_stop = model.hierarchy.noise_stop;
   static inline const int n_noise_max = model.hierarchy.n_noise_max;
@@ -111,8 +111,9 @@ struct Options
   bool defer_kernel_fits = Defaults::defer_kernel_fits;
   /** \brief -max_leaf_fits N: CollisionRequest::max_leaf_fits (0 = no cap). */
   std::size_t max_leaf_fits = Defaults::max_leaf_fits;
-  /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging). */
-  double noise_resolution = Defaults::noise_resolution;
+  /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging; unset: its
+    * default, CloudModelParams::noiseResolution()). */
+  std::optional<double> noise_resolution = Defaults::noise_resolution;
   /** \brief -noise_resolution_gate everywhere|spacing|cloud: CloudModelParams::noise_resolution_gate. */
   pcl_probcollision::CloudModelParams::ResolutionGate noise_resolution_gate = Defaults::noise_resolution_gate;
   /** \brief -noise_stop C: BVHParams::noise_stop (0 = off). */

@@ -4,6 +4,7 @@
 #include <pcl_probcollision/probabilistic_bvh.h>
 #include <pcl_probcollision/sensor_noise.h>
 
+#include <optional>
 #include <string>
 
 namespace pcl_probcollision
@@ -107,14 +108,30 @@ struct CloudModelParams
     * times the sensor noise's smallest standard deviation (at the sample seeding a merge, see
     * detail::noiseClusters) are merged into one sample at their centroid, whose covariance is
     * then estimated at the merged spacing; every merged sample reports its merged point's
-    * per-point values. In noise standard deviations, >= 0; 0 (default) merges nothing; 2 is
-    * the evaluated choice, which with the default noise_resolution_gate merges only a cloud
-    * sampled finer than its noise. Off by default: it lowers the probability of some deep
-    * collisions to contact (docs/PERFORMANCE.md, "Merging a whole cloud sampled finer than its
-    * noise"); keep_full_resolution gives most of them back, not all ("A full-resolution rung for
-    * merged clouds"). No effect without a noise model (noise None) or with covariances given by
-    * the caller. */
-  double noise_resolution = 0.0;
+    * per-point values. In noise standard deviations, >= 0; 0 merges nothing. Unset (the
+    * default): noiseResolution() decides, kDefaultNoiseResolution (2) without the surface model
+    * and 0 with it, and a cloud whose merge would keep no more than k points (an object smaller
+    * than its noise) stays unmerged, where a radius given merges it with a warning. With the default noise_resolution_gate only a cloud sampled finer than its
+    * noise merges, and keep_full_resolution asks the unmerged models again where a merged answer
+    * leans to collision: on the evaluation's reported run (seed 1, 2026-12-05) the separators
+    * then answer at 0.25-1 % noise exactly as unmerged, and at 2-4 % gain easy answers in every
+    * cell with a lower Brier score and a worst query 2-20 times shorter. The surface layer on
+    * merged models loses easy answers in the dense room at 2-4 % (docs/PERFORMANCE.md, "The
+    * whole-cloud merge as the separators' default"), so a model with the surface model merges only
+    * when asked. No effect without a noise model (noise None) or with covariances given by the
+    * caller. */
+  std::optional<double> noise_resolution;
+  /** \brief The merge radius of a model without the surface model when noise_resolution is
+    * unset, in noise standard deviations: the evaluated choice (docs/PERFORMANCE.md, "The merge
+    * radius"). */
+  static constexpr double kDefaultNoiseResolution = 2.0;
+  /** \brief noise_resolution as the build applies it: its value when set, else
+    * kDefaultNoiseResolution without the surface model and 0 (nothing merged) with it. */
+  double
+  noiseResolution () const
+  {
+    return noise_resolution ? *noise_resolution : surface ? 0.0 : kDefaultNoiseResolution;
+  }
   /** \brief Where noise_resolution merges (issue #17 item 1). Everywhere: every sample within
     * the radius of a seed. WhereNoiseExceedsSpacing: only samples whose local spacing is at most
     * their noise's smallest standard deviation, the spacing sqrt(pi / k) times the distance to

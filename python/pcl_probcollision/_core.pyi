@@ -65,7 +65,9 @@ class CloudModelParams:
     surface: bool
     orientation: NormalOrientation
     closed_objects: bool
-    noise_resolution: float
+    noise_resolution: Optional[float]  # None (default): 2 without the surface model, 0 with it
+    @property
+    def noise_resolution_applied(self) -> float: ...
     noise_resolution_gate: str
     noise_resolution_gated: bool
     noise_resolution_whole_cloud: bool
@@ -78,7 +80,7 @@ class CloudModelParams:
                  n_max: int = ..., n_min: Optional[int] = None, sigma_max: float = ..., epsilon: float = ...,
                  k_sigma: float = ..., surface: bool = False,
                  orientation: NormalOrientation = NormalOrientation.Auto, closed_objects: bool = False,
-                 threads: int = 0, noise_resolution: float = 0.0, noise_resolution_gate: str = "cloud",
+                 threads: int = 0, noise_resolution: Optional[float] = None, noise_resolution_gate: str = "cloud",
                  keep_full_resolution: bool = True, noise_stop: float = 0.0, split: str = "pca",
                  n_noise_max: int = 160, leakage_bound: str = "min_slab") -> None: ...
         # n_min None: min(8, n_max), as pcd_collision's -nmax sets it.

@@ -38,20 +38,32 @@ def table(table_path):
     return pc.load_model(table_path, NOISE)
 
 
+# The patch unmerged (noise_resolution 0), as the tests below take it; by default its 400 samples
+# merge (test_noise_resolution_merges_a_patch_sampled_finer_than_its_noise).
+UNMERGED = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005), noise_resolution=0.0)
+
+
 @pytest.fixture(scope="module")
 def gripper_patch():
-    return pc.build_model(patch(), params=NOISE, name="patch")
+    return pc.build_model(patch(), params=UNMERGED, name="patch")
 
 
 def test_noise_resolution_merges_a_patch_sampled_finer_than_its_noise(gripper_patch, table, table_path):
-    # 400 samples 2 mm apart under 5 mm noise: unmerged by default; with noise_resolution = 2 the
-    # patch is modelled by its merged few, while the table (5 mm noise on about 5.3 mm spacing) is
-    # kept whole.
+    # 400 samples 2 mm apart under 5 mm noise: merged by default (noise_resolution None: 2 without
+    # the surface model), as with noise_resolution = 2, into a few points, while the table (5 mm
+    # noise on about 5.3 mm spacing) is kept whole; unmerged with 0 or with the surface model.
     assert gripper_patch.size == 400 and gripper_patch.merged_samples == 0
+    by_default = pc.build_model(patch(), params=NOISE)
+    assert 0 < by_default.size < 40 and by_default.merged_samples == 400 - by_default.size
+    assert by_default.keeps_full_resolution is True
+    with_surface = pc.build_model(patch(), params=pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005),
+                                                                        surface=True))
+    assert with_surface.size == 400 and with_surface.merged_samples == 0
     merging = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005))
     merging.noise_resolution = 2.0
     merged = pc.build_model(patch(), params=merging)
     assert 0 < merged.size < 40 and merged.merged_samples == 400 - merged.size
+    assert merged.size == by_default.size
     kept = pc.load_model(table_path, merging)
     assert kept.size == table.size == 10848 and kept.merged_samples == 0
     # The merged patch keeps its unmerged model for the full-resolution rung; nothing else does.
@@ -88,8 +100,11 @@ def test_defaults_are_the_cpp_defaults():
     p = pc.CloudModelParams()
     assert (p.k, p.surface_projection, p.n_max, p.n_min, p.sigma_max, p.epsilon) == (10, True, 20, 8, 0.05, 0.02)
     assert p.surface is False and p.orientation == pc.NormalOrientation.Auto and p.closed_objects is False
-    # Issue #17's resolution: off by default; set, it merges a whole cloud sampled finer than its noise.
-    assert p.noise_resolution == 0.0 and p.noise_resolution_gate == "cloud" and p.keep_full_resolution is True
+    # Issue #17's resolution: unset by default, which merges a whole cloud sampled finer than its
+    # noise at 2 sigmas without the surface model and nothing with it.
+    assert p.noise_resolution is None and p.noise_resolution_gate == "cloud" and p.keep_full_resolution is True
+    assert p.noise_resolution_applied == 2.0 and pc.CloudModelParams(surface=True).noise_resolution_applied == 0.0
+    assert pc.CloudModelParams(surface=True, noise_resolution=1.5).noise_resolution_applied == 1.5
     assert p.noise_stop == 0.0
     assert p.noise_resolution_whole_cloud is True and p.noise_resolution_gated is False
     p.noise_resolution_gated = True  # one gate: the last set wins
@@ -1257,8 +1272,9 @@ def test_params_and_request_take_every_attribute_as_a_keyword_and_show_it():
     # CloudModelParams lacked n_noise_max and leakage_bound (BVHParams members the C++ struct has)
     # as keywords, attributes and in its repr. Every attribute of CloudModelParams and
     # CollisionRequest is now a keyword of its constructor and named in its repr, which builds it
-    # back; the two noise_resolution_gate views are the only ones left out (derived, not members).
-    derived = {"noise_resolution_gated", "noise_resolution_whole_cloud"}
+    # back; the two noise_resolution_gate views and the applied radius are the only ones left out
+    # (derived, not members).
+    derived = {"noise_resolution_gated", "noise_resolution_whole_cloud", "noise_resolution_applied"}
     scope = {"CloudModelParams": pc.CloudModelParams, "CollisionRequest": pc.CollisionRequest,
              "SensorNoiseModel": pc.SensorNoiseModel, "NormalOrientation": pc.NormalOrientation,
              "TraversalMode": pc.TraversalMode, "ClassifierParams": pc.ClassifierParams,

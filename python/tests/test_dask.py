@@ -631,7 +631,7 @@ def test_cli_shows_progress_on_a_terminal_only(tmp_path, table_points):
 
 def test_options_that_would_change_nothing_are_refused_as_pcd_collision_refuses_them(tmp_path, capsys):
     """A probe (2026-12-03) found -mesh_density accepted with two clouds and -noise_resolution_gate
-    without -noise_resolution, both changing nothing; pcd_collision refuses them now, and so does
+    where nothing merges (now -noise_resolution 0, or -surface without a radius), both changing nothing; pcd_collision refuses them now, and so does
     this layer, by the same rules (its parser; inputKindsUsageError once the inputs are read) in the
     same words, before the scheduler is reached."""
     from pcl_probcollision.dask import cli
@@ -649,7 +649,15 @@ def test_options_that_would_change_nothing_are_refused_as_pcd_collision_refuses_
     with pytest.raises(ValueError, match=r"^option mesh_density: neither input is a mesh \(both are point clouds"):
         pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), mesh_density=0.01)
     with pytest.raises(ValueError, match=r"^option noise_resolution_gate needs noise_resolution C > 0"):
-        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution_gate="spacing")
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), surface=True, noise_resolution_gate="spacing")
+    with pytest.raises(ValueError, match=r"^option noise_resolution_gate needs noise_resolution C > 0"):
+        pcd.collide_poses(patch(), patch(), np.zeros((1, 6)), noise_resolution=0, noise_resolution_gate="spacing")
+    # The default radius merges without -surface, so a gate given alone is passed on, not dropped.
+    from pcl_probcollision import dask as pdask
+    o = pdask.resolve_options({"noise_resolution_gate": "everywhere"})
+    assert pdask.model_params(o, "b", exact=False).noise_resolution_gate == "everywhere"
+    assert pdask.model_params(o, "b", exact=False).noise_resolution_applied == 2.0
+    assert pdask.model_params(pdask.resolve_options({}), "b", exact=False).noise_resolution_gate == "cloud"
     # A mesh among the inputs takes the spacing; merging takes its gate.
     r = pcd.collide_poses(str(DATA / "gripper.obj"), patch(), np.array([[0, 0, 1, 0, 0, 0]]), mesh_density=0.01)
     assert r.inputs[0]["spacing"] == 0.01
@@ -711,7 +719,8 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
                ["-max_leaf_fits", "-1"], ["-noise_stop", "1e999"], ["-noise_resolution", "-1"], ["-mesh_density", "0"],
                ["-sensor", "bogus"], ["-sensor", "kinect", "-sigma", "0.01"], ["-closed"], ["-orientation", "propagate"],
                ["-surface_pooled", "-surface_ladder"], ["-sigma_max", "-1"], ["-split", "kd"],
-               ["-noise_resolution_gate", "x"], ["-noise_resolution_gate", "cloud"], ["-stochastic", "-deterministic"],
+               ["-noise_resolution_gate", "x"], ["-surface", "-noise_resolution_gate", "cloud"],
+               ["-noise_resolution", "0", "-noise_resolution_gate", "cloud"], ["-stochastic", "-deterministic"],
                ["-surface_calibrated"],
                ["-sigma=0.01", "-sigma", "0.02"], ["-json=1"], ["-bogus", "1"], ["-sigma"]]
     for bad in refused:

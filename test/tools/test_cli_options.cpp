@@ -62,7 +62,11 @@ TEST (CliOptions, Defaults)
   EXPECT_FALSE (o.exhaustive);
   EXPECT_FALSE (o.surface);
   EXPECT_EQ (o.max_leaf_fits, 0u);        // no cap
-  EXPECT_EQ (o.noise_resolution, 0.0);    // no merging
+  // The library's default merge radius: 2 noise sigmas without -surface, none with it.
+  EXPECT_FALSE (o.noise_resolution.has_value ());
+  EXPECT_EQ (modelParamsFor (o, true).noiseResolution (), 2.0);
+  EXPECT_EQ (modelParamsFor (parse ({"-surface"}).options, true).noiseResolution (), 0.0);
+  EXPECT_EQ (modelParamsFor (parse ({"-surface_ladder", "-noise_resolution", "2"}).options, false).noiseResolution (), 2.0);
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);
@@ -186,14 +190,18 @@ TEST (CliOptions, OrientationSetsEachInputsSurfaceOrientation)
 
 // Options that would change nothing are refused, as conflicting ones are (found by a probe,
 // 2026-12-03): -noise_resolution_gate says where -noise_resolution merges, so without merging
-// (no -noise_resolution, or 0) it was accepted and ignored; -mesh_density sets a mesh's sample
-// spacing, so with two clouds it was too. The gate is judged by the parser; the inputs' kinds
-// once they are known (a .ply is a mesh or, without faces, a cloud), by inputKindsUsageError.
+// (-noise_resolution 0, or -surface without a radius) it was accepted and ignored; -mesh_density
+// sets a mesh's sample spacing, so with two clouds it was too. The gate is judged by the parser;
+// the inputs' kinds once they are known (a .ply is a mesh or, without faces, a cloud), by
+// inputKindsUsageError.
 TEST (CliOptions, OptionsThatWouldChangeNothingAreRefused)
 {
-  expectUsageError ({"-noise_resolution_gate", "spacing"},
+  expectUsageError ({"-surface", "-noise_resolution_gate", "spacing"},
                     "option -noise_resolution_gate needs -noise_resolution C > 0: it says where merging applies");
   expectUsageError ({"-noise_resolution", "0", "-noise_resolution_gate", "everywhere"}, "-noise_resolution_gate needs");
+  // Without -surface the default radius merges, so the gate says where.
+  EXPECT_EQ (parse ({"-noise_resolution_gate", "spacing"}).kind, Kind::Run);
+  EXPECT_EQ (parse ({"-surface", "-noise_resolution", "2", "-noise_resolution_gate", "spacing"}).kind, Kind::Run);
   EXPECT_EQ (parse ({"-noise_resolution", "0.5", "-noise_resolution_gate", "cloud"}).kind, Kind::Run);
   EXPECT_EQ (parse ({"-noise_resolution", "0"}).kind, Kind::Run);  // "never merge", said explicitly
 

@@ -1321,8 +1321,10 @@ TEST_F (PcdCollisionTool, OptionsThatWouldChangeNothingAreUsageErrors)
     EXPECT_EQ (r.status, 0) << r.err;
     EXPECT_NE (r.err.find ("at spacing 0.01, -mesh_density"), std::string::npos) << r.err;
   }
-  expectFailure ({kGripper.string (), kScene.string (), "-noise_resolution_gate", "everywhere"}, 2,
+  expectFailure ({kGripper.string (), kScene.string (), "-surface", "-noise_resolution_gate", "everywhere"}, 2,
                  "option -noise_resolution_gate needs -noise_resolution C > 0");
+  expectFailure ({kGripper.string (), kScene.string (), "-noise_resolution", "0", "-noise_resolution_gate", "everywhere"},
+                 2, "option -noise_resolution_gate needs -noise_resolution C > 0");
   const ToolRun gated = run ({kGripper.string (), kScene.string (), "-noise_resolution", "2", "-noise_resolution_gate",
                               "everywhere", "-pose", "0,0,1,0,0,0"});
   EXPECT_EQ (gated.status, 0) << gated.err;

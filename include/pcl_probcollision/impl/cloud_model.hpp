@@ -168,7 +168,11 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   const auto mergedModel = [&] (int gate_k) -> std::shared_ptr<const CloudModel> {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noise_resolution, gate_k, merged, cluster_of, seeds))
+    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noiseResolution (), gate_k, merged, cluster_of, seeds))
+      return nullptr;
+    // The default radius leaves an object smaller than its noise unmerged: its merge would keep no
+    // more points than k, which no longer resolve its shape (a radius given says so in a warning).
+    if (!params.noise_resolution && merged.size () <= static_cast<std::size_t> (std::max (params.k, 1)))
       return nullptr;
     CloudModelParams once = params;
     once.noise_resolution = 0.0;
@@ -179,7 +183,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
     return model;
   };
   using Gate = CloudModelParams::ResolutionGate;
-  const bool merging = params.noise_resolution > 0.0 && !covariances;
+  const bool merging = params.noiseResolution () > 0.0 && !covariances;
   // The whole-cloud gate reads the covariance estimation's neighbour radii (below) and decides
   // there; the other gates merge first.
   // The merged model, when samples merge; with keep_full_resolution the unmerged one is built

@@ -58,7 +58,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "defer_kernel_fits": _REQUEST.defer_kernel_fits,
     # At most this many leaf pairs tested a query, nearest first (0: no cap).
     "max_leaf_fits": _REQUEST.max_leaf_fits,
-    # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none).
+    # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none;
+    # None: CloudModelParams' default, 2 without the surface layer and 0 with it).
     "noise_resolution": _MODEL.noise_resolution,
     # Where it merges (pcd_collision's -noise_resolution_gate): everywhere, spacing (only samples
     # spaced closer than their noise) or cloud (a whole cloud sampled finer than its noise).
@@ -186,9 +187,10 @@ _NOT_PARAMS = {"sensor", "sensor_a", "sensor_b", "sigma", "sigma_a", "sigma_b", 
 
 def _params(o: Dict[str, Any]):
     """pcd_collision's modelParamsFor (<a>, <b>) and requestFor of resolved options (the merging's
-    gate only where it merges: pcd_collision refuses -noise_resolution_gate without it)."""
+    gate only when not the default: pcd_collision refuses -noise_resolution_gate where nothing
+    merges, and resolve_options has let a given one through its parser)."""
     given = {k: v for k, v in o.items() if k not in _NOT_PARAMS and (o["surface"] or not k.startswith("orientation"))
-             and (o["noise_resolution"] or k != "noise_resolution_gate")}
+             and (k != "noise_resolution_gate" or v != DEFAULT_OPTIONS[k])}
     return core.pcd_collision_params(_as_flags(given))
 
 
