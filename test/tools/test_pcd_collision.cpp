@@ -754,6 +754,23 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
              std::string::npos)
       << told.err;
   EXPECT_EQ (told.err.find ("samples merged"), told.err.rfind ("samples merged")) << "only the table merges: " << told.err;
+  // Without -noise_resolution the default radius applies: 2 sigmas (the table merged at 8 mm as
+  // above, the same points), none with -surface; the JSON gives the radius applied.
+  const auto by_default = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008"});
+  const auto told_json = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008",
+                                   "-noise_resolution", "2"});
+  ASSERT_EQ (by_default.size (), 1u);
+  ASSERT_EQ (told_json.size (), 1u);
+  EXPECT_EQ (by_default[0]["parameters"]["noise_resolution"].number, 2.0);
+  EXPECT_EQ (by_default[0]["points_b"].number, told_json[0]["points_b"].number);
+  EXPECT_LT (by_default[0]["points_b"].number, static_cast<double> (kScenePoints) / 2.0);
+  EXPECT_EQ (by_default[0]["probability"].number, told_json[0]["probability"].number);
+  const auto surface_default =
+      runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-sigma", "0.008", "-surface"});
+  ASSERT_EQ (surface_default.size (), 1u);
+  EXPECT_EQ (surface_default[0]["parameters"]["noise_resolution"].number, 0.0);
+  EXPECT_EQ (surface_default[0]["points_b"].number, static_cast<double> (kScenePoints));
+  EXPECT_EQ (surface_default[0]["inputs"]["b"]["merged_samples"].number, 0.0);
 
   // The demo's table is 5 mm noise on 3-4 mm spacing: at C = 20 most of it stays in whole nodes.
   const auto stopped = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-noise_stop", "20"});
