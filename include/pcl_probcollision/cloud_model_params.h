@@ -110,16 +110,17 @@ struct CloudModelParams
     * then estimated at the merged spacing; every merged sample reports its merged point's
     * per-point values. In noise standard deviations, >= 0; 0 merges nothing. Unset (the
     * default): noiseResolution() decides, kDefaultNoiseResolution (2) without the surface model
-    * and 0 with it, and a cloud whose merge would keep no more than k points (an object smaller
-    * than its noise) stays unmerged, where a radius given merges it with a warning. With the default noise_resolution_gate only a cloud sampled finer than its
-    * noise merges, and keep_full_resolution asks the unmerged models again where a merged answer
-    * leans to collision: on the evaluation's reported run (seed 1, 2026-12-05) the separators
-    * then answer at 0.25-1 % noise exactly as unmerged, and at 2-4 % gain easy answers in every
-    * cell with a lower Brier score and a worst query 2-20 times shorter. The surface layer on
+    * and 0 with it; a cloud the default would merge into no more than k points (an object
+    * smaller than its noise) stays unmerged, where a radius given merges it with a warning.
+    * With the default noise_resolution_gate only a cloud sampled finer than its noise merges,
+    * and keep_full_resolution asks the unmerged models again where a merged answer leans to
+    * collision. On the evaluation's reported run (seed 1, 2026-12-05) the separators then answer
+    * as unmerged at 0.25-1 % noise and, at 2-4 %, gain 12 easy answers and lose 1, with a lower
+    * Brier score in every cell and a worst query up to 11 times shorter. The surface layer on
     * merged models loses easy answers in the dense room at 2-4 % (docs/PERFORMANCE.md, "The
-    * whole-cloud merge as the separators' default"), so a model with the surface model merges only
-    * when asked. No effect without a noise model (noise None) or with covariances given by the
-    * caller. */
+    * whole-cloud merge as the separators' default"), so a model with the surface model merges
+    * only when asked. No effect without a noise model (noise None) or with covariances given by
+    * the caller. */
   std::optional<double> noise_resolution;
   /** \brief The merge radius of a model without the surface model when noise_resolution is
     * unset, in noise standard deviations: the evaluated choice (docs/PERFORMANCE.md, "The merge
