@@ -422,12 +422,20 @@ answersOnSharedBuild (const OursSetting& s, const pcl_probcollision::CloudModelP
          (m.noiseResolution () == 0.0 || m.noise_resolution_gate == shared.noise_resolution_gate);
 }
 
+/** \brief The shared build's model: the library's defaults with the surface model built. */
+pcl_probcollision::CloudModelParams
+sharedModel ()
+{
+  pcl_probcollision::CloudModelParams m = OursSetting ().model;
+  m.surface = true;
+  return m;
+}
+
 SharedBuild
 sharedBuild (const Options& o)
 {
   SharedBuild b;
-  b.model = OursSetting ().model;
-  b.model.surface = true;
+  b.model = sharedModel ();
   for (const OursSetting& s : oursSettings (false))
     if (answersOnSharedBuild (s, b.model) && o.keeps (s.name))
       b.settings.push_back (s);
@@ -444,9 +452,9 @@ std::vector<OursSetting>
 ownBuildSettings (const Options& o)
 {
   std::vector<OursSetting> out;
-  const SharedBuild shared = sharedBuild (o);
+  const pcl_probcollision::CloudModelParams shared = sharedModel ();
   for (const OursSetting& s : oursSettings (false, {}, {}, {}, {}, o.cloud_merge))
-    if ((((s.name == "default" || s.name == "classifier") && !answersOnSharedBuild (s, shared.model)) || s.name == "max" ||
+    if ((((s.name == "default" || s.name == "classifier") && !answersOnSharedBuild (s, shared)) || s.name == "max" ||
          s.name.rfind ("cloudmerge", 0) == 0 || s.name.rfind ("surface-cloudmerge", 0) == 0) &&
         o.keeps (s.name))
       out.push_back (s);
