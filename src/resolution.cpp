@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 
 namespace pcl_probcollision
@@ -22,14 +23,69 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
   out.cluster_of.assign (n, -1);
   if (n == 0)
     return out;
-  const auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>> ();
-  cloud->resize (n);
+  // A uniform grid of cells at least the largest radius wide, so that a search visits three or
+  // four cells along each axis. Cells are numbered as in a dense grid over the bounding box,
+  // wrapped onto 2n to 4n buckets: neighbouring cells stay close in memory (a k-d tree's radius
+  // searches cost 5 times as much on 5,000,000 points, docs/PERFORMANCE.md), and two cells that
+  // share a bucket only cost distance tests.
+  float largest = 0.0f;
+  Eigen::Vector3f lo = positions[0], hi = positions[0];
   for (std::size_t i = 0; i < n; ++i)
-    (*cloud)[i].getVector3fMap () = positions[i];
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree (false);  // unsorted: the order of a search plays no part
-  tree.setInputCloud (cloud);
-  pcl::Indices found;
-  std::vector<float> distances;
+  {
+    largest = std::max (largest, radii[i]);
+    lo = lo.cwiseMin (positions[i]);
+    hi = hi.cwiseMax (positions[i]);
+  }
+  if (!(largest > 0.0f))
+  {
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      out.cluster_of[i] = static_cast<int> (i);
+      out.seeds.push_back (static_cast<int> (i));
+    }
+    return out;
+  }
+  const double extent = (hi - lo).cast<double> ().maxCoeff ();
+  const double inverse = 1.0 / std::max (static_cast<double> (largest), 1e-9 * extent);
+  const auto cell = [&] (double v, int axis) {
+    return static_cast<std::uint64_t> ((std::clamp (v, double (lo[axis]), double (hi[axis])) - lo[axis]) * inverse);
+  };
+  const std::uint64_t nx = cell (hi.x (), 0) + 1, ny = cell (hi.y (), 1) + 1;
+  std::size_t buckets = 1;
+  while (buckets < 2 * n)
+    buckets <<= 1;
+  const std::uint64_t mask = buckets - 1;  // unsigned arithmetic wraps: any cell has a bucket
+  const auto bucketOf = [&] (std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+    return static_cast<std::size_t> ((x + nx * (y + ny * z)) & mask);
+  };
+
+  // Counting sort into buckets; each bucket keeps its samples' positions, and whether each is
+  // still free to join a cluster, side by side.
+  std::vector<std::uint32_t> first (buckets + 1, 0), bucket (n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Eigen::Vector3f& p = positions[i];
+    bucket[i] = static_cast<std::uint32_t> (bucketOf (cell (p.x (), 0), cell (p.y (), 1), cell (p.z (), 2)));
+    ++first[bucket[i] + 1];
+  }
+  for (std::size_t b = 0; b < buckets; ++b)
+    first[b + 1] += first[b];
+  std::vector<std::uint32_t> member (n), slot (n);
+  std::vector<Eigen::Vector3f> member_position (n);
+  std::vector<char> free_to_join (n, 1);
+  {
+    std::vector<std::uint32_t> next (first.begin (), first.end () - 1);
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      const std::uint32_t s = next[bucket[i]]++;
+      member[s] = static_cast<std::uint32_t> (i);
+      member_position[s] = positions[i];
+      slot[i] = s;
+      if (eligible)
+        free_to_join[s] = (*eligible)[i];
+    }
+  }
+
   for (std::size_t i = 0; i < n; ++i)
   {
     if (out.cluster_of[i] >= 0)
@@ -37,12 +93,43 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
     const int cluster = static_cast<int> (out.seeds.size ());
     out.seeds.push_back (static_cast<int> (i));
     out.cluster_of[i] = cluster;
-    if (!(radii[i] > 0.0f))
+    free_to_join[slot[i]] = 0;
+    const float r = radii[i];
+    if (!(r > 0.0f))
       continue;
-    tree.radiusSearch ((*cloud)[i], static_cast<double> (radii[i]), found, distances);
-    for (const int j : found)
-      if (out.cluster_of[static_cast<std::size_t> (j)] < 0 && (!eligible || (*eligible)[static_cast<std::size_t> (j)]))
-        out.cluster_of[static_cast<std::size_t> (j)] = cluster;
+    // FLANN's radius test (pcl::KdTreeFLANN::radiusSearch, L2_Simple): the squared distance
+    // summed in float, strictly below the squared radius rounded to float.
+    const float squared = static_cast<float> (static_cast<double> (r) * r);
+    const Eigen::Vector3f& q = positions[i];
+    // The cells searched reach a little past r: a float distance can round below it.
+    const double reach = 1.00001 * r;
+    std::uint64_t from[3], to[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      from[axis] = cell (q[axis] - reach, axis);
+      to[axis] = cell (q[axis] + reach, axis);
+    }
+    for (std::uint64_t z = from[2]; z <= to[2]; ++z)
+      for (std::uint64_t y = from[1]; y <= to[1]; ++y)
+        for (std::uint64_t x = from[0]; x <= to[0]; ++x)
+        {
+          const std::size_t b = bucketOf (x, y, z);
+          for (std::uint32_t s = first[b]; s < first[b + 1]; ++s)
+          {
+            if (!free_to_join[s])
+              continue;
+            const Eigen::Vector3f& p = member_position[s];
+            const float dx = q.x () - p.x (), dy = q.y () - p.y (), dz = q.z () - p.z ();
+            float distance = dx * dx;
+            distance += dy * dy;
+            distance += dz * dz;
+            if (distance < squared)
+            {
+              out.cluster_of[member[s]] = cluster;
+              free_to_join[s] = 0;
+            }
+          }
+        }
   }
   return out;
 }

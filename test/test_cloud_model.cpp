@@ -748,6 +748,83 @@ gated (double sigma, double factor,
 }
 } // namespace
 
+namespace
+{
+/** The greedy clustering noiseClusters() documents, tested against every other sample: the
+  * squared distance summed in float, strictly below the squared radius rounded to float. */
+detail::NoiseClusters
+bruteForceClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii,
+                    const std::vector<char>* eligible)
+{
+  detail::NoiseClusters out;
+  out.cluster_of.assign (positions.size (), -1);
+  for (std::size_t i = 0; i < positions.size (); ++i)
+  {
+    if (out.cluster_of[i] >= 0)
+      continue;
+    const int cluster = static_cast<int> (out.seeds.size ());
+    out.seeds.push_back (static_cast<int> (i));
+    out.cluster_of[i] = cluster;
+    const float squared = static_cast<float> (static_cast<double> (radii[i]) * radii[i]);
+    for (std::size_t j = 0; j < positions.size () && radii[i] > 0.0f; ++j)
+    {
+      const Eigen::Vector3f d = positions[i] - positions[j];
+      float distance = d.x () * d.x ();
+      distance += d.y () * d.y ();
+      distance += d.z () * d.z ();
+      if (out.cluster_of[j] < 0 && (!eligible || (*eligible)[j]) && distance < squared)
+        out.cluster_of[j] = cluster;
+    }
+  }
+  return out;
+}
+} // namespace
+
+TEST (NoiseResolution, ClustersAreTheGreedyRadiusSearchesInSampleOrder)
+{
+  std::mt19937 rng (7);
+  std::uniform_real_distribution<float> unit (0.0f, 1.0f);
+  const auto check = [&] (const std::vector<Eigen::Vector3f>& positions, const std::vector<float>& radii,
+                          const std::vector<char>* eligible, const char* what) {
+    SCOPED_TRACE (what);
+    const detail::NoiseClusters expected = bruteForceClusters (positions, radii, eligible);
+    const detail::NoiseClusters got = detail::noiseClusters (positions, radii, eligible);
+    EXPECT_EQ (got.cluster_of, expected.cluster_of);
+    EXPECT_EQ (got.seeds, expected.seeds);
+    EXPECT_TRUE (expected.merged ());  // each case merges something
+  };
+  // A noisy sheet, radii varying fourfold.
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<float> radii;
+  for (const auto& p : *sheet (0.2, 0.004, 0.002, 3))
+  {
+    positions.push_back (p.getVector3fMap ());
+    radii.push_back (0.004f + 0.012f * unit (rng));
+  }
+  check (positions, radii, nullptr, "noisy sheet");
+  // Half of it eligible to join another's cluster (ResolutionGate::WhereNoiseExceedsSpacing).
+  std::vector<char> eligible (positions.size ());
+  for (std::size_t i = 0; i < positions.size (); ++i)
+    eligible[i] = unit (rng) < 0.5f;
+  check (positions, radii, &eligible, "half eligible");
+  // An exact grid whose neighbours lie exactly at the radius: ties are left out.
+  const Cloud::Ptr grid = sheet (0.1, 0.005, 0.0, 1);
+  positions.clear ();
+  for (const auto& p : *grid)
+    positions.push_back (p.getVector3fMap ());
+  check (positions, std::vector<float> (positions.size (), 0.01f), nullptr, "exact grid");
+  // Repeated samples, and a sample a kilometre away (the grid's cells wrap onto its buckets).
+  positions.push_back (positions[5]);
+  positions.push_back (positions[5]);
+  positions.push_back (Eigen::Vector3f (1000.0f, -700.0f, 3.0f));
+  positions.push_back (Eigen::Vector3f (1000.0f, -700.0f, 3.001f));
+  check (positions, std::vector<float> (positions.size (), 0.012f), nullptr, "duplicates and a far sample");
+  // No radius: every sample its own cluster.
+  const detail::NoiseClusters none = detail::noiseClusters (positions, std::vector<float> (positions.size (), 0.0f));
+  EXPECT_FALSE (none.merged ());
+  EXPECT_EQ (none.seeds.size (), positions.size ());
+}
+
 TEST (NoiseResolutionGate, LocalSpacingOfAGridIsItsSpacing)
 {
   // A 41 x 41 grid, h = 5 mm: the 10th neighbour of an inner sample is at 2 h, so its spacing

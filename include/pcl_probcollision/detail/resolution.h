@@ -26,9 +26,11 @@ struct NoiseClusters
 
 /** \brief Greedy clustering of samples closer than their noise (CloudModelParams::noise_resolution):
   * samples are visited in the order given; each one not yet in a cluster seeds a new cluster
-  * and takes every sample not yet in a cluster within radii[seed] of it (k-d tree radius
-  * search, pcl::KdTreeFLANN). Serial, so the result depends only on the input (not on threads),
-  * and invariant under rigid motion of the samples.
+  * and takes every sample not yet in a cluster within radii[seed] of it: squared distance
+  * summed in float, strictly below the squared radius rounded to float, as
+  * pcl::KdTreeFLANN::radiusSearch tests it. The search is a uniform grid of cells the largest
+  * radius wide (linear time and memory). Serial, so the result depends only on the input (not on
+  * threads), and invariant under rigid motion of the samples up to float rounding.
   * \param[in] positions the samples (finite)
   * \param[in] radii per sample, the merge radius when it seeds a cluster (0: it merges nothing)
   * \param[in] eligible per sample, whether it may join another's cluster (nullptr: every one;

@@ -75,9 +75,13 @@ mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
     spacing = localSpacing (positions, gate_k);
     eligible.assign (positions.size (), 0);
   }
+  // A model without a sensor pose has one covariance everywhere: one eigen solve, not one per
+  // sample (0.2 s serial on 5,000,000 points).
+  const bool uniform = !noise.usesSensorPose ();
+  const double uniform_deviation = uniform ? smallestDeviation (noise, Eigen::Vector3d::Zero (), sensor) : 0.0;
   for (std::size_t p = 0; p < positions.size (); ++p)
   {
-    const double deviation = smallestDeviation (noise, positions[p].cast<double> (), sensor);
+    const double deviation = uniform ? uniform_deviation : smallestDeviation (noise, positions[p].cast<double> (), sensor);
     if (gate_k > 0)
     {
       // The gate: the noise at least the local spacing (a sample spaced wider never merges).
