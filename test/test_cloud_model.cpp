@@ -796,7 +796,8 @@ TEST (NoiseResolution, ClustersAreTheGreedyRadiusSearchesInSampleOrder)
   // A noisy sheet, radii varying fourfold.
   std::vector<Eigen::Vector3f> positions;
   std::vector<float> radii;
-  for (const auto& p : *sheet (0.2, 0.004, 0.002, 3))
+  const Cloud::Ptr noisy = sheet (0.2, 0.004, 0.002, 3);  // named: a temporary would die before the loop
+  for (const auto& p : *noisy)
   {
     positions.push_back (p.getVector3fMap ());
     radii.push_back (0.004f + 0.012f * unit (rng));
