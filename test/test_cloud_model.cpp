@@ -946,6 +946,12 @@ TEST (NoiseResolutionGate, DeterministicAndIndependentOfThreads)
     ASSERT_GT (x->mergedSamples (), 0u);
     EXPECT_EQ (x->pointOfSource (), y->pointOfSource ());
     EXPECT_EQ (x->hierarchy ().means (), y->hierarchy ().means ());
+    // The full-resolution rung, which the whole-cloud gate builds beside the merged model with
+    // two threads and after it with one.
+    ASSERT_NE (x->fullResolution (), nullptr);
+    ASSERT_NE (y->fullResolution (), nullptr);
+    EXPECT_EQ (x->fullResolution ()->hierarchy ().means (), y->fullResolution ()->hierarchy ().means ());
+    EXPECT_EQ (x->fullResolution ()->hierarchy ().nodes ().size (), y->fullResolution ()->hierarchy ().nodes ().size ());
   }
 }
 

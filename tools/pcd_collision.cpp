@@ -139,6 +139,19 @@ loadInput (Input& in, bool with_normals, FILE* log)
   }
 }
 
+/** \brief A cloud's median nearest-neighbour spacing (io::medianSpacing's number), read from its
+  * model's neighbour search where the build measured it, a merged model's from its full-resolution
+  * rung (the same cloud, searched whole); else (no model, or none that searched the whole cloud)
+  * measured here with a k-d tree of its own, 0.8 s at 5,000,000 points. */
+double
+cloudSpacing (const pcl_probcollision::CloudModel* model, const Cloud& cloud)
+{
+  double spacing = model ? model->medianNeighbourSpacing () : std::numeric_limits<double>::quiet_NaN ();
+  if (std::isnan (spacing) && model && model->fullResolution ())
+    spacing = model->fullResolution ()->medianNeighbourSpacing ();
+  return std::isnan (spacing) ? medianSpacing (cloud) : spacing;
+}
+
 void
 sampleInput (Input& in, double spacing, const std::string& source, FILE* log)
 {
@@ -600,21 +613,20 @@ run (int argc, char** argv)
     {
       // The other cloud's early build measured it; a build that failed is left to compute(),
       // which reports its error, and the spacing is then measured here.
-      double spacing = std::numeric_limits<double>::quiet_NaN ();
+      pcl_probcollision::CloudModel::ConstPtr built;
       const auto& early = (m == &a) ? early_b : early_a;
       if (early.valid ())
       {
         try
         {
           const auto shown = ticker.show ("Building " + other.path);
-          spacing = early.get ()->medianNeighbourSpacing ();
+          built = early.get ();
         }
         catch (const pcl::PCLException&)
         {
         }
       }
-      if (std::isnan (spacing))
-        spacing = medianSpacing (*other.cloud);
+      const double spacing = cloudSpacing (built.get (), *other.cloud);
       sampleInput (*m, spacing, "median nearest-neighbour spacing of '" + other.path + "'", log);
     }
     else
@@ -790,11 +802,7 @@ run (int argc, char** argv)
         const auto cloud_model = a.kind == InputKind::Mesh ? pc.getTargetModel () : pc.getInputModel ();
         if (free && result.leaf_pairs_tested > 0)
         {
-          // The build's neighbour search measured it; where it could not (merged samples), as the
-          // sampling measures it.
-          double spacing = cloud_model ? cloud_model->medianNeighbourSpacing () : std::nan ("");
-          if (std::isnan (spacing))
-            spacing = medianSpacing (*cloud.cloud);
+          const double spacing = cloudSpacing (cloud_model.get (), *cloud.cloud);
           warning = pcl_probcollision::io::coarseMeshWarning (free, result.leaf_pairs_tested, where, mesh.path, mesh.spacing,
                                                               spacing);
         }

@@ -102,8 +102,9 @@ public:
     * (detail::medianNearestSpacing), read from the covariance estimation's own neighbour search:
     * what pcd_collision samples a mesh at, without a second k-d tree over a large cloud. NaN
     * when the build did not search the whole cloud's neighbours (covariances given without the
-    * surface model, indices given, samples merged) or cannot tell (a sampled point with more
-    * than k coincident neighbours); the caller then measures it itself. */
+    * surface model, indices given, samples merged: fullResolution(), where kept, has the
+    * cloud's) or cannot tell (a sampled point with more than k coincident neighbours); the caller
+    * then measures it itself. */
   double medianNeighbourSpacing () const { return neighbour_spacing_; }
   /** \brief The oriented surface (METHOD.md 10a), in the local frame; empty() when built
     * with CloudModelParams::surface off. */

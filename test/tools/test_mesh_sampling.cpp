@@ -104,6 +104,28 @@ TEST (MedianSpacing, AModelThatCannotTellSaysSo)
   EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));
 }
 
+TEST (MedianSpacing, AMergedModelKeepsTheCloudsSpacingInItsFullResolutionRung)
+{
+  // The default whole-cloud gate merges a cloud sampled finer than its noise and keeps it
+  // unmerged beside (built on a thread of its own with two): pcd_collision reads the spacing
+  // there rather than search the cloud again. One thread builds the two in turn: the same.
+  const Cloud cloud = sheet (5000, 2);
+  const double io = pcl_probcollision::io::medianSpacing (cloud);
+  ASSERT_GT (io, 0.0);
+  for (const int threads : {1, 2})
+  {
+    pcl_probcollision::CloudModelParams params = noisyParams ();
+    params.noise = pcl_probcollision::SensorNoiseModel::isotropic (0.05);  // far above the spacing: samples merge
+    params.threads = threads;
+    const auto model = pcl_probcollision::buildCloudModel (cloud, params);
+    ASSERT_GT (model->mergedSamples (), 0u) << threads << " threads";
+    ASSERT_NE (model->fullResolution (), nullptr) << threads << " threads";
+    EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));
+    EXPECT_EQ (model->fullResolution ()->medianNeighbourSpacing (), io) << threads << " threads";
+    EXPECT_EQ (model->fullResolution ()->size () + model->fullResolution ()->skippedPoints (), cloud.size ());
+  }
+}
+
 // Without vertices the sampler gives its area samples alone, the same ones: the evaluation's
 // re-scans use it so that no sample sits at the same place in every re-scan.
 TEST (MeshSampling, WithoutVerticesGivesTheSameAreaSamples)
