@@ -20,6 +20,7 @@
 #include <future>
 #include <memory>
 #include <sstream>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -256,11 +257,21 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
             return merged_model;
         }
         else
+        {
           // The merged model reads nothing of the unmerged one: it is built beside it, on a
           // thread of its own where the build has more than one (its clustering is serial,
-          // 0.4 s of 5,000,000 points, and so are parts of the hierarchy's build).
-          merged_aside = std::async (detail::threadCount (params.threads) > 1 ? std::launch::async : std::launch::deferred,
-                                     mergedModel, 0);
+          // 0.4 s of 5,000,000 points, and so are parts of the hierarchy's build); after it
+          // where no thread can be started (as detail::parallelFor does).
+          const bool aside = detail::threadCount (params.threads) > 1;
+          try
+          {
+            merged_aside = std::async (aside ? std::launch::async : std::launch::deferred, mergedModel, 0);
+          }
+          catch (const std::system_error&)
+          {
+            merged_aside = std::async (std::launch::deferred, mergedModel, 0);
+          }
+        }
       }
     }
     displacements = estimation.getSurfaceDisplacements ();
