@@ -38,6 +38,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -204,6 +206,12 @@ measureBuild (benchmark::State& state, bool surface)
   double ms = 0.0;  // summed over the iterations
   double hierarchy_ms = 0.0;
   std::size_t bytes = 0, hierarchy_bytes = 0, surface_bytes = 0, stored = 0, nodes = 0;
+  const auto minorFaults = [] {
+    rusage usage {};
+    getrusage (RUSAGE_SELF, &usage);
+    return static_cast<double> (usage.ru_minflt);
+  };
+  const double faults_before = minorFaults ();
   for (auto _ : state)
   {
     const CloudModel::ConstPtr model = buildCloudModel (*room, params);
@@ -224,6 +232,8 @@ measureBuild (benchmark::State& state, bool surface)
   state.counters["build_ms"] = ms;
   state.counters["ms_per_10k_points"] = ms / n * 1e4;
   state.counters["hierarchy_ms"] = hierarchy_ms;
+  // First touches of fresh memory (minor page faults) per build: costly in a virtual machine.
+  state.counters["page_faults"] = (minorFaults () - faults_before) / runs;
   state.counters["bytes_per_point"] = static_cast<double> (bytes) / n;
   // Where they are: the hierarchy (points, covariances, nodes, indices) and the surface model.
   state.counters["hierarchy_bytes_per_point"] = static_cast<double> (hierarchy_bytes) / n;

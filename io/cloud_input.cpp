@@ -2,6 +2,8 @@
 #include "cloud_input.h"
 #include "quiet_pcl_console.h"
 
+#include <pcl_probcollision/detail/huge_pages.h>
+
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
 #include <pcl/conversions.h>
@@ -639,6 +641,7 @@ template <typename PointT>
 void
 copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud, XyzRounding* rounding)
 {
+  pcl_probcollision::detail::reserveHugePages (cloud.points, file.size);
   cloud.resize (file.size);
   XyzRounding cost;
   for (std::size_t j = 0; j < file.size; ++j)
@@ -693,6 +696,8 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
   CloudFile file;
   if (!readCloudFile (path, false, file, error))
     return false;
+  // fromPCLPointCloud2 resizes the cloud to width x height.
+  pcl_probcollision::detail::reserveHugePages (cloud.points, std::size_t{file.blob.width} * file.blob.height);
   if (xyzAreFloat (file))
     pcl::fromPCLPointCloud2 (file.blob, cloud);
   else

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/impl/cloud_model.hpp>
+#include <pcl_probcollision/detail/huge_pages.h>
 
 #include <pcl/exceptions.h>
 #include <pcl/point_types.h>
@@ -125,7 +126,7 @@ CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size,
   std::vector<int> point_of_merged (seeds.size (), -1);
   for (std::size_t j = 0; j < bvh_.size (); ++j)
     point_of_merged[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
-  point_of_source_.assign (source_size, -1);
+  detail::assignHugePages (point_of_source_, source_size, -1);
   std::size_t mapped = 0;
   for (std::size_t i = 0; i < cluster_of.size () && i < source_size; ++i)
     if (cluster_of[i] >= 0 && point_of_merged[static_cast<std::size_t> (cluster_of[i])] >= 0)

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/detail/resolution.h>
+#include <pcl_probcollision/detail/huge_pages.h>
 
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
@@ -20,7 +21,7 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
 {
   NoiseClusters out;
   const std::size_t n = positions.size ();
-  out.cluster_of.assign (n, -1);
+  assignHugePages (out.cluster_of, n, -1);
   if (n == 0)
     return out;
   // A uniform grid of cells at least the largest radius wide, so that a search visits three or
@@ -61,7 +62,9 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
 
   // Counting sort into buckets; each bucket keeps its samples' positions, and whether each is
   // still free to join a cluster, side by side.
-  std::vector<std::uint32_t> first (buckets + 1, 0), bucket (n);
+  std::vector<std::uint32_t> first, bucket;
+  assignHugePages (first, buckets + 1, 0u);
+  resizeHugePages (bucket, n);
   for (std::size_t i = 0; i < n; ++i)
   {
     const Eigen::Vector3f& p = positions[i];
@@ -70,11 +73,17 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
   }
   for (std::size_t b = 0; b < buckets; ++b)
     first[b + 1] += first[b];
-  std::vector<std::uint32_t> member (n), slot (n);
-  std::vector<Eigen::Vector3f> member_position (n);
-  std::vector<char> free_to_join (n, 1);
+  std::vector<std::uint32_t> member, slot;
+  resizeHugePages (member, n);
+  resizeHugePages (slot, n);
+  std::vector<Eigen::Vector3f> member_position;
+  resizeHugePages (member_position, n);
+  std::vector<char> free_to_join;
+  assignHugePages (free_to_join, n, char{1});
   {
-    std::vector<std::uint32_t> next (first.begin (), first.end () - 1);
+    std::vector<std::uint32_t> next;
+    reserveHugePages (next, buckets);
+    next.assign (first.begin (), first.end () - 1);
     for (std::size_t i = 0; i < n; ++i)
     {
       const std::uint32_t s = next[bucket[i]]++;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+using pcl_probcollision::detail::cheapChunk;
 using pcl_probcollision::detail::parallelFor;
 using pcl_probcollision::detail::threadCount;
 
@@ -19,6 +20,15 @@ TEST (Parallel, ThreadCountReadsZeroAsEveryCore)
   EXPECT_EQ (threadCount (3), 3u);
   EXPECT_EQ (threadCount (1024), 1024u);
   EXPECT_EQ (threadCount (2147483647), 1024u);  // capped: per-worker scratch is allocated up front
+}
+
+TEST (Parallel, CheapChunksGiveEveryWorkerRangesWithinBounds)
+{
+  // 50,000 points on two threads: eight ranges, not one (it was one range of 65,536).
+  EXPECT_EQ (cheapChunk (50000, 2), 6250u);
+  EXPECT_EQ (cheapChunk (1000, 2), 4096u);          // at least 4,096 items a range
+  EXPECT_EQ (cheapChunk (5000000, 2), 65536u);      // at most 65,536
+  EXPECT_EQ (cheapChunk (50000, 0), cheapChunk (50000, 1));  // no worker reads as one
 }
 
 TEST (Parallel, EveryItemRunsOnceOnAWorkerInRange)

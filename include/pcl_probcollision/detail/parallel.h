@@ -106,6 +106,17 @@ parallelFor (std::size_t count, std::size_t workers, Task&& task)
     std::rethrow_exception (errors[first]);
 }
 
+/** \brief The range size for parallelChunks() over `count` cheap items on `workers`: about four
+  * ranges a worker, so that a cloud of 50,000 points is not one range on one thread (a fixed
+  * 65,536 left the second thread idle there), but at least 4,096 items (a range must outweigh a
+  * hand-out) and at most 65,536. */
+inline std::size_t
+cheapChunk (std::size_t count, std::size_t workers)
+{
+  const std::size_t ranges = 4 * std::max<std::size_t> (workers, 1);
+  return std::min<std::size_t> (65536, std::max<std::size_t> (4096, (count + ranges - 1) / ranges));
+}
+
 /** \brief task(c, begin, end) for the consecutive ranges [begin, end) of `chunk` items (the last
   * one shorter) that cover [0, count), c the range's number, on parallelFor's workers: for loops
   * over many cheap items, where one item is not worth handing out alone. */

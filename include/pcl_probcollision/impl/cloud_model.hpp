@@ -3,6 +3,7 @@
 
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/detail/huge_pages.h>
 #include <pcl_probcollision/detail/input_checks.h>
 #include <pcl_probcollision/detail/parallel.h>
 #include <pcl_probcollision/detail/sample_spacing.h>
@@ -235,18 +236,24 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
         all_given = !pcl::isXYZFinite (cloud[at (j)]) || usableNormal (cloud[at (j)]);
       estimation.setComputeNormals (!all_given);
     }
+    detail::reserveHugePages (estimated.points, n);  // compute() resizes it to n
     estimation.compute (estimated);
-    radii = estimation.getNeighbourRadii ();
+    const auto copyOf = [] (const auto& from, auto& to) {  // on memory offered to huge pages
+      detail::reserveHugePages (to, from.size ());
+      to.assign (from.begin (), from.end ());
+    };
+    copyOf (estimation.getNeighbourRadii (), radii);
     // Sampled finer than its noise (ResolutionGate::WholeCloud): the merged cloud's model instead,
     // the estimation above spent once. A cloud sampled coarser goes on, modelled as unmerged.
     if (merging && params.noise_resolution_gate == Gate::WholeCloud)
     {
-      const SensorPose sensor = SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_);
+      const detail::SmallestDeviation smallestDeviation (
+          params.noise, SensorPose::fromViewpoint (cloud.sensor_origin_, cloud.sensor_orientation_));
       const auto deviation = [&] (std::size_t j) {
         const PointT& p = cloud[at (j)];
         if (!pcl::isXYZFinite (p))
           return std::numeric_limits<double>::quiet_NaN ();
-        return detail::smallestDeviation (params.noise, p.getVector3fMap ().template cast<double> (), sensor);
+        return smallestDeviation (p.getVector3fMap ().template cast<double> ());
       };
       if (!merged_model && detail::noiseExceedsTypicalSpacing (radii, params.k, deviation))
       {
@@ -274,9 +281,9 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
         }
       }
     }
-    displacements = estimation.getSurfaceDisplacements ();
-    normals = estimation.getNormals ();
-    neighbours = estimation.getNeighbours ();
+    copyOf (estimation.getSurfaceDisplacements (), displacements);
+    copyOf (estimation.getNormals (), normals);
+    copyOf (estimation.getNeighbours (), neighbours);
     // medianNeighbourSpacing(): io::medianSpacing's rule on the estimation's own search, whose
     // k-d tree holds the cloud's finite points in cloud order as medianSpacing's does, so that
     // the squared distances, and the number, are the same.
@@ -299,16 +306,17 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
 
   // The model's points: the finite ones with a finite covariance, in cloud order. Chunks count
   // theirs, then fill their own slots on the build's threads (5,000,000 points: 0.4 s serial).
+  // The slots do not depend on the ranges.
   const auto covarianceOf = [&] (std::size_t j) -> const Covariance& {
     static const Covariance kNaN = Covariance::nan ();
     return covariances ? (*covariances)[at (j)] : (estimated.size () == n ? estimated[j] : kNaN);
   };
   const auto kept = [&] (std::size_t j) { return pcl::isXYZFinite (cloud[at (j)]) && covarianceOf (j).isFinite (); };
-  constexpr std::size_t kChunk = 65536;
-  const std::size_t chunks = (n + kChunk - 1) / kChunk;
   const std::size_t workers = detail::threadCount (params.threads);
+  const std::size_t chunk = detail::cheapChunk (n, workers);
+  const std::size_t chunks = (n + chunk - 1) / chunk;
   std::vector<std::size_t> first (chunks + 1, 0);  // model slot of each chunk's first kept point
-  detail::parallelChunks (n, kChunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
+  detail::parallelChunks (n, chunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
     std::size_t count = 0;
     for (std::size_t j = begin; j < end; ++j)
       count += kept (j) ? 1 : 0;
@@ -319,14 +327,14 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   const std::size_t model_points = first[chunks];
   const std::size_t skipped = n - model_points;
   UncertainCloud points;
-  points.means.resize (model_points);
-  points.covariances.resize (model_points);
-  points.source_indices.resize (model_points);
+  detail::resizeHugePages (points.means, model_points);
+  detail::resizeHugePages (points.covariances, model_points);
+  detail::resizeHugePages (points.source_indices, model_points);
   const bool weights = !radii.empty () && !covariances;
   if (weights)
-    points.area_weights.resize (model_points);
+    detail::resizeHugePages (points.area_weights, model_points);
   std::vector<std::size_t> kept_slots (params.surface ? model_points : 0);  // estimation slot of each model point (surface model)
-  detail::parallelChunks (n, kChunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
+  detail::parallelChunks (n, chunk, workers, [&] (std::size_t c, std::size_t begin, std::size_t end) {
     std::size_t slot = first[c];
     for (std::size_t j = begin; j < end; ++j)
     {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <pcl_probcollision/covariance_estimation.h>
+#include <pcl_probcollision/detail/huge_pages.h>
 #include <pcl_probcollision/detail/parallel.h>
 
 #include <pcl/common/point_tests.h>
@@ -52,6 +53,9 @@ public:
     tree_.reset ();
     if (!cloud)
       return;
+    const std::size_t most = indices ? indices->size () : cloud->size ();
+    detail::reserveHugePages (xyz_, 3 * most);
+    detail::reserveHugePages (cloud_index_, most);
     const auto add = [this] (pcl::index_t i) {
       const PointT& p = (*this->input_)[i];
       if (!pcl::isXYZFinite (p))
@@ -223,7 +227,8 @@ zOrder (const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices)
     }
   constexpr double kCells = (1 << 21) - 1;
   const Eigen::Array3d scale = (hi > lo).select (kCells / (hi - lo), 0.0);
-  std::vector<std::pair<std::uint64_t, std::size_t>> keyed (indices.size ());
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed;
+  resizeHugePages (keyed, indices.size ());
   for (std::size_t j = 0; j < indices.size (); ++j)
   {
     std::uint64_t key = std::numeric_limits<std::uint64_t>::max ();
@@ -237,7 +242,8 @@ zOrder (const pcl::PointCloud<PointT>& cloud, const pcl::Indices& indices)
     keyed[j] = {key, j};
   }
   std::sort (keyed.begin (), keyed.end ());
-  std::vector<std::size_t> order (keyed.size ());
+  std::vector<std::size_t> order;
+  resizeHugePages (order, keyed.size ());
   std::transform (keyed.begin (), keyed.end (), order.begin (), [] (const auto& e) { return e.second; });
   return order;
 }
@@ -471,19 +477,19 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   for (const auto& p : surface.points)
     finite_surface += pcl::isXYZFinite (p) ? 1 : 0;
 
-  radii_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
-  nearest_sqr_.assign (indices.size (), std::numeric_limits<float>::quiet_NaN ());
+  detail::assignHugePages (radii_, indices.size (), std::numeric_limits<float>::quiet_NaN ());
+  detail::assignHugePages (nearest_sqr_, indices.size (), std::numeric_limits<float>::quiet_NaN ());
   normals_.clear ();
   neighbours_.clear ();
   const bool fit_normals = compute_surface_ && compute_normals_;
   if (compute_surface_)
   {
     if (fit_normals)
-      normals_.assign (indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
-    neighbours_.assign (indices.size () * static_cast<std::size_t> (this->k_), -1);
+      detail::assignHugePages (normals_, indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
+    detail::assignHugePages (neighbours_, indices.size () * static_cast<std::size_t> (this->k_), -1);
   }
   if (project_)
-    displacements_.assign (indices.size (), Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
+    detail::assignHugePages (displacements_, indices.size (), Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
   // Ask one more than k: the query itself comes back when it is part of the surface.
   const int k_ask = static_cast<int> (std::min<std::size_t> (this->k_ + 1, finite_surface));
   // Neighbours are searched a block of points at a time: one FLANN call per block, and the
