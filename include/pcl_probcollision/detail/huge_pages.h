@@ -53,6 +53,7 @@ reserveHugePages (Vector& v, std::size_t n)
   v.reserve (n);
   adviseHugePages (v.data (), v.capacity () * sizeof (typename Vector::value_type));
 }
+
 /** \brief v.resize(n) on memory offered to huge pages (reserveHugePages). */
 template <typename Vector>
 void
