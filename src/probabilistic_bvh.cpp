@@ -425,18 +425,25 @@ withinNoise (const NodeGeometry& g, double noise_stop, std::vector<double>& tmp)
 
 using Node = ProbabilisticBVH::Node;
 
-/** \brief What a worker reuses from node to node. */
 /** \brief Nodes to reserve for a subtree of m points, so that its node vector is allocated once:
   * builds made 0.32-0.46 nodes a point (the room sampled at 11,540 / 49,992 / 99,993 points:
   * 5,303 / 16,445 / 32,231 nodes). A vector grown by doubling touched about twice the memory it
-  * kept, and every first touch is a page fault (about 9 us in this project's VM; 200 of the 816
-  * faults of a 10,000-point build). Reserved memory never written is never touched. */
+  * kept, and every first touch is a page fault (about 11 us in this project's VMs, detail/
+  * huge_pages.h). Reserved memory never written is never touched. */
 std::size_t
 nodesToReserve (std::size_t m)
 {
   return m / 2 + 8;
 }
 
+/** \brief Point indices to reserve for a subtree of m points: a few percent are duplicated. */
+std::size_t
+indicesToReserve (std::size_t m)
+{
+  return m + m / 4 + 8;
+}
+
+/** \brief What a worker reuses from node to node. */
 struct NodeScratch
 {
   NodeGeometry g;
@@ -602,7 +609,7 @@ buildParts (const BuildPoints& points, const BVHParams& params, BuildTask root, 
   detail::parallelFor (wholes.size (), workers, [&] (std::size_t i, std::size_t w) {
     TopPart& part = parts[wholes[i]];
     detail::reserveHugePages (part.subtree.nodes, nodesToReserve (part.task.points.size ()));
-    detail::reserveHugePages (part.subtree.indices, part.task.points.size () + part.task.points.size () / 4 + 8);
+    detail::reserveHugePages (part.subtree.indices, indicesToReserve (part.task.points.size ()));
     part.subtree.nodes.emplace_back ();
     BuildTask task = std::move (part.task);
     task.node = 0;
@@ -751,9 +758,8 @@ ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& param
     }
     else
     {
-      // A few percent of duplicated indices.
       detail::reserveHugePages (tree.nodes, nodesToReserve (n));
-      detail::reserveHugePages (tree.indices, n + n / 4 + 8);
+      detail::reserveHugePages (tree.indices, indicesToReserve (n));
       tree.nodes.emplace_back ();
       NodeScratch scratch;
       buildSubtree (points, params, std::move (root), tree, scratch);
