@@ -62,7 +62,7 @@ CloudModel::CloudModel (UncertainCloud points, const BVHParams& hierarchy, std::
   }
   const auto start = std::chrono::steady_clock::now ();
   params_.hierarchy = hierarchy;
-  buildLocal (std::move (points), hierarchy, source_size);
+  buildLocal (std::move (points), {}, hierarchy, source_size);
   if (params_.surface)
     buildSurfaceFromPoints (params_.orientation, params_.k);
   build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
@@ -94,7 +94,8 @@ CloudModel::buildSurfaceFromPoints (NormalOrientation orientation, int k)
 }
 
 void
-CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size, int threads)
+CloudModel::buildLocal (UncertainCloud&& points, std::vector<PackedCovariance>&& packed, const BVHParams& hierarchy,
+                        std::size_t source_size, int threads)
 {
   if (source_size == 0)
   {
@@ -114,7 +115,10 @@ CloudModel::buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std
       m -= centroid;
     origin_ = centroid;
   }
-  bvh_.build (std::move (points), hierarchy, threads);
+  if (packed.empty ())
+    bvh_.build (std::move (points), hierarchy, threads);
+  else
+    bvh_.build (std::move (points), std::move (packed), hierarchy, threads);
   source_size_ = source_size;
 }
 

@@ -66,13 +66,16 @@ namespace
 // Largest accepted cloud: stored indices (with duplication) and node ranges are int32.
 constexpr std::size_t kMaxPoints = std::size_t (1) << 28;
 
+/** \brief Throws for what build() refuses. The covariances are counted by `covariances` and
+  * tested by finiteCovariance(i), wherever they are held (cloud.covariances, or packed). */
+template <typename FiniteCovariance>
 void
-validateCloud (const UncertainCloud& cloud)
+validateCloud (const UncertainCloud& cloud, std::size_t covariances, FiniteCovariance finiteCovariance)
 {
   const std::size_t n = cloud.means.size ();
-  if (cloud.covariances.size () != n)
+  if (covariances != n)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
-                         "[pcl_probcollision::ProbabilisticBVH::build] " << cloud.covariances.size ()
+                         "[pcl_probcollision::ProbabilisticBVH::build] " << covariances
                              << " covariances for " << n << " means");
   if (!cloud.area_weights.empty () && cloud.area_weights.size () != n)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
@@ -94,7 +97,7 @@ validateCloud (const UncertainCloud& cloud)
                            "[pcl_probcollision::ProbabilisticBVH::build] point "
                                << i << " has a non-finite mean (" << cloud.means[i].x () << ", "
                                << cloud.means[i].y () << ", " << cloud.means[i].z () << ")");
-    if (!cloud.covariances[i].allFinite ())
+    if (!finiteCovariance (i))
       PCL_THROW_EXCEPTION (pcl::BadArgumentException,
                            "[pcl_probcollision::ProbabilisticBVH::build] point "
                                << i << " has a non-finite covariance");
@@ -313,9 +316,10 @@ splitPca (const std::vector<int>& points, const NodeGeometry& g, double epsilon,
       continue;  // split without overlap
     // Every point is written to both children and kept where it belongs by advancing the
     // write position or not (no data-dependent branch); one spare slot takes the last writes.
+    // Fresh arrays (the last children were moved away): a top node's are large.
     children.resize (2);
-    children[0].resize (nl + 1);
-    children[1].resize (nr + 1);
+    detail::resizeHugePages (children[0], nl + 1);
+    detail::resizeHugePages (children[1], nr + 1);
     int* left = children[0].data ();
     int* right = children[1].data ();
     std::size_t il = 0, ir = 0;
@@ -702,6 +706,13 @@ checkedThreads (int threads, const char* where)
                                                                   << " must be >= 0 (0: one per hardware thread)");
   return detail::threadCount (threads);
 }
+
+/** \brief validateCloud() for covariances held in cloud.covariances. */
+void
+validateCloud (const UncertainCloud& cloud)
+{
+  validateCloud (cloud, cloud.covariances.size (), [&] (std::size_t i) { return cloud.covariances[i].allFinite (); });
+}
 } // namespace
 
 bool
@@ -710,7 +721,7 @@ ProbabilisticBVH::build (const UncertainCloud& cloud, const BVHParams& params, i
   params.validate ();
   const std::size_t workers = checkedThreads (threads, "build");
   validateCloud (cloud);
-  return buildValidated (UncertainCloud (cloud), params, workers);
+  return buildValidated (UncertainCloud (cloud), {}, params, workers);
 }
 
 bool
@@ -719,23 +730,43 @@ ProbabilisticBVH::build (UncertainCloud&& cloud, const BVHParams& params, int th
   params.validate ();
   const std::size_t workers = checkedThreads (threads, "build");
   validateCloud (cloud);
-  return buildValidated (std::move (cloud), params, workers);
+  return buildValidated (std::move (cloud), {}, params, workers);
 }
 
 bool
-ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers)
+ProbabilisticBVH::build (UncertainCloud&& cloud, std::vector<PackedCovariance>&& covariances, const BVHParams& params,
+                         int threads)
+{
+  params.validate ();
+  const std::size_t workers = checkedThreads (threads, "build");
+  if (!cloud.covariances.empty ())
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException,
+                         "[pcl_probcollision::ProbabilisticBVH::build] cloud.covariances holds "
+                             << cloud.covariances.size () << " covariances where they are given packed: it must be empty");
+  validateCloud (cloud, covariances.size (), [&] (std::size_t i) { return covariances[i].allFinite (); });
+  return buildValidated (std::move (cloud), std::move (covariances), params, workers);
+}
+
+bool
+ProbabilisticBVH::buildValidated (UncertainCloud&& cloud, std::vector<PackedCovariance>&& packed,
+                                  const BVHParams& params, std::size_t workers)
 {
   const auto t0 = std::chrono::steady_clock::now ();
   UncertainCloud copy = std::move (cloud);
   copy.means.shrink_to_fit ();
   copy.source_indices.shrink_to_fit ();
-  // Packed once, in chunks on the workers: the build reads the covariances the hierarchy keeps.
-  std::vector<PackedCovariance> covariances;
-  detail::resizeHugePages (covariances, copy.size ());
-  detail::parallelChunks (copy.size (), detail::cheapChunk (copy.size (), workers), workers, [&] (std::size_t, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
-      covariances[i] = PackedCovariance (copy.covariances[i]);
-  });
+  // The covariances the hierarchy keeps and the build reads: given packed, or packed here once,
+  // in chunks on the workers.
+  std::vector<PackedCovariance> covariances = std::move (packed);
+  if (covariances.size () != copy.size ())
+  {
+    detail::resizeHugePages (covariances, copy.size ());
+    detail::parallelChunks (copy.size (), detail::cheapChunk (copy.size (), workers), workers,
+                            [&] (std::size_t, std::size_t begin, std::size_t end) {
+                              for (std::size_t i = begin; i < end; ++i)
+                                covariances[i] = PackedCovariance (copy.covariances[i]);
+                            });
+  }
   copy.covariances = std::vector<Eigen::Matrix3d> ();
   const BuildPoints points {copy.means, covariances, copy.area_weights};
   Tree tree;

@@ -614,6 +614,56 @@ TEST (ProbabilisticBVH, MoveBuildAndUnionBound)
   EXPECT_GT (strictly, 0u);
 }
 
+// Covariances given packed (buildCloudModel's way) build the hierarchy the double ones build,
+// and are checked as they are.
+TEST (ProbabilisticBVH, PackedCovariancesBuildTheSameHierarchy)
+{
+  const UncertainCloud cloud = shapeCloud (Shape::Sphere, 20000, 94, 0.003);
+  const auto packedOf = [] (const UncertainCloud& c) {
+    std::vector<PackedCovariance> packed;
+    for (const Eigen::Matrix3d& s : c.covariances)
+      packed.emplace_back (s);
+    return packed;
+  };
+  const auto withoutCovariances = [] (UncertainCloud c) {
+    c.covariances.clear ();
+    return c;
+  };
+  for (const int threads : {1, 2})
+  {
+    const ProbabilisticBVH by_matrix (cloud, BVHParams (), threads);
+    ProbabilisticBVH by_packed;
+    ASSERT_TRUE (by_packed.build (withoutCovariances (cloud), packedOf (cloud), BVHParams (), threads));
+    ASSERT_EQ (by_packed.nodes ().size (), by_matrix.nodes ().size ());
+    EXPECT_EQ (differingNodes (by_matrix, by_packed), 0u) << "threads " << threads;
+    EXPECT_EQ (by_packed.pointIndices (), by_matrix.pointIndices ());
+    EXPECT_EQ (by_packed.means (), by_matrix.means ());
+    ASSERT_EQ (by_packed.covariances ().size (), cloud.size ());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < cloud.size (); ++i)
+      differing += by_packed.covariances ()[i].matrix () != by_matrix.covariances ()[i].matrix ();
+    EXPECT_EQ (differing, 0u);
+  }
+
+  ProbabilisticBVH bvh;
+  ASSERT_TRUE (bvh.build (shapeCloud (Shape::Box, 50, 1)));
+  const std::size_t nodes_before = bvh.nodes ().size ();
+  const UncertainCloud small = shapeCloud (Shape::Box, 10, 2);
+  // Covariances in both places, too few, a non-finite one: refused, the hierarchy kept.
+  EXPECT_THROW (bvh.build (UncertainCloud (small), packedOf (small)), pcl::BadArgumentException);
+  std::vector<PackedCovariance> short_list = packedOf (small);
+  short_list.pop_back ();
+  EXPECT_THROW (bvh.build (withoutCovariances (small), std::move (short_list)), pcl::BadArgumentException);
+  std::vector<PackedCovariance> non_finite = packedOf (small);
+  non_finite[4].yz = std::numeric_limits<float>::infinity ();
+  EXPECT_THROW (bvh.build (withoutCovariances (small), std::move (non_finite)), pcl::BadArgumentException);
+  EXPECT_EQ (bvh.size (), 50u);
+  EXPECT_EQ (bvh.nodes ().size (), nodes_before);
+  // An empty cloud, as build() takes it: an empty hierarchy.
+  EXPECT_FALSE (bvh.build (UncertainCloud (), std::vector<PackedCovariance> ()));
+  EXPECT_TRUE (bvh.empty ());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Degenerate clouds: documented results
 

@@ -163,8 +163,10 @@ public:
 
 private:
   CloudModel () = default;
-  /** \brief Centres the points on their centroid (origin()) and builds the hierarchy there. */
-  void buildLocal (UncertainCloud&& points, const BVHParams& hierarchy, std::size_t source_size, int threads = 1);
+  /** \brief Centres the points on their centroid (origin()) and builds the hierarchy there, on
+    * the covariances `packed` holds, or where it is empty on points.covariances. */
+  void buildLocal (UncertainCloud&& points, std::vector<PackedCovariance>&& packed, const BVHParams& hierarchy,
+                   std::size_t source_size, int threads = 1);
 
   template <typename PointT>
   friend std::shared_ptr<const CloudModel>

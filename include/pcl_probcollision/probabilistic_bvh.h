@@ -197,6 +197,14 @@ public:
     * it is left untouched. */
   bool build (UncertainCloud&& cloud, const BVHParams& params = BVHParams (), int threads = 1);
 
+  /** \brief As build(UncertainCloud&&, const BVHParams&, int), with the covariances given
+    * packed (one a point, as covariances() keeps them) instead of in cloud.covariances, which
+    * must then be empty: no double-precision copy of them is made (72 bytes a point that a
+    * large build would write and read once; buildCloudModel() builds this way).
+    * \throws pcl::BadArgumentException as build() does, and for a non-empty cloud.covariances */
+  bool build (UncertainCloud&& cloud, std::vector<PackedCovariance>&& covariances, const BVHParams& params = BVHParams (),
+              int threads = 1);
+
   /** \brief Drops the hierarchy and the stored cloud. */
   void clear ();
 
@@ -294,7 +302,10 @@ public:
                              std::vector<Eigen::Matrix3d>& covariances) const;
 
 private:
-  bool buildValidated (UncertainCloud&& cloud, const BVHParams& params, std::size_t workers);
+  /** \brief The build after validation: covariances packed, or empty to pack cloud.covariances
+    * here (within buildMilliseconds()). */
+  bool buildValidated (UncertainCloud&& cloud, std::vector<PackedCovariance>&& covariances, const BVHParams& params,
+                       std::size_t workers);
 
   // The points, in the cloud's own frame: 48 bytes a point, 52 with source indices.
   std::vector<Eigen::Vector3d> means_;

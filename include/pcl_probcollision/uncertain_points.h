@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -52,6 +53,13 @@ struct PackedCovariance
     Eigen::Matrix3d m;
     m << double (xx), double (xy), double (xz), double (xy), double (yy), double (yz), double (xz), double (yz), double (zz);
     return m;
+  }
+  /** \brief True when all six entries are finite. */
+  bool
+  allFinite () const
+  {
+    return std::isfinite (xx) && std::isfinite (xy) && std::isfinite (xz) && std::isfinite (yy) &&
+           std::isfinite (yz) && std::isfinite (zz);
   }
   /** \brief a^T Sigma a: the variance along a (for a unit a). */
   double
