@@ -639,6 +639,47 @@ TEST (CovarianceEstimation, NeighboursWithoutNormalFits)
 
 // Blocks of points go to several threads; every output must be what one thread gives, bit for
 // bit, including the NaN rows and is_dense.
+// On threads the outputs are sized beside the k-d tree's build (initCompute): a second compute
+// with other settings, into the same output cloud, must show nothing of the first.
+TEST (CovarianceEstimation, ARepeatedComputeOnThreadsStartsAfresh)
+{
+  const Cloud::Ptr cloud = scrambledPlaneWithNaN ();
+  CovarianceEstimation<pcl::PointXYZ> est;
+  est.setNumberOfThreads (2);
+  est.setInputCloud (cloud);
+  est.setComputeSurface (true);
+  pcl::PointCloud<Covariance> out;
+  est.compute (out);
+  ASSERT_EQ (out.size (), cloud->size ());
+  ASSERT_EQ (est.getNormals ().size (), cloud->size ());
+  ASSERT_EQ (est.getSurfaceDisplacements ().size (), cloud->size ());
+  est.setComputeSurface (false);
+  est.setSurfaceProjection (false);
+  est.setSensorNoise (SensorNoiseModel::isotropic (0.01));
+  est.compute (out);
+  EXPECT_TRUE (est.getNormals ().empty ());
+  EXPECT_TRUE (est.getNeighbours ().empty ());
+  EXPECT_TRUE (est.getSurfaceDisplacements ().empty ());
+
+  CovarianceEstimation<pcl::PointXYZ> fresh;  // one thread, the second compute's settings
+  fresh.setInputCloud (cloud);
+  fresh.setSurfaceProjection (false);
+  fresh.setSensorNoise (SensorNoiseModel::isotropic (0.01));
+  pcl::PointCloud<Covariance> ref;
+  fresh.compute (ref);
+  ASSERT_EQ (out.size (), ref.size ());
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < out.size (); ++i)
+  {
+    const bool both_nan = !out[i].isFinite () && !ref[i].isFinite ();
+    differing += both_nan ? 0 : (out[i].matrix () == ref[i].matrix () ? 0 : 1);
+    differing += std::isnan (est.getNeighbourRadii ()[i]) == std::isnan (fresh.getNeighbourRadii ()[i]) ? 0 : 1;
+  }
+  EXPECT_EQ (differing, 0u);
+  EXPECT_EQ (out.width, ref.width);
+  EXPECT_EQ (out.height, ref.height);
+}
+
 TEST (CovarianceEstimation, AnyThreadCountGivesTheOneThreadOutput)
 {
   const Cloud::Ptr cloud = scrambledPlaneWithNaN ();  // 1,600 points: 7 blocks of 256

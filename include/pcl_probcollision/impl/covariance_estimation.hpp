@@ -377,11 +377,14 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
     this->tree_.reset (new detail::BatchKdTree<PointInT> ());
   // With threads, the visiting order (zOrder, a sort) is computed while the base class builds
   // the k-d tree: both are serial and take about as long (5,000,000 points: 0.45 and 0.9 s).
+  // The per-point outputs are then sized there too: their first writes are page faults, 0.2-0.3
+  // s of serial work at 5,000,000 points in this project's VMs (detail/huge_pages.h).
   order_.clear ();
+  outputs_ready_ = false;
   std::thread side;
   if (threadCount () > 1 && pcl::PCLBase<PointInT>::initCompute ())
   {
-    // A failure here only means computeFeature computes the order itself.
+    // A failure here only means computeFeature does it itself.
     const auto order = [this] {
       try
       {
@@ -390,6 +393,22 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
       catch (const std::exception&)
       {
         order_.clear ();
+      }
+      try
+      {
+        const std::size_t n = this->indices_->size ();
+        resetOutputs (n);
+        // pcl::Feature::compute() sizes its output only where it has another size.
+        if (output_ && output_->size () != n)
+        {
+          detail::reserveHugePages (output_->points, n);
+          output_->resize (n);
+        }
+        outputs_ready_ = true;
+      }
+      catch (const std::exception&)
+      {
+        outputs_ready_ = false;
       }
     };
     try
@@ -404,6 +423,42 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
   if (side.joinable ())
     side.join ();
   return ok;
+}
+
+template <typename PointInT, typename PointOutT>
+void
+CovarianceEstimation<PointInT, PointOutT>::compute (PointCloudOut& output)
+{
+  output_ = &output;
+  try
+  {
+    pcl::Feature<PointInT, PointOutT>::compute (output);
+  }
+  catch (...)
+  {
+    output_ = nullptr;
+    throw;
+  }
+  output_ = nullptr;
+}
+
+template <typename PointInT, typename PointOutT>
+void
+CovarianceEstimation<PointInT, PointOutT>::resetOutputs (std::size_t n)
+{
+  detail::assignHugePages (radii_, n, std::numeric_limits<float>::quiet_NaN ());
+  detail::assignHugePages (nearest_sqr_, n, std::numeric_limits<float>::quiet_NaN ());
+  normals_.clear ();
+  neighbours_.clear ();
+  displacements_.clear ();
+  if (compute_surface_)
+  {
+    if (compute_normals_)
+      detail::assignHugePages (normals_, n, Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
+    detail::assignHugePages (neighbours_, n * static_cast<std::size_t> (this->k_), -1);
+  }
+  if (project_)
+    detail::assignHugePages (displacements_, n, Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
 }
 
 template <typename PointInT, typename PointOutT>
@@ -477,19 +532,10 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   for (const auto& p : surface.points)
     finite_surface += pcl::isXYZFinite (p) ? 1 : 0;
 
-  detail::assignHugePages (radii_, indices.size (), std::numeric_limits<float>::quiet_NaN ());
-  detail::assignHugePages (nearest_sqr_, indices.size (), std::numeric_limits<float>::quiet_NaN ());
-  normals_.clear ();
-  neighbours_.clear ();
+  if (!outputs_ready_)
+    resetOutputs (indices.size ());
+  outputs_ready_ = false;
   const bool fit_normals = compute_surface_ && compute_normals_;
-  if (compute_surface_)
-  {
-    if (fit_normals)
-      detail::assignHugePages (normals_, indices.size (), Eigen::Vector3f::Constant (std::numeric_limits<float>::quiet_NaN ()));
-    detail::assignHugePages (neighbours_, indices.size () * static_cast<std::size_t> (this->k_), -1);
-  }
-  if (project_)
-    detail::assignHugePages (displacements_, indices.size (), Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ()));
   // Ask one more than k: the query itself comes back when it is part of the surface.
   const int k_ask = static_cast<int> (std::min<std::size_t> (this->k_ + 1, finite_surface));
   // Neighbours are searched a block of points at a time: one FLANN call per block, and the
