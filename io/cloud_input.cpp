@@ -22,6 +22,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <new>
 #include <set>
 #include <sstream>
 #include <string>
@@ -549,11 +550,20 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
   {
     // readHeader() sizes blob.data for the points (and read() reuses it): on memory offered to
     // huge pages, the file's size being the binary data's (a 5,000,000-point floor: 15,000
-    // faults at about 11 us fewer, detail/huge_pages.h). Other encodings may outgrow it.
+    // faults at about 11 us fewer, detail/huge_pages.h). Other encodings may outgrow it. Only a
+    // hint: a file too large to reserve for is left to PCL's reader, as before.
     std::error_code size_error;
     const std::uintmax_t bytes = std::filesystem::file_size (path, size_error);
     if (!size_error)
-      pcl_probcollision::detail::reserveHugePages (blob.data, static_cast<std::size_t> (bytes));
+    {
+      try
+      {
+        pcl_probcollision::detail::reserveHugePages (blob.data, static_cast<std::size_t> (bytes));
+      }
+      catch (const std::bad_alloc&)
+      {
+      }
+    }
     pcl::PCDReader reader;
     int version = 0, data_type = 0;
     unsigned int data_idx = 0;
