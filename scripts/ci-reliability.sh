@@ -3,12 +3,12 @@
 #   1. clang, AddressSanitizer + UndefinedBehaviorSanitizer (+ LeakSanitizer): build everything
 #      (with the libFuzzer targets) and run the whole ctest suite;
 #   2. libFuzzer: each fuzz target for FUZZ_SECONDS (default 60) from the seed corpus;
-#   3. ThreadSanitizer: the concurrency tests;
+#   3. ThreadSanitizer: the concurrency tests, of the queries and of the builds on threads;
 #   4. valgrind memcheck on pcd_collision over data/ (the Release build of scripts/test.sh).
 # Build directories: ${BUILD_PREFIX}asan and ${BUILD_PREFIX}tsan, BUILD_PREFIX=build- by default
 # (never build/, which step 4 only reads; PCD_COLLISION_EXE names another pcd_collision).
 # Each step builds only what it runs: no benchmarks, no evaluation, and the TSan tree only the
-# four programs holding the concurrency tests. Budget (issue #7): sanitizer and fuzz steps within
+# seven programs holding the concurrency tests. Budget (issue #7): sanitizer and fuzz steps within
 # 15 minutes on 2 cores; measured times are in docs/RELIABILITY.md.
 # Usage: bash scripts/ci-reliability.sh [all | asan|fuzz|tsan|valgrind ...]   (default: all, in order)
 set -euo pipefail
@@ -92,17 +92,23 @@ tsan_build () {
   export TSAN_OPTIONS="$tsan_options"
   sanitized_configure "$tsan_dir" thread -DPCL_PROBCOLLISION_BUILD_EXAMPLES=OFF
   cmake --build "$tsan_dir" -j"$jobs" --target test_collide test_bvh_traversal test_robust_classifier \
-    test_probabilistic_collision
+    test_probabilistic_collision test_covariance_estimation test_probabilistic_bvh test_cloud_model
 }
 tsan_test () {
-  # The hierarchies of these tests are built before the threads start; the threads run only our
-  # code (collide(), collideBatch(), computeBatch(), classify(), the traversal). test/tools/tsan.supp holds
+  # The queries' threads run only our code (collide(), collideBatch(), computeBatch(),
+  # classify(), the traversal) on hierarchies built before they start; the builds' threads run
+  # ours and FLANN's (header-only, so instrumented too). test/tools/tsan.supp holds
   # the one suppression (libOpenNI2's static initializer).
   export TSAN_OPTIONS="$tsan_options"
   "$tsan_dir/test/test_collide" --gtest_filter='*Concurrent*'
   "$tsan_dir/test/test_bvh_traversal" --gtest_filter='*Threads*'
   "$tsan_dir/test/test_robust_classifier" --gtest_filter='*Concurrent*'
   "$tsan_dir/test/test_probabilistic_collision" --gtest_filter='*Concurrent*'
+  # The builds on threads: the covariance estimation (its side thread beside FLANN's tree
+  # build), the hierarchy's parts, and a whole model with the merged one built beside.
+  "$tsan_dir/test/test_covariance_estimation" --gtest_filter='*Thread*:*Afresh*'
+  "$tsan_dir/test/test_probabilistic_bvh" --gtest_filter='*ThreadCount*:*Packed*'
+  "$tsan_dir/test/test_cloud_model" --gtest_filter='*ThreadCount*:*IndependentOfThreads*'
 }
 
 valgrind_cli () {
