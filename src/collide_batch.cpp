@@ -5,6 +5,9 @@
 #include <pcl/exceptions.h>
 
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -12,6 +15,12 @@ namespace pcl_probcollision
 {
 namespace
 {
+/** \brief Poses a worker may answer ahead of the first one not yet handed over, per worker: a
+  * slow pose then holds back at most this many finished results (each may carry per-point
+  * arrays), while the others keep every thread busy. pcd_collision answered chunks of this many
+  * poses a thread before answers were streamed. */
+constexpr std::size_t kStreamWindowPerWorker = 64;
+
 /** \brief Whether collide() would get as far as classifying, i.e. need a classifier. */
 bool
 needsClassifier (const CollisionRequest& request)
@@ -26,12 +35,83 @@ needsClassifier (const CollisionRequest& request)
   }
   return true;
 }
-} // namespace
 
+/** \brief Hands items finished in any order over to `ready` in index order. done (i) marks item i
+  * finished; the thread that finds the next items in order finished calls ready for them, one call
+  * at a time and outside the lock, so that the other workers keep finishing items meanwhile.
+  * waitForRoom (i) holds a worker about to start item i while i lies `window` or more items past
+  * the next one to hand over. stop () ends the handing over: waits return false at once. An
+  * exception from ready stops it too and leaves done () to its caller. */
+class InOrderHandover
+{
+public:
+  InOrderHandover (std::size_t count, std::size_t window, const std::function<void (std::size_t)>& ready)
+    : done_ (count, 0), window_ (window), ready_ (ready)
+  {}
+
+  bool
+  waitForRoom (std::size_t i)
+  {
+    std::unique_lock<std::mutex> lock (mutex_);
+    room_.wait (lock, [&] { return stopped_ || i < next_ + window_; });
+    return !stopped_;
+  }
+
+  void
+  done (std::size_t i)
+  {
+    std::unique_lock<std::mutex> lock (mutex_);
+    done_[i] = 1;
+    if (handing_ || stopped_)
+      return;  // the thread handing over meets item i in its turn
+    handing_ = true;
+    while (!stopped_ && next_ < done_.size () && done_[next_])
+    {
+      const std::size_t item = next_;
+      lock.unlock ();
+      try
+      {
+        ready_ (item);
+      }
+      catch (...)
+      {
+        lock.lock ();
+        handing_ = false;
+        stopped_ = true;
+        room_.notify_all ();
+        throw;
+      }
+      lock.lock ();
+      ++next_;
+      room_.notify_all ();
+    }
+    handing_ = false;
+  }
+
+  void
+  stop ()
+  {
+    const std::lock_guard<std::mutex> lock (mutex_);
+    stopped_ = true;
+    room_.notify_all ();
+  }
+
+private:
+  std::mutex mutex_;
+  std::condition_variable room_;
+  std::vector<char> done_;
+  std::size_t next_ = 0;  ///< the first item not yet handed over
+  std::size_t window_;
+  bool handing_ = false;  ///< a thread is handing items over
+  bool stopped_ = false;
+  const std::function<void (std::size_t)>& ready_;
+};
+
+/** \brief Both collideBatch() overloads: the plain batch without ready, the streamed one with it. */
 bool
-collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
-              const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
-              const RobustClassifier* classifier)
+runBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+          const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
+          const RobustClassifier* classifier, const std::function<void (std::size_t)>* ready)
 {
   if (threads < 0)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
@@ -42,19 +122,52 @@ collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen:
   if (count == 0)
     return true;
 
-  // Drawing the random features is costly: one classifier for every pose. collide() would draw
-  // the same one (its parameters and seed are the request's), so results do not change.
   std::optional<RobustClassifier> shared;
   if (!classifier && needsClassifier (request))
     classifier = &shared.emplace (request.classifier);
 
-  // Poses are independent and their results stored by index: which thread answers a pose, and
-  // when, changes nothing. Poses are handed out one at a time since their costs differ widely
-  // (a free pose prunes at the roots, a contact fits hundreds of leaf pairs); a failure rethrows
-  // the earliest pose's.
-  detail::parallelFor (count, detail::threadCount (threads), [&] (std::size_t i, std::size_t) {
-    collide (a, b, T_a_b[i], request, results[i], classifier);
+  const std::size_t workers = std::min (count, detail::threadCount (threads));
+  if (!ready)
+  {
+    detail::parallelFor (count, workers, [&] (std::size_t i, std::size_t) {
+      collide (a, b, T_a_b[i], request, results[i], classifier);
+    });
+    return std::all_of (results.begin (), results.end (), [] (const CollisionResult& r) { return r.ok (); });
+  }
+  InOrderHandover handover (count, kStreamWindowPerWorker * workers, *ready);
+  std::atomic<std::size_t> failed (0);  // ready may clear a result before the end
+  detail::parallelFor (count, workers, [&] (std::size_t i, std::size_t) {
+    try
+    {
+      if (!handover.waitForRoom (i))
+        return;
+      if (!collide (a, b, T_a_b[i], request, results[i], classifier))
+        failed.fetch_add (1, std::memory_order_relaxed);
+      handover.done (i);
+    }
+    catch (...)
+    {
+      handover.stop ();  // no worker may wait for this pose
+      throw;
+    }
   });
-  return std::all_of (results.begin (), results.end (), [] (const CollisionResult& r) { return r.ok (); });
+  return failed.load () == 0;
+}
+} // namespace
+
+bool
+collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+              const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
+              const RobustClassifier* classifier)
+{
+  return runBatch (a, b, T_a_b, request, results, threads, classifier, nullptr);
+}
+
+bool
+collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+              const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
+              const RobustClassifier* classifier, const std::function<void (std::size_t)>& ready)
+{
+  return runBatch (a, b, T_a_b, request, results, threads, classifier, ready ? &ready : nullptr);
 }
 } // namespace pcl_probcollision

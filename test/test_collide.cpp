@@ -725,6 +725,89 @@ TEST (CollideBatch, InvalidRequestOrPoseFailsEveryPoseLikeCollide)
   }
 }
 
+// The overload with `ready` (pcd_collision -poses prints through it): every pose handed over once,
+// in pose order, each as the batch without it answers it, whatever the thread count; a failed pose
+// in its place; the batch's verdict counted before ready clears the results.
+TEST (CollideBatch, StreamedAnswersComeInPoseOrderAsTheBatchGivesThem)
+{
+  const CloudModel a (jitteredGrid (20, 0.005, 0.001, 1));
+  const CloudModel b (jitteredGrid (24, 0.005, 0.001, 2));
+  std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 3);
+  CollisionRequest request;
+  request.per_point = true;
+  const RobustClassifier classifier (request.classifier);
+  std::vector<CollisionResult> want;
+  ASSERT_TRUE (collideBatch (a, b, poses, request, want, 1, &classifier));
+  const std::vector<int> counts = verdictCounts (want);
+  EXPECT_GT (counts[static_cast<int> (Verdict::Free)], 0);
+  EXPECT_GT (counts[static_cast<int> (Verdict::InContact)] + counts[static_cast<int> (Verdict::InCollision)], 0);
+  for (const bool bad_pose : {false, true})
+  {
+    if (bad_pose)
+      poses[1].translation ().x () = std::numeric_limits<double>::quiet_NaN ();
+    for (const int threads : {1, 2, 3})
+    {
+      std::vector<std::size_t> order;
+      std::vector<CollisionResult> got (poses.size ()), results;
+      const bool ok = collideBatch (a, b, poses, request, results, threads, &classifier, [&] (std::size_t i) {
+        order.push_back (i);
+        got[i] = std::move (results[i]);
+        results[i] = CollisionResult ();  // what a caller that prints each answer does
+      });
+      const std::string where = "threads " + std::to_string (threads) + (bad_pose ? ", a bad pose" : "");
+      EXPECT_EQ (ok, !bad_pose) << where;
+      ASSERT_EQ (order.size (), poses.size ()) << where;
+      for (std::size_t i = 0; i < poses.size (); ++i)
+      {
+        EXPECT_EQ (order[i], i) << where;
+        if (bad_pose && i == 1)
+        {
+          EXPECT_EQ (got[i].status, CollisionResult::Status::InvalidInput) << where;
+          continue;
+        }
+        expectSameResult (want[i], got[i], where + ", pose " + std::to_string (i));
+      }
+    }
+  }
+}
+
+TEST (CollideBatch, AnExceptionFromReadyStopsTheBatchAndIsRethrown)
+{
+  const CloudModel a (jitteredGrid (12, 0.005, 0.001, 4));
+  const CloudModel b (jitteredGrid (12, 0.005, 0.001, 5));
+  const std::vector<Eigen::Isometry3d> poses = poseSweep (kPoses, 6);
+  struct Stop
+  {
+    std::size_t pose;
+  };
+  for (const int threads : {1, 2})
+  {
+    std::vector<std::size_t> order;
+    std::vector<CollisionResult> results;
+    try
+    {
+      collideBatch (a, b, poses, CollisionRequest (), results, threads, nullptr, [&] (std::size_t i) {
+        order.push_back (i);
+        if (i == 3)
+          throw Stop{i};
+      });
+      FAIL () << "threads " << threads << ": the exception from ready was lost";
+    }
+    catch (const Stop& stop)
+    {
+      EXPECT_EQ (stop.pose, 3u);
+    }
+    EXPECT_EQ (order, (std::vector<std::size_t>{0, 1, 2, 3})) << "threads " << threads;
+  }
+  // An empty ready is the batch without it.
+  std::vector<CollisionResult> plain, streamed;
+  ASSERT_TRUE (collideBatch (a, b, poses, CollisionRequest (), plain, 2));
+  ASSERT_TRUE (collideBatch (a, b, poses, CollisionRequest (), streamed, 2, nullptr, {}));
+  ASSERT_EQ (streamed.size (), plain.size ());
+  for (std::size_t i = 0; i < plain.size (); ++i)
+    expectSameResult (plain[i], streamed[i], "pose " + std::to_string (i));
+}
+
 // ---------------------------------------------------------------------------------------------
 // verdictFor()
 

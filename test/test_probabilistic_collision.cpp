@@ -365,6 +365,23 @@ TEST (ProbabilisticCollision, ConcurrentComputeBatchEqualsComputePoseByPose)
     }
     EXPECT_NE (batch[4].message.find ("pose 4: "), std::string::npos) << batch[4].message;
     EXPECT_TRUE (batched.getInputModel () && batched.getTargetModel ());
+
+    // Streamed (computeBatch's `ready`): every pose handed over once, in pose order, the refused
+    // ones in their places, each as the batch above gives it; ready may take the result.
+    ProbabilisticCollision<pcl::PointXYZ> streaming;
+    configure (streaming);
+    std::vector<std::size_t> order;
+    std::vector<CollisionResult> results, got (poses.size ());
+    EXPECT_FALSE (streaming.computeBatch (poses, results, threads, [&] (std::size_t i) {
+      order.push_back (i);
+      got[i] = std::move (results[i]);
+    }));
+    ASSERT_EQ (order.size (), poses.size ());
+    for (std::size_t i = 0; i < poses.size (); ++i)
+    {
+      EXPECT_EQ (order[i], i);
+      expectSameResult (batch[i], got[i], "streamed, threads " + std::to_string (threads) + ", pose " + std::to_string (i));
+    }
   }
 }
 

@@ -24,7 +24,6 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
-#include <deque>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -713,25 +712,6 @@ run (int argc, char** argv)
   Progress progress (poses.size (), batch && ::isatty (STDERR_FILENO));
   // Summary lines on a terminal that also shows the progress: erase the progress first.
   const bool shares_terminal = !o.json && ::isatty (STDOUT_FILENO);
-  // The poses are answered by computeBatch in chunks of a few per thread, each chunk printed in
-  // pose order as soon as it is done: answers stream, and a chunk's slowest pose idles the
-  // other threads only briefly. Which thread answers a pose changes nothing in its answer.
-  const std::size_t chunk = std::size_t{64} * workers;
-  using Results = std::vector<pcl_probcollision::CollisionResult>;
-  struct Chunk
-  {
-    std::size_t start = 0;
-    std::vector<Eigen::Isometry3d> T;
-    Results results;
-  };
-  auto answer = [&] (std::size_t start) {
-    Chunk c;
-    c.start = start;
-    for (std::size_t j = start; j < std::min (poses.size (), start + chunk); ++j)
-      c.T.push_back (poseTransform (poses[j]));
-    pc.computeBatch (c.T, c.results, static_cast<int> (workers));
-    return c;
-  };
   // Two meshes are sampled exactly (zero covariance), so nothing models the surface between
   // their samples: a thin part through a thin wall can pass between the samples of both and read
   // free (FCL's piano legs, 40 mm across, through its 9 mm floor at a 90 mm spacing).
@@ -739,19 +719,19 @@ run (int argc, char** argv)
   // so, once a run.
   const bool both_meshes = a.kind == InputKind::Mesh && b.kind == InputKind::Mesh;
   bool warned_between_samples = false;
-  // Prints pose i (k-th of its chunk) and its answer; throws Failure for a failed query.
-  auto emit = [&] (std::size_t i, std::size_t k, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
+  // Prints pose i and its answer; throws Failure for a failed query.
+  auto emit = [&] (std::size_t i, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
     if (!result.ok () || shares_terminal)
       progress.clear ();
     if (!result.ok ())
     {
-      // computeBatch names the pose within its chunk: name it within the file instead.
-      const std::string prefix = "pose " + std::to_string (k) + ": ";
+      // computeBatch names the pose: the failure line names it once, after "pose i: ".
+      const std::string prefix = "pose " + std::to_string (i) + ": ";
       std::string message = result.message.rfind (prefix, 0) == 0 ? result.message.substr (prefix.size ()) : result.message;
       throw Failure{kRuntimeFailure, (batch ? "pose " + std::to_string (i) + ": " : std::string ()) + "query failed: " +
                                          (message.empty () ? std::string ("the query failed") : message)};
     }
-    // The models are built once, by the first chunk, whose every answer carries that time: it
+    // The models are built once, before the first pose, and every answer carries that time: it
     // belongs to the first pose, as a serial loop of compute() would report it.
     if (i > 0 && std::isfinite (result.build_ms))
       result.build_ms = 0.0;
@@ -833,83 +813,19 @@ run (int argc, char** argv)
                     o.output->c_str (), *write_ms, written);
     progress.show (i + 1);
   };
-  if (!batch || workers < 2)
-  {
-    for (std::size_t start = 0; start < poses.size (); start += chunk)
-    {
-      Chunk c = answer (start);
-      for (std::size_t k = 0; k < c.T.size (); ++k)
-        emit (start + k, k, c.T[k], c.results[k]);
-    }
-  }
-  else
-  {
-    // With several threads, printing (formatting the answers: a few percent of a batch of the
-    // separators) runs on a thread of its own while the next chunk is answered; the calling
-    // thread keeps answering, as with one chunk at a time. Lines come out in the same order.
-    std::mutex mutex;
-    std::condition_variable ready;
-    std::deque<Chunk> queue;
-    bool finished = false;
-    std::exception_ptr error;  // set by the printer when it stops at a failed query
-    std::thread printer ([&] {
-      try
-      {
-        for (;;)
-        {
-          Chunk c;
-          {
-            std::unique_lock<std::mutex> lock (mutex);
-            ready.wait (lock, [&] { return !queue.empty () || finished; });
-            if (queue.empty ())
-              return;
-            c = std::move (queue.front ());
-            queue.pop_front ();
-          }
-          for (std::size_t k = 0; k < c.T.size (); ++k)
-            emit (c.start + k, k, c.T[k], c.results[k]);
-        }
-      }
-      catch (...)
-      {
-        const std::lock_guard<std::mutex> lock (mutex);
-        error = std::current_exception ();
-      }
-    });
-    auto finish = [&] {
-      {
-        const std::lock_guard<std::mutex> lock (mutex);
-        finished = true;
-      }
-      ready.notify_one ();
-      printer.join ();
-    };
-    try
-    {
-      for (std::size_t start = 0; start < poses.size (); start += chunk)
-      {
-        {
-          const std::lock_guard<std::mutex> lock (mutex);
-          if (error)
-            break;  // the printer stopped at a failed query: answer no more
-        }
-        Chunk c = answer (start);
-        {
-          const std::lock_guard<std::mutex> lock (mutex);
-          queue.push_back (std::move (c));
-        }
-        ready.notify_one ();
-      }
-    }
-    catch (...)
-    {
-      finish ();
-      throw;
-    }
-    finish ();
-    if (error)
-      std::rethrow_exception (error);
-  }
+  // The poses are answered on `workers` threads and each answer is printed as soon as it and every
+  // pose before it are done (computeBatch's `ready`, one call at a time, on the threads that
+  // answer): the lines stream in pose order, and no thread waits for a batch's slowest pose. An
+  // answer printed is dropped (with -o it holds both clouds' per-point values).
+  std::vector<Eigen::Isometry3d> transforms;
+  transforms.reserve (poses.size ());
+  for (const auto& pose : poses)
+    transforms.push_back (poseTransform (pose));
+  std::vector<pcl_probcollision::CollisionResult> results;
+  pc.computeBatch (transforms, results, static_cast<int> (workers), [&] (std::size_t i) {
+    emit (i, transforms[i], results[i]);
+    results[i] = pcl_probcollision::CollisionResult ();
+  });
   progress.clear ();
   return 0;
 }

@@ -8,6 +8,8 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace pcl_probcollision
@@ -63,6 +65,24 @@ bool collide (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d&
 bool collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
                    const CollisionRequest& request, std::vector<CollisionResult>& results, int threads = 0,
                    const RobustClassifier* classifier = nullptr);
+
+/** \brief collideBatch() that hands each result over while the later poses are answered:
+  * ready (i) is called once for every pose, in pose order, as soon as results[i] and every
+  * result before it are final.
+  *
+  * The answers are those of the other overload, whatever the thread count. Calls of ready never
+  * overlap; they are made on the batch's threads (the calling one included), so a slow ready
+  * holds up one worker, and it may move from or clear results[i] (a caller that prints or stores
+  * each answer then keeps none of them). A worker does not start a pose 64 times the thread count
+  * or more past the first one not yet handed over, so a slow pose holds back a bounded number of
+  * finished results. With an empty ready this is the other overload.
+  * \return true when every pose succeeded (counted before ready sees each result)
+  * \throws pcl::BadArgumentException for threads < 0. An exception from ready stops the batch:
+  *         no later pose is handed over, and it is rethrown here once every worker has stopped
+  *         (an exception escaping collide() likewise). */
+bool collideBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Isometry3d>& T_a_b,
+                   const CollisionRequest& request, std::vector<CollisionResult>& results, int threads,
+                   const RobustClassifier* classifier, const std::function<void (std::size_t)>& ready);
 
 /** \brief The verdict of a probability under a request's thresholds (Unknown for NaN, "not
   * computed"): the one rule every verdict, label and colour of the library and its tools derives

@@ -13,6 +13,8 @@
 
 #include <Eigen/Geometry>
 
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -171,6 +173,14 @@ public:
     *         failure otherwise. */
   bool computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input, std::vector<CollisionResult>& results,
                      int threads = 0);
+  /** \brief computeBatch() that hands each result over while the later poses are answered
+    * (collideBatch()'s overload with `ready`): ready (i) is called once for every pose, in pose
+    * order, as soon as results[i] is final (failed poses included, with their "pose <i>: "
+    * message). The calls never overlap and run on the batch's threads; ready may move from or
+    * clear results[i], and must not change this object. An exception from ready stops the batch
+    * and is rethrown here. pcd_collision -poses prints its answers so. */
+  bool computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input, std::vector<CollisionResult>& results,
+                     int threads, const std::function<void (std::size_t)>& ready);
 
   /** \brief Like pcl::Filter::filter, but the output is cleared first, so a failed call never
     * leaves stale points behind. */
@@ -194,6 +204,11 @@ private:
   /** \brief Turns collide()'s answer (A's frame) into compute()'s: the witness in the
     * target's frame and, with timings, build_ms. */
   void finishResult (const Eigen::Isometry3d& T_target_input, double build_ms, CollisionResult& result) const;
+  /** \brief computeBatch()'s last step for pose i: finishResult() for an answer, the pose's
+    * number before a failure's message (and a PCL_ERROR for the first failure, counted in
+    * failed). */
+  void finishBatchResult (std::size_t i, const Eigen::Isometry3d& T_target_input, double build_ms,
+                          CollisionResult& result, std::size_t& failed) const;
 
   PointCloudConstPtr target_;
   pcl::IndicesConstPtr target_indices_;

@@ -253,9 +253,33 @@ ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input
 }
 
 template <typename PointT>
+void
+ProbabilisticCollision<PointT>::finishBatchResult (std::size_t i, const Eigen::Isometry3d& T_target_input,
+                                                   double build_ms, CollisionResult& result, std::size_t& failed) const
+{
+  if (result.ok ())
+  {
+    finishResult (T_target_input, build_ms, result);
+    return;
+  }
+  result.message = "pose " + std::to_string (i) + ": " + result.message;
+  if (failed++ == 0)
+    PCL_ERROR ("[pcl_probcollision::%s::computeBatch] %s\n", this->getClassName ().c_str (), result.message.c_str ());
+}
+
+template <typename PointT>
 bool
 ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input,
                                               std::vector<CollisionResult>& results, int threads)
+{
+  return computeBatch (T_target_input, results, threads, {});
+}
+
+template <typename PointT>
+bool
+ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input,
+                                              std::vector<CollisionResult>& results, int threads,
+                                              const std::function<void (std::size_t)>& ready)
 {
   if (threads < 0)
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
@@ -275,35 +299,35 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
       T_input_target.push_back (T_target_input[i].inverse ());
     }
   }
-  // Like compute(), build only when some pose gets that far; every such pose shares the outcome.
+  // Every pose is finished and handed over in pose order: those up to `end` once results hold them.
   CollisionResult prepared;
+  std::size_t handed = 0, failed = 0;
+  auto handOverUpTo = [&] (std::size_t end) {
+    for (; handed < end; ++handed)
+    {
+      finishBatchResult (handed, T_target_input[handed], prepared.build_ms, results[handed], failed);
+      if (ready)
+        ready (handed);
+    }
+  };
+  // Like compute(), build only when some pose gets that far; every such pose shares the outcome.
   if (!posed.empty ())
   {
     if (prepare (prepared))
     {
       std::vector<CollisionResult> answers;
-      collideBatch (*input_model_, *target_model_, T_input_target, request_, answers, threads, &classifier_);
-      for (std::size_t k = 0; k < posed.size (); ++k)
-        results[posed[k]] = std::move (answers[k]);
+      collideBatch (*input_model_, *target_model_, T_input_target, request_, answers, threads, &classifier_,
+                    [&] (std::size_t k) {
+                      handOverUpTo (posed[k]);  // the refused poses before it
+                      results[posed[k]] = std::move (answers[k]);
+                      handOverUpTo (posed[k] + 1);
+                    });
     }
     else
       for (const std::size_t i : posed)
         results[i] = prepared;
   }
-
-  std::size_t failed = 0;
-  for (std::size_t i = 0; i < count; ++i)
-  {
-    CollisionResult& result = results[i];
-    if (result.ok ())
-    {
-      finishResult (T_target_input[i], prepared.build_ms, result);
-      continue;
-    }
-    result.message = "pose " + std::to_string (i) + ": " + result.message;
-    if (failed++ == 0)
-      PCL_ERROR ("[pcl_probcollision::%s::computeBatch] %s\n", this->getClassName ().c_str (), result.message.c_str ());
-  }
+  handOverUpTo (count);
   if (failed > 1)
     PCL_ERROR ("[pcl_probcollision::%s::computeBatch] %zu of %zu poses failed\n", this->getClassName ().c_str (),
                failed, count);
