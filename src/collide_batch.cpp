@@ -122,10 +122,16 @@ runBatch (const CloudModel& a, const CloudModel& b, const std::vector<Eigen::Iso
   if (count == 0)
     return true;
 
+  // Drawing the random features is costly: one classifier for every pose. collide() would draw
+  // the same one (its parameters and seed are the request's), so results do not change.
   std::optional<RobustClassifier> shared;
   if (!classifier && needsClassifier (request))
     classifier = &shared.emplace (request.classifier);
 
+  // Poses are independent and their results stored by index: which thread answers a pose, and
+  // when, changes nothing. Poses are handed out one at a time since their costs differ widely
+  // (a free pose prunes at the roots, a contact fits hundreds of leaf pairs); a failure rethrows
+  // the earliest pose's.
   const std::size_t workers = std::min (count, detail::threadCount (threads));
   if (!ready)
   {
