@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -417,6 +418,83 @@ TEST_F (PcdCollisionTool, JsonKeysAreDocumented)
   ASSERT_EQ (now.size (), 1u);
   collectKeys (now[0], "", actual);
   EXPECT_EQ (documented, actual);
+}
+
+/** \brief s with every run of white space (line breaks included) made one space. */
+std::string
+oneSpaced (const std::string& s)
+{
+  std::string out;
+  for (const char c : s)
+    if (!std::isspace (static_cast<unsigned char> (c)))
+      out += c;
+    else if (!out.empty () && out.back () != ' ')
+      out += ' ';
+  return out;
+}
+
+/** \brief A human answer line up to its timings ("; build ..."), which vary from run to run. */
+std::string
+withoutTimings (const std::string& line)
+{
+  return line.substr (0, line.find ("; build "));
+}
+
+// The answers README.md and docs/CLI.md quote are the tool's: the Quick start's three lines
+// (each doc's `pose N:` lines, timings aside) and the demo's lines with other flags that the
+// prose quotes, each found both in a doc (white space aside: prose wraps its quotes) and in the
+// tool's line for that pose. A change of the answers then fails here until the docs follow.
+TEST_F (PcdCollisionTool, TheDemoAnswersTheDocsQuote)
+{
+  const ToolRun demo = run ({kGripper.string (), kScene.string (), "-poses", kPoses.string ()});
+  ASSERT_EQ (demo.status, 0) << demo.err;
+  const auto printed = lines (demo.out);
+  ASSERT_EQ (printed.size (), 3u) << demo.out;
+  for (const std::string doc : {README_DOC, CLI_DOC})
+  {
+    SCOPED_TRACE (doc);
+    std::size_t quoted = 0;
+    for (const auto& l : lines (readFile (doc)))
+    {
+      if (l.rfind ("pose ", 0) != 0 || l.find ("[points a ") == std::string::npos)
+        continue;
+      ASSERT_LT (quoted, printed.size ()) << "more demo lines quoted than the demo prints: " << l;
+      EXPECT_EQ (withoutTimings (l), withoutTimings (printed[quoted])) << "the doc quotes a line the demo does not print";
+      ++quoted;
+    }
+    EXPECT_EQ (quoted, printed.size ());
+  }
+
+  struct Quote
+  {
+    std::vector<std::string> flags;
+    std::size_t pose;
+    std::string text;
+    std::vector<std::string> docs;
+  };
+  const std::vector<Quote> quotes = {
+      {{"-surface"}, 2,
+       "collision P >= 0.995821 d = -0.0021 +- 0.0008 (first deciding point) (unobserved: across a hole or behind a sheet)",
+       {README_DOC, CLI_DOC}},
+      {{"-surface", "-exhaustive"}, 2, "d = -0.0197 +- 0.0006", {README_DOC, CLI_DOC}},
+      {{"-surface", "-distance"}, 2, "d = -0.0197 +- 0.0006", {README_DOC}},
+      {{"-surface_pooled"}, 2, "collision P >= 0.908024", {README_DOC}},
+      {{"-distance"}, 0, "free P = 0.000000 d = +0.1482 +- 0.0049 (nearest samples)", {README_DOC, CLI_DOC}},
+      {{"-surface_ladder"}, 2, "collision P >= 0.995821", {README_DOC}},
+  };
+  for (const Quote& q : quotes)
+  {
+    std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses", kPoses.string ()};
+    args.insert (args.end (), q.flags.begin (), q.flags.end ());
+    SCOPED_TRACE (q.flags[0] + (q.flags.size () > 1 ? " " + q.flags[1] : std::string ()) + ": " + q.text);
+    const ToolRun r = run (args);
+    ASSERT_EQ (r.status, 0) << r.err;
+    const auto answers = lines (r.out);
+    ASSERT_EQ (answers.size (), 3u) << r.out;
+    EXPECT_NE (oneSpaced (answers[q.pose]).find (q.text), std::string::npos) << "the tool prints: " << answers[q.pose];
+    for (const std::string& doc : q.docs)
+      EXPECT_NE (oneSpaced (readFile (doc)).find (q.text), std::string::npos) << doc << " no longer quotes it";
+  }
 }
 
 TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
