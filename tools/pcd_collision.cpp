@@ -20,19 +20,19 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cinttypes>
 #include <cmath>
 #include <condition_variable>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <future>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
-#include <tuple>
 #include <vector>
 
 namespace pcd_collision
@@ -62,6 +62,16 @@ struct Failure
 
 constexpr int kRuntimeFailure = 1;
 constexpr int kUsageError = 2;
+
+/** \brief Flushes the results' stream (stdout) and fails where they could not be written (a
+  * full disk, a quota): an answer lost must not exit 0. A closed pipe ends the tool by SIGPIPE
+  * before this is reached, as for any Unix filter. */
+void
+flushResults ()
+{
+  if (std::fflush (stdout) != 0 || std::ferror (stdout))
+    throw Failure{kRuntimeFailure, std::string ("cannot write the results to standard output: ") + std::strerror (errno)};
+}
 
 double
 msSince (std::chrono::steady_clock::time_point start)
@@ -799,14 +809,14 @@ run (int argc, char** argv)
     {
       std::fprintf (stdout, "%s\n", resultJson (o, summaryOf (a, pc.getInputModel ().get ()), summaryOf (b, pc.getTargetModel ().get ()), result, poses[i], index,
                                                 write_ms, written).c_str ());
-      std::fflush (stdout);
+      flushResults ();
     }
     else
     {
       std::fprintf (human, "%s\n", humanLine (result, index, o.surface_ladder, o.distance).c_str ());
       if (!batch)
         std::fprintf (human, "%s\n", witnessLine (result).c_str ());
-      std::fflush (human);
+      flushResults ();  // human is stdout here
     }
     if (o.output)
       std::fprintf (log, "Writing %s [done, %.1f ms : %zu points, a then b, fields x y z intensity rgb label]\n",
@@ -838,7 +848,9 @@ main (int argc, char** argv)
   pcd_collision::installInterruptCleanup ();
   try
   {
-    return pcd_collision::run (argc, argv);
+    const int status = pcd_collision::run (argc, argv);
+    pcd_collision::flushResults ();  // what else went to stdout (the help)
+    return status;
   }
   catch (const pcd_collision::Failure& f)
   {

@@ -497,6 +497,37 @@ TEST_F (PcdCollisionTool, TheDemoAnswersTheDocsQuote)
   }
 }
 
+// Results that cannot be written (a full disk: /dev/full) fail the run with exit 1 and a message,
+// in each output mode, the first failed line ending a batch; the help alike. Until 2026-12-06 the
+// tool exited 0 with its answers lost.
+TEST_F (PcdCollisionTool, AResultThatCannotBeWrittenFailsTheRun)
+{
+  ASSERT_TRUE (fs::exists ("/dev/full"));
+  const std::vector<std::vector<std::string>> runs = {
+      {kGripper.string (), kScene.string (), "-poses", kPoses.string ()},
+      {kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-json"},
+      {kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0"},
+      {"-h"},
+  };
+  for (const auto& args : runs)
+  {
+    std::string cmd = quote (kExe);
+    for (const auto& arg : args)
+      cmd += " " + quote (arg);
+    SCOPED_TRACE (cmd);
+    const fs::path err = io_ / "stderr";
+    const int w = std::system ((cmd + " > /dev/full 2> " + quote (err.string ()) + " < /dev/null").c_str ());
+    ASSERT_TRUE (WIFEXITED (w));
+    EXPECT_EQ (WEXITSTATUS (w), 1);
+    const std::string message = readFile (err);
+    EXPECT_NE (message.find ("pcd_collision: error: cannot write the results to standard output: "), std::string::npos)
+        << message;
+    // One message: a batch stops at its first line lost.
+    const std::size_t first = message.find ("cannot write");
+    EXPECT_EQ (message.find ("cannot write", first + 1), std::string::npos) << message;
+  }
+}
+
 TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
 {
   // Far apart: no leaf pair, no witness; every field must still be valid JSON.
