@@ -490,6 +490,7 @@ dumpCell (const Options& o, const Density& den, double pct, double sigma, const 
           << ' ' << ypr[1] << ' ' << ypr[0] << "  # " << i << ' ' << cell.set[i] << ' ' << cell.poses[i].signed_distance
           << '\n';
   }
+  poses.close ();
   if (!poses)
     throw std::runtime_error ("cannot write " + stem + "_poses.txt");
 }
@@ -884,6 +885,7 @@ writeFile (const std::string& path, const std::string& text)
   {
     std::ofstream f (tmp);
     f << text;
+    f.close ();  // the last buffer's write can fail too (a full disk)
     if (!f)
       throw std::runtime_error ("cannot write " + tmp);
   }
