@@ -22,6 +22,7 @@
 #include <cstring>
 #include <fstream>
 #include <exception>
+#include <filesystem>
 #include <iterator>
 #include <mutex>
 #include <string>
@@ -327,6 +328,40 @@ readVtkLegacy (const std::string& path, std::vector<std::array<double, 3>>& vert
     return fail ("no vertex");
   return true;
 }
+
+/** \brief A binary STL is as long as its header says: 80 bytes, a little-endian uint32 triangle
+  * count n, 50 bytes a triangle. VTK's reader reads what is there and says nothing: a cut file
+  * lost its last triangles, a count of 1,000 over 12 triangles was taken, and trailing bytes were
+  * read as a vertex. A file that begins with "solid" and whose first bytes are text is ASCII STL,
+  * which VTK's reader checks itself (a binary file may begin with "solid" too: its size decides). */
+bool
+checkStlSize (const std::string& path, std::string& error)
+{
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size (path, ec);
+  if (ec)
+    return true;  // left to the reader, which names the failure
+  std::ifstream in (path, std::ios::binary);
+  unsigned char head[84] = {};
+  in.read (reinterpret_cast<char*> (head), sizeof head);
+  const std::size_t got = static_cast<std::size_t> (in.gcount ());
+  const std::uint32_t n = static_cast<std::uint32_t> (head[80]) | static_cast<std::uint32_t> (head[81]) << 8 |
+                          static_cast<std::uint32_t> (head[82]) << 16 | static_cast<std::uint32_t> (head[83]) << 24;
+  const std::uintmax_t expected = 84 + std::uintmax_t{50} * n;
+  if (got == sizeof head && bytes == expected)
+    return true;
+  const bool text = got >= 5 && std::memcmp (head, "solid", 5) == 0 &&
+                    std::all_of (head, head + got, [] (unsigned char c) { return c >= 32 || std::isspace (c); });
+  if (text)
+    return true;
+  error = "'" + path + "' is not a readable stl mesh (" +
+          (got < sizeof head ? std::string ("shorter than a binary STL's 84-byte header, and no ASCII 'solid'")
+                             : "a binary STL of " + std::to_string (n) + " triangles by its header, " +
+                                   std::to_string (expected) + " bytes, but the file has " + std::to_string (bytes) +
+                                   ": truncated or corrupt") +
+          ")";
+  return false;
+}
 } // namespace
 
 bool
@@ -392,7 +427,11 @@ loadTriangleMesh (const std::string& path, TriangleMesh& mesh, std::string& erro
         read = pcl::io::loadPLYFile (path, polygon_mesh) >= 0;
       }
       else
+      {
+        if (!checkStlSize (path, error))
+          return false;
         read = pcl::io::loadPolygonFileSTL (path, polygon_mesh) > 0;
+      }
     }
     catch (const std::exception& e)  // e.g. std::bad_alloc (a negative count did it before the header check)
     {

@@ -31,15 +31,20 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <future>
 #include <fstream>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace py = pybind11;
@@ -144,6 +149,11 @@ fillCovariances (const py::array& arr, pcl::PointCloud<Covariance>& covs)
         for (int c = r + 1; c < 3; ++c)
           if (std::abs (m (r, c) - m (c, r)) > 1e-6 * (std::abs (m (r, c)) + std::abs (m (c, r))) + 1e-30)
             throw py::value_error ("covariances: matrix " + std::to_string (i) + " is not symmetric");
+    // float64 finite in double but beyond float: it would silently become Inf and its point be
+    // skipped, as a point's coordinate would (fillPoints).
+    if (m.allFinite () && !(m.cwiseAbs ().maxCoeff () <= static_cast<double> (std::numeric_limits<float>::max ())))
+      throw py::value_error ("covariances: matrix " + std::to_string (i) +
+                             " has an entry beyond the float range (covariances are stored as float32)");
     covs[static_cast<std::size_t> (i)] = m.allFinite () ? Covariance (m) : Covariance::nan ();
   }
 }
@@ -306,7 +316,7 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   if (ext != ".pcd" && ext != ".ply")
     throw py::value_error ("path: only .pcd and face-less .ply files are read, got '" + path.string () + "'");
   const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : castArgument<CloudModelParams> (params_obj, "params", "CloudModelParams");
-  const std::string name = name_obj.is_none () ? path.filename ().string () : name_obj.cast<std::string> ();
+  const std::string name = name_obj.is_none () ? path.filename ().string () : castArgument<std::string> (name_obj, "name", "str");
 
   // io::loadCloud is pcd_collision's reader: every check a file of unknown origin needs (PCL
   // 1.13's PCDReader crashes on a header without FIELDS), messages naming the file. With a
@@ -350,21 +360,45 @@ warnedModel (const CloudModel::ConstPtr& model)
   return std::const_pointer_cast<CloudModel> (model);
 }
 
-/** A 4x4 rigid transform from a 4x4 array or (R, t). */
+/** obj as a float64 array (a nested list too), or TypeError naming `what` for anything that is no
+  * array of real numbers: numpy's own cast would keep a complex number's real part (5j read as 0)
+  * and parse a string in an object array. `expected` says what was expected. */
+py::array_t<double, py::array::forcecast>
+realArray (const py::object& obj, const std::string& what, const std::string& expected)
+{
+  const py::array raw = py::array::ensure (obj);
+  if (!raw)
+  {
+    PyErr_Clear ();
+    throw py::type_error (what + ": expected " + expected + ", got " + typeName (obj));
+  }
+  const char kind = raw.dtype ().kind ();
+  if (raw.size () > 0 && kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::type_error (what + ": expected " + expected + " of real numbers, got dtype " +
+                          py::str (raw.dtype ()).cast<std::string> ());
+  auto a = py::array_t<double, py::array::forcecast>::ensure (raw);
+  if (!a)
+  {
+    PyErr_Clear ();
+    throw py::type_error (what + ": expected " + expected + ", got " + typeName (obj));
+  }
+  return a;
+}
+
+/** A 4x4 rigid transform from a 4x4 array (or nested list) or a pair (R, t). */
 Eigen::Isometry3d
 toPose (const py::object& obj, const char* arg)
 {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity ();
   const std::string expected = std::string (arg) + ": expected a 4x4 matrix or a pair (R, t), R 3x3 and t of 3";
-  if (py::isinstance<py::tuple> (obj) || py::isinstance<py::list> (obj))
+  // A pair is (R, t); any other sequence (a nested 4x4 list) is read as the matrix.
+  if ((py::isinstance<py::tuple> (obj) || py::isinstance<py::list> (obj)) && py::len (obj) == 2)
   {
     py::sequence seq = py::reinterpret_borrow<py::sequence> (obj);
-    if (seq.size () != 2)
-      throw py::value_error (expected + ", got a sequence of " + std::to_string (seq.size ()));
-    auto R = py::array_t<double, py::array::forcecast>::ensure (seq[0]);
+    const auto R = realArray (seq[0], arg, "R of a pair (R, t)");
     // C order: t may be a (3,), (3, 1) or (1, 3) view of a larger array (a column of a 4x4).
-    auto t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (seq[1]);
-    if (!R || !t)
+    const auto t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure (realArray (seq[1], arg, "t of a pair (R, t)"));
+    if (!t)
     {
       PyErr_Clear ();
       throw py::type_error (expected + ", got non-numeric entries");
@@ -381,12 +415,7 @@ toPose (const py::object& obj, const char* arg)
   }
   else
   {
-    auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
-    if (!a)
-    {
-      PyErr_Clear ();
-      throw py::type_error (expected + ", got " + typeName (obj));
-    }
+    const auto a = realArray (obj, arg, "a 4x4 matrix or a pair (R, t)");
     if (a.ndim () != 2 || a.shape (0) != 4 || a.shape (1) != 4)
       throw py::value_error (expected + ", got shape " + shapeOf (a));
     const auto r = a.unchecked<2> ();
@@ -500,16 +529,68 @@ poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool
   return T;
 }
 
+/** Runs work (a batch given the `ready` callback collideBatch calls after each pose) on a thread of
+  * its own, while the calling thread waits without the GIL and checks for signals every 50 ms:
+  * Ctrl-C stops the batch at its next pose (ready throws) and raises KeyboardInterrupt here, where
+  * a call of 60,000 poses went on for half a minute before. Signals reach the main thread only, so
+  * a call from another Python thread runs to its end, as before. */
+template <typename Work>
+void
+runInterruptibly (Work&& work)
+{
+  struct Interrupted
+  {
+  };
+  std::atomic<bool> stop{false};
+  const std::function<void (std::size_t)> ready = [&stop] (std::size_t) {
+    if (stop.load (std::memory_order_relaxed))
+      throw Interrupted{};
+  };
+  std::future<void> done;
+  try
+  {
+    done = std::async (std::launch::async, [&] { work (ready); });
+  }
+  catch (const std::system_error&)  // no thread to be had: the batch on this one, as before
+  {
+    py::gil_scoped_release release;
+    work (ready);
+    return;
+  }
+  for (;;)
+  {
+    bool finished = false;
+    {
+      py::gil_scoped_release release;
+      finished = done.wait_for (std::chrono::milliseconds (50)) == std::future_status::ready;
+    }
+    if (finished)
+      break;
+    if (PyErr_CheckSignals () != 0)  // a handler raised (KeyboardInterrupt): stop, then raise it
+    {
+      stop = true;
+      {
+        py::gil_scoped_release release;
+        done.wait ();
+      }
+      try
+      {
+        done.get ();
+      }
+      catch (...)  // Interrupted, or whatever else ended the batch: the signal's exception is raised
+      {
+      }
+      throw py::error_already_set ();
+    }
+  }
+  done.get ();
+}
+
 std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
              int threads)
 {
-  auto poses = py::array_t<double, py::array::forcecast>::ensure (poses_obj);
-  if (!poses)
-  {
-    PyErr_Clear ();
-    throw py::type_error ("poses: expected a numpy array of shape (M, 4, 4), got " + typeName (poses_obj));
-  }
+  const auto poses = realArray (poses_obj, "poses", "a numpy array of shape (M, 4, 4)");
   if (poses.ndim () != 3 || poses.shape (1) != 4 || poses.shape (2) != 4)
     throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (poses));
   checkThreads (threads);
@@ -519,10 +600,9 @@ collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, 
   for (py::ssize_t k = 0; k < p.shape (0); ++k)
     T[static_cast<std::size_t> (k)] = poseAt (p, k, false);
   std::vector<CollisionResult> results;
-  {
-    py::gil_scoped_release release;
-    collideBatch (*a, *b, T, request, results, threads);
-  }
+  runInterruptibly ([&] (const std::function<void (std::size_t)>& ready) {
+    collideBatch (*a, *b, T, request, results, threads, nullptr, ready);
+  });
   for (std::size_t k = 0; k < results.size (); ++k)
     if (results[k].status == CollisionResult::Status::InvalidInput)
       throw py::value_error ("poses[" + std::to_string (k) + "]: " + results[k].message);
@@ -729,11 +809,32 @@ meshOf (const py::object& vertices_obj, const py::object& triangles_obj)
   for (py::ssize_t i = 0; i < f.shape (0); ++i)
   {
     for (int d = 0; d < 3; ++d)
+    {
       if (f (i, d) < 0 || f (i, d) >= v.shape (0))
         throw py::value_error ("triangles: row " + std::to_string (i) + " refers to a missing vertex");
+      // A triangle's corners must be points the library takes (its coordinate range; a NaN
+      // would read as a spacing problem in sample_mesh).
+      const py::ssize_t j = static_cast<py::ssize_t> (f (i, d));
+      for (int c = 0; c < 3; ++c)
+        if (!(std::abs (v (j, c)) <= pcl_probcollision::detail::kMaxCoordinate))
+          throw py::value_error ("vertices: row " + std::to_string (j) + " (a corner of triangle " + std::to_string (i) +
+                                 ") is not finite or beyond the supported coordinate range of +-1e15");
+    }
     mesh.triangles.push_back ({static_cast<int> (f (i, 0)), static_cast<int> (f (i, 1)), static_cast<int> (f (i, 2))});
   }
   return mesh;
+}
+
+/** The sampler's refusal of a spacing as a Python message: it names pcd_collision's flag, which
+  * is `spacing` here. */
+std::string
+spacingError (const std::runtime_error& e)
+{
+  std::string why = e.what ();
+  const std::string flag = "raise -mesh_density";
+  if (const std::size_t at = why.find (flag); at != std::string::npos)
+    why.replace (at, flag.size (), "raise spacing");
+  return "spacing: " + why;
 }
 
 py::array_t<float>
@@ -770,12 +871,7 @@ readPoses (const std::filesystem::path& path)
 py::array_t<double>
 posesFromXyzRpy (const py::object& obj)
 {
-  auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
-  if (!a)
-  {
-    PyErr_Clear ();
-    throw py::type_error ("poses: expected a numeric array of shape (M, 6)");
-  }
+  const auto a = realArray (obj, "poses", "a numeric array of shape (M, 6)");
   if (a.ndim () != 2 || a.shape (1) != 6)
     throw py::value_error ("poses: expected shape (M, 6), got " + shapeOf (a));
   const auto p = a.unchecked<2> ();
@@ -783,7 +879,11 @@ posesFromXyzRpy (const py::object& obj)
   auto o = out.mutable_unchecked<3> ();
   for (py::ssize_t k = 0; k < p.shape (0); ++k)
   {
-    const Eigen::Isometry3d T = pcd_collision::poseTransform ({p (k, 0), p (k, 1), p (k, 2), p (k, 3), p (k, 4), p (k, 5)});
+    const pcd_collision::Pose pose = {p (k, 0), p (k, 1), p (k, 2), p (k, 3), p (k, 4), p (k, 5)};
+    // The rule of pcd_collision's -pose and read_poses: a NaN or a translation out of range is no pose.
+    if (const std::string why = pcd_collision::poseValueError (pose); !why.empty ())
+      throw py::value_error ("poses[" + std::to_string (k) + "]: " + why);
+    const Eigen::Isometry3d T = pcd_collision::poseTransform (pose);
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         o (k, i, j) = T.matrix () (i, j);
@@ -796,12 +896,7 @@ posesFromXyzRpy (const py::object& obj)
 py::array_t<double, py::array::forcecast>
 poseArray (const py::object& obj)
 {
-  auto a = py::array_t<double, py::array::forcecast>::ensure (obj);
-  if (!a)
-  {
-    PyErr_Clear ();
-    throw py::type_error ("poses: expected a numeric array of shape (M, 4, 4)");
-  }
+  const auto a = realArray (obj, "poses", "a numeric array of shape (M, 4, 4)");
   if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
     throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
   return a;
@@ -1506,7 +1601,8 @@ PYBIND11_MODULE (_core, m)
                               "median_spacing() of the points, read from the build's own neighbour search (the same number);\n"
                               "NaN when the build did not search the whole cloud (covariances given, merged samples) or cannot tell.")
       .def_property_readonly ("precision_ratio", &CloudModel::precisionRatio)
-      .def_property_readonly ("params", &CloudModel::params, "The CloudModelParams it was built with.")
+      .def_property_readonly ("params", [] (const CloudModel& c) { return c.params (); },
+                              "A copy of the CloudModelParams it was built with (the model is immutable).")
       .def_property_readonly ("has_surface", [] (const CloudModel& c) { return !c.surface ().empty (); },
                               "True when built with CloudModelParams.surface (the surface layer can query it).")
       .def_property_readonly ("surface_orientation",
@@ -1763,7 +1859,7 @@ PYBIND11_MODULE (_core, m)
            }
            catch (const std::runtime_error& e)  // the sampler's spacing checks: a ValueError here
            {
-             throw py::value_error (std::string ("spacing: ") + e.what ());
+             throw py::value_error (spacingError (e));
            }
            return cloudArray (cloud);
          },
@@ -1780,7 +1876,7 @@ PYBIND11_MODULE (_core, m)
            }
            catch (const std::runtime_error& e)  // the sampler's spacing checks: a ValueError here
            {
-             throw py::value_error (std::string ("spacing: ") + e.what ());
+             throw py::value_error (spacingError (e));
            }
            py::array_t<float> points ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});
            py::array_t<float> normals ({static_cast<py::ssize_t> (cloud.size ()), static_cast<py::ssize_t> (3)});

@@ -159,6 +159,17 @@ nonFiniteNumber (const std::string& text)
   return end == text.c_str () + text.size () && !std::isfinite (v);
 }
 
+/** \brief "is not an integer", or "is out of range" for a whole number beyond int's
+  * (99999999999999999999 is an integer). */
+std::string
+notAnInt (const std::string& text)
+{
+  const std::size_t first = !text.empty () && (text[0] == '+' || text[0] == '-') ? 1 : 0;
+  const bool whole = text.size () > first && text.find_first_not_of ("0123456789", first) == std::string::npos;
+  return whole ? "is out of range (at most " + std::to_string (std::numeric_limits<int>::max ()) + ")"
+               : "is not an integer";
+}
+
 /** \brief "is not a number", or "is not a finite number" for a non-finite one. */
 std::string
 notANumber (const std::string& text)
@@ -166,18 +177,22 @@ notANumber (const std::string& text)
   return nonFiniteNumber (text) ? "is not a finite number" : "is not a number";
 }
 
-/** \brief Why a pose's translation is out of the library's range (detail::kMaxCoordinate, the
-  * bound collide() enforces), so that the command line refuses it where it is read; empty if
-  * none. Finite angles always give a rotation. */
+} // namespace
+
 std::string
-translationRangeError (const Pose& pose)
+poseValueError (const Pose& pose)
 {
-  for (int i = 0; i < 3; ++i)
-    if (!(std::abs (pose[static_cast<std::size_t> (i)]) <= pcl_probcollision::detail::kMaxCoordinate))
+  static const char* const kNames[6] = {"tx", "ty", "tz", "roll", "pitch", "yaw"};
+  for (std::size_t i = 0; i < 6; ++i)
+    if (!std::isfinite (pose[i]))
+      return std::string (kNames[i]) + " is not a finite number";
+  // The bound collide() enforces, refused where the pose is read. Finite angles always give a
+  // rotation.
+  for (std::size_t i = 0; i < 3; ++i)
+    if (!(std::abs (pose[i]) <= pcl_probcollision::detail::kMaxCoordinate))
       return "translation beyond the supported range of +-1e15";
   return std::string ();
 }
-} // namespace
 
 Eigen::Isometry3d
 poseTransform (const Pose& p)
@@ -240,7 +255,7 @@ parsePoseLine (const std::string& line, Pose& pose, std::string& error)
       return -1;
     }
   }
-  error = translationRangeError (pose);
+  error = poseValueError (pose);
   return error.empty () ? 1 : -1;
 }
 
@@ -440,10 +455,24 @@ parseCommandLine (const std::vector<std::string>& args)
     {
       std::vector<double> vals;
       if (!parseDoubleList (v, 6, vals))
+      {
+        // Six values, one of them no number: name it (-pose 0,0,0,0,0,nan has six numbers' shape).
+        std::vector<std::string> items (1);
+        for (const char c : v)
+          if (c == ',')
+            items.emplace_back ();
+          else
+            items.back ().push_back (c);
+        double unused = 0.0;
+        for (std::size_t i = 0; items.size () == 6 && i < 6; ++i)
+          if (!parseDouble (items[i], unused))
+            return usage (bad + "value " + std::to_string (i + 1) + " '" + items[i] + "' " + notANumber (items[i]) +
+                          " (tx,ty,tz,roll,pitch,yaw)");
         return usage (bad + "must be six comma-separated numbers tx,ty,tz,roll,pitch,yaw");
+      }
       Pose p{};
       std::copy (vals.begin (), vals.end (), p.begin ());
-      if (const std::string why = translationRangeError (p); !why.empty ())
+      if (const std::string why = poseValueError (p); !why.empty ())  // finite: parseDoubleList
         return usage (bad + "has a " + why);
       o.pose = p;
     }
@@ -456,7 +485,7 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-threads")
     {
       if (!parseInt (v, o.threads))
-        return usage (bad + "is not an integer");
+        return usage (bad + notAnInt (v));
       if (const std::string why = pcl_probcollision::detail::threadsRangeError (o.threads); !why.empty ())
         return usage (bad + why);
     }
@@ -484,7 +513,7 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-k")
     {
       if (!parseInt (v, o.k))
-        return usage (bad + "is not an integer");
+        return usage (bad + notAnInt (v));
       if (o.k < 1)
         return usage (bad + "must be >= 1");
     }
@@ -510,7 +539,7 @@ parseCommandLine (const std::vector<std::string>& args)
     else if (a == "-nmax")
     {
       if (!parseInt (v, o.n_max))
-        return usage (bad + "is not an integer");
+        return usage (bad + notAnInt (v));
       if (o.n_max < 1)
         return usage (bad + "must be >= 1");
     }

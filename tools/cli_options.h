@@ -27,6 +27,11 @@ using Pose = std::array<double, 6>;
   * -pose and -poses, and Python's poses_from_xyzrpy. */
 Eigen::Isometry3d poseTransform (const Pose& pose);
 
+/** \brief Why six numbers are no pose the tool takes: a value that is not finite, or a
+  * translation beyond the library's range (detail::kMaxCoordinate); empty if none. The rule of
+  * -pose, -poses and Python's poses_from_xyzrpy. */
+std::string poseValueError (const Pose& pose);
+
 /** \brief The defaults of the options, shown by helpText(). The library's settings are read
   * from the structs that own them (CloudModelParams, BVHParams, CollisionRequest); only what
   * the tool decides itself is written here. */

@@ -1444,3 +1444,97 @@ def test_organized_sensor_pose_finds_the_sensor_of_a_moved_image(tmp_path):
         pc.build_model(np.zeros((4, 5, 4)))
     with pytest.raises(ValueError, match=r"normals: expected shape"):
         pc.build_model(moved, params=params, normals=np.zeros((48, 64, 2)))
+
+
+# --- The probe of 2026-12-06 (docs/RELIABILITY.md, "Found and fixed (2026-12-06)") ---------------
+
+INTERRUPTED_BATCH = """
+import sys
+import numpy as np
+import pcl_probcollision as pc
+
+if __name__ == "__main__":
+    table = pc.load_model(sys.argv[1], pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.005)))
+    poses = np.repeat(np.eye(4)[None], 1000, axis=0)  # exhaustive self-queries: minutes in all
+    print("start", flush=True)
+    pc.collide_batch(table, table, poses, pc.CollisionRequest(exhaustive=True), threads=int(sys.argv[2]))
+    print("done", flush=True)
+"""
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_ctrl_c_stops_a_batch(tmp_path, table_path, threads):
+    # The batch takes minutes uninterrupted (about 0.2 s a pose); SIGINT must end it at the next
+    # pose with KeyboardInterrupt (it went on to the end before: half a minute for the probe's).
+    import signal
+    import subprocess
+    import sys
+    script = tmp_path / "batch.py"
+    script.write_text(INTERRUPTED_BATCH)
+    p = subprocess.Popen([sys.executable, str(script), str(table_path), str(threads)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout.readline().strip() == "start"
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)  # a hang bound, far under the batch's minutes
+    finally:
+        p.kill()
+    assert "done" not in out
+    assert "KeyboardInterrupt" in err, err
+    assert p.returncode != 0
+
+
+def test_model_params_are_a_copy(table):
+    # A live reference let a built model report parameters it was not built with.
+    params = table.params
+    params.k = 3
+    params.n_max = 1
+    assert table.params.k == NOISE.k and table.params.n_max == NOISE.n_max
+
+
+def test_load_model_refuses_a_name_that_is_no_string(table_path):
+    for name in (123, ["a"]):
+        with pytest.raises(TypeError, match="name: expected str"):
+            pc.load_model(table_path, NOISE, name=name)
+
+
+def test_covariances_beyond_the_float_range_are_refused():
+    points = patch(n=10)
+    cov = np.tile(np.eye(3) * 1e-6, (100, 1, 1))
+    cov[5, 0, 0] = 1e45  # finite, but Inf as float32: its point was dropped without a word
+    with pytest.raises(ValueError, match="covariances: matrix 5 has an entry beyond the float range"):
+        pc.build_model(points, covariances=cov, params=NOISE)
+
+
+@pytest.mark.parametrize("row, words", [
+    ([np.nan, 0, 0, 0, 0, 0], "tx is not a finite number"),
+    ([0, 0, 0, np.inf, 0, 0], "roll is not a finite number"),
+    ([1e300, 0, 0, 0, 0, 0], "translation beyond the supported range"),
+])
+def test_poses_from_xyzrpy_refuses_what_read_poses_refuses(row, words):
+    with pytest.raises(ValueError, match=r"poses\[1\]: " + words):
+        pc.poses_from_xyzrpy([[0, 0, 0, 0, 0, 0], row])
+
+
+def test_sample_mesh_names_a_vertex_it_cannot_take():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    triangles = np.array([[0, 1, 2]])
+    for bad in (np.nan, 1e300):
+        v = vertices.copy()
+        v[1, 2] = bad
+        with pytest.raises(ValueError, match=r"vertices: row 1 \(a corner of triangle 0\)"):
+            pc.sample_mesh(v, triangles, 0.01)
+    with pytest.raises(ValueError, match="raise spacing$"):  # not pcd_collision's -mesh_density
+        pc.sample_mesh(vertices, triangles, 1e-9)
+
+
+def test_poses_must_hold_real_numbers(table):
+    T = np.eye(4)
+    assert pc.collide(table, table, T.tolist()).probability == pc.collide(table, table, T).probability
+    for bad in (T * (1 + 0j), T.astype(object)):
+        with pytest.raises(TypeError, match="real numbers"):
+            pc.collide(table, table, bad)
+        with pytest.raises(TypeError, match="real numbers"):
+            pc.collide_batch(table, table, bad[None])
+    with pytest.raises(TypeError, match="real numbers"):
+        pc.poses_from_xyzrpy(np.zeros((1, 6), dtype=complex))

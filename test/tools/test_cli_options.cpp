@@ -305,6 +305,14 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-noise_resolution_gate", "somewhere"}, "-noise_resolution_gate");
   expectUsageError ({"-noise_stop", "-0.5"}, "-noise_stop");
   expectUsageError ({"-noise_stop", "nan"}, "-noise_stop");
+  // A whole number beyond int is out of range, not "not an integer"; the value of -pose that is
+  // no number is named (the probe of 2026-12-06).
+  expectUsageError ({"-k", "99999999999999999999"}, "option -k: '99999999999999999999' is out of range (at most 2147483647)");
+  expectUsageError ({"-nmax", "4294967297"}, "option -nmax: '4294967297' is out of range");
+  expectUsageError ({"-threads", "-99999999999"}, "option -threads: '-99999999999' is out of range");
+  expectUsageError ({"-k", "2.5"}, "option -k: '2.5' is not an integer");
+  expectUsageError ({"-pose", "0,0,0,0,0,nan"}, "option -pose: '0,0,0,0,0,nan' value 6 'nan' is not a finite number");
+  expectUsageError ({"-pose", "0,0,x,0,0,0"}, "value 3 'x' is not a number (tx,ty,tz,roll,pitch,yaw)");
 }
 
 TEST (CliOptions, FlagsAndPositionals)

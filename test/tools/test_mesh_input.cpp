@@ -261,3 +261,58 @@ TEST_F (MeshInput, AMeshWhoseTrianglesHaveNoAreaIsRefused)
   EXPECT_FALSE (pcl_probcollision::io::loadTriangleMesh ((dir_ / "line.obj").string (), mesh, error));
   EXPECT_NE (error.find ("line.obj' has no triangle with an area (2 triangles"), std::string::npos) << error;
 }
+
+// A binary STL must be as long as its header says (80 bytes, a triangle count, 50 bytes a
+// triangle): VTK's reader took a cut file (a triangle lost), a count of 1,000 over 12 triangles
+// and trailing bytes (read as a vertex) without a word (the probe of 2026-12-06). An 80-byte
+// header that begins with "solid", as some exporters write, is still binary when the size fits.
+TEST_F (MeshInput, ABinaryStlMustBeAsLongAsItsHeaderSays)
+{
+  const auto binaryStl = [] (const std::string& header, std::uint32_t count, std::size_t triangles) {
+    std::string bytes = header;
+    bytes.resize (80, ' ');
+    for (int shift = 0; shift < 32; shift += 8)
+      bytes.push_back (static_cast<char> ((count >> shift) & 0xffu));
+    for (std::size_t t = 0; t < triangles; ++t)
+    {
+      // Normal, then the corners (0,0,t) (1,0,t) (0,1,t) as little-endian floats, then 2 bytes.
+      const float values[12] = {0, 0, 1, 0, 0, float (t), 1, 0, float (t), 0, 1, float (t)};
+      bytes.append (reinterpret_cast<const char*> (values), sizeof values);
+      bytes.append (2, '\0');
+    }
+    return bytes;
+  };
+  const std::string whole = binaryStl ("binary", 12, 12);
+  const struct
+  {
+    const char* name;
+    std::string bytes;
+    const char* message;  // empty: read
+  } cases[] = {
+      {"whole.stl", whole, ""},
+      {"solid_header.stl", binaryStl ("solid exported", 12, 12), ""},
+      {"cut.stl", whole.substr (0, whole.size () - 30), "a binary STL of 12 triangles by its header, 684 bytes, but the file has 654"},
+      {"count.stl", binaryStl ("binary", 1000, 12), "a binary STL of 1000 triangles by its header, 50084 bytes, but the file has 684"},
+      {"trailing.stl", whole + std::string (100, 'x'), "but the file has 784: truncated or corrupt"},
+      {"short.stl", "abc", "shorter than a binary STL's 84-byte header"},
+  };
+  for (const auto& c : cases)
+  {
+    SCOPED_TRACE (c.name);
+    test_files::writeFile (dir_ / c.name, c.bytes);
+    TriangleMesh mesh;
+    std::string error;
+    const bool ok = pcl_probcollision::io::loadTriangleMesh ((dir_ / c.name).string (), mesh, error);
+    if (std::string (c.message).empty ())
+    {
+      EXPECT_TRUE (ok) << error;
+      EXPECT_EQ (mesh.triangles.size (), 12u);
+    }
+    else
+    {
+      EXPECT_FALSE (ok);
+      EXPECT_NE (error.find (c.message), std::string::npos) << error;
+      EXPECT_NE (error.find (c.name), std::string::npos) << error;
+    }
+  }
+}
