@@ -228,6 +228,29 @@ TEST (SurfaceModel, GivenNormalsAreKeptEvenInsideOut)
   EXPECT_NEAR (s.windingNumber (model->hierarchy (), Eigen::Vector3d (0.3, 0.0, 0.0)), 0.0, 0.05);
 }
 
+// Normals of any finite length are taken (the surface model normalises them): the same orientation
+// and the same answer as unit ones, at lengths 1e20 and 1e-20, whose float length overflows or
+// leaves float's normal range (until 2026-12-06 such normals were set aside and the surface
+// propagated: a probe's finding).
+TEST (SurfaceModel, NormalsOfAnyFiniteLengthAreTaken)
+{
+  const auto unit = sphere (200, 0.1, Eigen::Vector3d::Zero ());
+  const auto reference = buildCloudModel (unit, withSurface ());
+  ASSERT_EQ (reference->surface ().orientation (), NormalOrientation::PointNormals);
+  const Eigen::Vector3d probe (0.0, 0.0, 0.095);  // just inside the sphere
+  const double inside = reference->surface ().windingNumber (reference->hierarchy (), probe);
+  for (const float scale : {1e20f, 1e-20f})
+  {
+    SCOPED_TRACE (scale);
+    auto scaled = unit;
+    for (auto& p : scaled.points)
+      p.getNormalVector3fMap () *= scale;
+    const auto model = buildCloudModel (scaled, withSurface ());
+    EXPECT_EQ (model->surface ().orientation (), NormalOrientation::PointNormals);
+    EXPECT_NEAR (model->surface ().windingNumber (model->hierarchy (), probe), inside, 1e-6);
+  }
+}
+
 // NaN or zero marks "no normal"; an infinite component is a broken normal, refused by point
 // (it read as "none" until 2026-12-04), and only where the surface model reads normals.
 TEST (SurfaceModel, AnInfiniteNormalIsRefusedByPoint)

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <future>
 #include <memory>
 #include <sstream>
@@ -54,9 +55,11 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   auto at = [&] (std::size_t j) { return indices ? (*indices)[j] : static_cast<int> (j); };
   // A point's own normal, as the surface model takes it: finite and not zero (point types with
   // normals only).
+  // Its length in double: in float a normal of length 1e20 (or 1e-20) overflowed (underflowed)
+  // on the way to unit length and was set aside.
   const auto usableNormal = [] (const auto& p) {
-    const Eigen::Vector3f given (p.normal_x, p.normal_y, p.normal_z);
-    return given.allFinite () && given.squaredNorm () > 0.0f;
+    const Eigen::Vector3d given = Eigen::Vector3f (p.normal_x, p.normal_y, p.normal_z).template cast<double> ();
+    return given.allFinite () && given.squaredNorm () > 0.0;
   };
 
   // Finite but absurd coordinates overflow the float arithmetic of the k-d tree (FLANN's middle
@@ -408,7 +411,13 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
         const PointT& pt = cloud[at (kept_slots[p])];
         if (usableNormal (pt))
         {
-          in.normals[p] = Eigen::Vector3f (pt.normal_x, pt.normal_y, pt.normal_z);
+          // As given (its bits: the surface model normalises it); rescaled in double only where
+          // its float length overflows or leaves float's normal range.
+          const Eigen::Vector3f given (pt.normal_x, pt.normal_y, pt.normal_z);
+          const float length2 = given.squaredNorm ();
+          in.normals[p] = std::isfinite (length2) && length2 >= std::numeric_limits<float>::min ()
+                              ? given
+                              : Eigen::Vector3f (given.cast<double> ().normalized ().cast<float> ());
           in.given[p] = 1;
         }
       }
