@@ -64,7 +64,8 @@ fieldSize (std::uint8_t datatype)
     default: return 0;
   }
 }
-/** \brief Whether strtod reads the whole word as a number (nan and inf included), and which. */
+/** \brief Whether strtod reads the whole word as a number (nan and inf included), and which.
+  * strtod's hex forms ("0x10", "0x1p-3") are not numbers: PCL's reader reads them as 0. */
 bool
 wholeNumber (const std::string& word, double* value = nullptr)
 {
@@ -72,47 +73,140 @@ wholeNumber (const std::string& word, double* value = nullptr)
   const double v = std::strtod (word.c_str (), &end);
   if (value)
     *value = v;
-  return !word.empty () && end == word.c_str () + word.size ();
+  return !word.empty () && end == word.c_str () + word.size () && word.find_first_of ("xX") == std::string::npos;
+}
+
+/** \brief Whether a word of an ascii PCD line, read by strtod as value (erange: strtod's
+  * ERANGE), keeps its value in the field as PCL's ascii reader reads it; if not, why ("is not an
+  * integer within ..."). An integer field takes a whole number within its type's range (PCL read
+  * "300" in a U 1 field as 44 and "1.5" in an I field as 1), a float one a number within its
+  * range, nan and inf included (PCL read 1e39 in a float32 field as Inf: the point was dropped as
+  * non-finite). */
+bool
+fieldValue (const char* word, std::size_t length, double value, bool erange, const pcl::PCLPointField& field,
+            std::string& why)
+{
+  long long low = 0, high = 0;
+  const char* type = nullptr;  // TYPE and SIZE
+  switch (field.datatype)
+  {
+    case pcl::PCLPointField::INT8: low = -128; high = 127; type = "I SIZE 1"; break;
+    case pcl::PCLPointField::UINT8: high = 255; type = "U SIZE 1"; break;
+    case pcl::PCLPointField::INT16: low = -32768; high = 32767; type = "I SIZE 2"; break;
+    case pcl::PCLPointField::UINT16: high = 65535; type = "U SIZE 2"; break;
+    case pcl::PCLPointField::INT32: low = -2147483648LL; high = 2147483647LL; type = "I SIZE 4"; break;
+    case pcl::PCLPointField::UINT32: high = 4294967295LL; type = "U SIZE 4"; break;
+    case pcl::PCLPointField::INT64:
+      low = std::numeric_limits<long long>::min ();
+      high = std::numeric_limits<long long>::max ();
+      type = "I SIZE 8";
+      break;
+    case pcl::PCLPointField::UINT64: type = "U SIZE 8"; break;
+    case pcl::PCLPointField::FLOAT32:
+      // From 2^128 - 2^103 on (FLT_MAX and half its last place) a number rounds to Inf as a float.
+      if (!(std::isfinite (value) && std::abs (value) >= 0x1.ffffffp+127) && !(std::isinf (value) && erange))
+        return true;
+      why = "is beyond the float range of field '" + field.name + "' (TYPE F SIZE 4)";
+      return false;
+    case pcl::PCLPointField::FLOAT64:
+      if (!(std::isinf (value) && erange))  // "inf" itself sets no ERANGE
+        return true;
+      why = "is beyond the double range of field '" + field.name + "' (TYPE F SIZE 8)";
+      return false;
+    default:
+      return true;  // bool, or a type PCL's reader skips
+  }
+  char* end = nullptr;
+  errno = 0;
+  bool ok = false;
+  if (field.datatype == pcl::PCLPointField::UINT64)
+    ok = word[0] != '-' && (std::strtoull (word, &end, 10), end == word + length) && errno == 0;  // strtoull takes "-1"
+  else
+  {
+    const long long v = std::strtoll (word, &end, 10);
+    ok = end == word + length && errno == 0 && v >= low && v <= high;
+  }
+  if (!ok)
+    why = "is not an integer within the range of field '" + field.name + "' (TYPE " + type + ": " +
+          (field.datatype == pcl::PCLPointField::UINT64 ? std::string ("0 to 18446744073709551615")
+                                                        : std::to_string (low) + " to " + std::to_string (high)) +
+          ")";
+  return ok;
 }
 
 /** \brief For a PCD with DATA ascii: every value of its first `points` data lines a number, as
-  * strtod reads it whole (nan and inf included), and `values` of them a line (the header's
-  * COUNTs summed), or `values_unpadded` (those of padding fields "_" left out: PCL's writer
-  * leaves them out of an ascii file, its reader skips their places), the rest of the file unread. PCL's reader reads a value that is not a number
-  * ("abc") as 0, one with trailing garbage ("1.5x") as its numeric start, and a missing value as
-  * 0 (a short line became a point at the origin), and says nothing. */
+  * strtod reads it whole (nan and inf included; hex forms not), and as many of them a line as the
+  * fields' COUNTs, with or without those of padding fields "_" (PCL's writer leaves them out of an
+  * ascii file, its reader skips their places), each a value its field keeps (fieldValue), the rest
+  * of the file unread. PCL's reader reads a value that is not a number ("abc") as 0, one with
+  * trailing garbage ("1.5x") as its numeric start, and a missing value as 0 (a short line became a
+  * point at the origin), and says nothing. fields are the header's as PCL's readHeader read them. */
 bool
-checkAsciiValues (const std::string& path, std::size_t points, std::size_t values, std::size_t values_unpadded,
+checkAsciiValues (const std::string& path, std::size_t points, const std::vector<pcl::PCLPointField>& fields,
                   std::string& error)
 {
+  std::size_t values = 0, values_unpadded = 0;
+  for (const pcl::PCLPointField& f : fields)
+  {
+    values += std::max<std::size_t> (1, f.count);
+    values_unpadded += f.name == "_" ? 0 : std::max<std::size_t> (1, f.count);
+  }
+  struct Word
+  {
+    std::size_t begin, end;  // in the line
+    double value;
+    bool erange;
+  };
+  std::vector<Word> words;
   std::ifstream in (path, std::ios::binary);
-  std::string line;
+  std::string line, why;
   std::size_t line_number = 0;
   bool in_data = false;
-  for (std::size_t read = 0; read < points && std::getline (in, line);)
+  std::size_t read = 0;
+  for (; read < points && std::getline (in, line);)
   {
     ++line_number;
     if (!in_data)
     {
-      in_data = line.compare (0, 4, "DATA") == 0;
+      const std::size_t first = line.find_first_not_of (" \t\r");  // PCL reads a keyword after blanks
+      in_data = first != std::string::npos && line.compare (first, 4, "DATA") == 0;
       continue;
     }
-    std::istringstream words (line);
-    std::string word;
-    bool any = false;
-    std::size_t column = 0;
-    while (words >> word)
+    const auto where = [&] (std::size_t k) {
+      return "'" + path + "' line " + std::to_string (line_number) + ", value " + std::to_string (k + 1) + ": '" +
+             line.substr (words[k].begin, words[k].end - words[k].begin) + "' ";
+    };
+    // The words between blanks, each read once (a blank after it made its end for strtod).
+    words.clear ();
+    line.push_back ('\0');
+    for (std::size_t i = 0; i < line.size () - 1;)
     {
-      ++column;
-      any = true;
-      if (!wholeNumber (word))
+      if (std::isspace (static_cast<unsigned char> (line[i])))
       {
-        error = "'" + path + "' line " + std::to_string (line_number) + ", value " + std::to_string (column) + ": '" +
-                word + "' is not a number";
+        ++i;
+        continue;
+      }
+      std::size_t j = i;
+      while (j < line.size () - 1 && !std::isspace (static_cast<unsigned char> (line[j])))
+        ++j;
+      const char blank = line[j];
+      line[j] = '\0';
+      char* end = nullptr;
+      errno = 0;
+      const double v = std::strtod (line.c_str () + i, &end);
+      const bool number = end == line.c_str () + j && std::memchr (line.c_str () + i, 'x', j - i) == nullptr &&
+                          std::memchr (line.c_str () + i, 'X', j - i) == nullptr;
+      words.push_back ({i, j, v, errno == ERANGE});
+      line[j] = blank;
+      if (!number)  // as wholeNumber: strtod's hex forms are not numbers
+      {
+        error = where (words.size () - 1) + "is not a number";
         return false;
       }
+      i = j;
     }
-    if (any && column != values && column != values_unpadded)
+    const std::size_t column = words.size ();
+    if (column > 0 && column != values && column != values_unpadded)
     {
       error = "'" + path + "' line " + std::to_string (line_number) + ": " + std::to_string (column) + " value" +
               (column == 1 ? "" : "s") + ", expected " + std::to_string (values_unpadded) +
@@ -120,46 +214,283 @@ checkAsciiValues (const std::string& path, std::size_t points, std::size_t value
               " (its header's FIELDS and COUNT)";
       return false;
     }
-    read += any ? 1 : 0;  // PCL skips blank lines
+    // Each value against its field; a padding field's values, when the line has them, PCL skips.
+    std::size_t k = 0;
+    for (const pcl::PCLPointField& f : fields)
+    {
+      const bool padding = f.name == "_";
+      if (padding && column != values)
+        continue;
+      for (std::size_t c = 0; c < std::max<std::size_t> (1, f.count) && k < column; ++c, ++k)
+        if (!padding && !fieldValue (line.c_str () + words[k].begin, words[k].end - words[k].begin, words[k].value,
+                                     words[k].erange, f, why))
+        {
+          error = where (k) + why;
+          return false;
+        }
+    }
+    read += column > 0 ? 1 : 0;  // PCL skips blank lines
+  }
+  if (in_data && read < points)  // PCL's reader: "could not be read", no line named
+  {
+    error = "'" + path + "' is truncated: it ends at line " + std::to_string (line_number) + ", after " +
+            std::to_string (read) + " of the " + std::to_string (points) + " points its header announces";
+    return false;
   }
   return true;
 }
 
-/** \brief A PCD header's VIEWPOINT line, if any, holds seven finite numbers (tx ty tz qw qx qy
-  * qz). PCL's reader stops at a value it cannot read ("nan", "inf") and leaves the sensor origin
-  * at 0 0 0 and the rest of the quaternion uninitialised, without a word: the orientation
-  * toward the viewpoint and `-o`'s header then rest on garbage. */
+/** \brief A PCD header's VIEWPOINT line (its words after the keyword) holds seven finite
+  * numbers within the float range (tx ty tz qw qx qy qz). PCL's reader stops at a value it cannot
+  * read ("nan", "inf", "1e39") and leaves the sensor origin at 0 0 0 and the rest of the
+  * quaternion uninitialised, without a word: the orientation toward the viewpoint and `-o`'s
+  * header then rest on garbage; with fewer than seven it refuses the whole header, unexplained. */
 bool
-checkViewpoint (const std::string& path, std::string& error)
+checkViewpoint (const std::string& path, std::size_t line_number, const std::vector<std::string>& words,
+                std::string& error)
 {
-  std::ifstream in (path, std::ios::binary);
-  std::string line;
-  for (std::size_t line_number = 1; std::getline (in, line) && line.compare (0, 4, "DATA") != 0; ++line_number)
+  for (std::size_t column = 1; column < words.size (); ++column)
   {
-    if (line.compare (0, 9, "VIEWPOINT") != 0)
-      continue;
-    std::istringstream words (line.substr (9));
-    std::string word;
-    std::size_t column = 0;
-    while (words >> word)
+    double value = 0.0;
+    const std::string& word = words[column];
+    if (!wholeNumber (word, &value) || !std::isfinite (value) || std::isinf (std::strtof (word.c_str (), nullptr)))
     {
-      ++column;
-      double value = 0.0;
-      if (!wholeNumber (word, &value) || !std::isfinite (value))
-      {
-        error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT value " + std::to_string (column) +
-                " '" + word + "' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)";
-        return false;
-      }
-    }
-    if (column != 7)
-    {
-      error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT has " + std::to_string (column) +
-              " values, expected 7 (tx ty tz qw qx qy qz)";
+      error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT value " + std::to_string (column) +
+              " '" + word + "' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)";
       return false;
     }
   }
+  if (words.size () != 8)
+  {
+    error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT has " + std::to_string (words.size () - 1) +
+            " values, expected 7 (tx ty tz qw qx qy qz)";
+    return false;
+  }
   return true;
+}
+
+/** \brief a x b, or the largest std::uint64_t where that overflows (a size no file reaches). */
+std::uint64_t
+product (std::uint64_t a, std::uint64_t b)
+{
+  return b != 0 && a > std::numeric_limits<std::uint64_t>::max () / b ? std::numeric_limits<std::uint64_t>::max ()
+                                                                         : a * b;
+}
+
+/** \brief Whether word is a whole number (digits only) of at most max, and which. */
+bool
+headerNumber (const std::string& word, std::uint64_t max, std::uint64_t& value)
+{
+  if (word.empty () || word.find_first_not_of ("0123456789") != std::string::npos)
+    return false;
+  errno = 0;
+  value = std::strtoull (word.c_str (), nullptr, 10);
+  return errno == 0 && value <= max;
+}
+
+/** \brief A PCD header, read as PCL's readHeader reads it (a line's keyword by its start, '#'
+  * comments and empty lines skipped, the header ending at its DATA line), checked before that
+  * reader sees it: readHeader sets aside POINTS x the point's bytes when it reads POINTS, before
+  * anything refuses the file (a 187-byte binary PCD claiming 1,000,000,000 points took 12 GB and
+  * 52 s to be refused; POINTS -5, or a negative SIZE or COUNT, ended in a bad_alloc or
+  * "vector::_M_default_append" naming no file). Refused, naming the file and the line: WIDTH,
+  * HEIGHT, POINTS, SIZE or COUNT values that are not whole numbers; POINTS other than WIDTH x
+  * HEIGHT; a DATA type other than ascii, binary or binary_compressed (PCL read "binaryX" as binary
+  * and any other word as ascii); a VIEWPOINT it cannot read (checkViewpoint); a header without a
+  * DATA line (PCL read its lines as points at the origin); and points the data after the header
+  * cannot hold: binary, POINTS x the point's bytes; ascii, a character a value, and no more than
+  * 8 bytes set aside a character (a value of a known type takes 8 bytes at most, and a separator
+  * besides its character); binary_compressed, the two little-endian uint32 after the header: the
+  * compressed size, which the file must hold, and the uncompressed one, which must be POINTS x
+  * the point's bytes and within what LZF unpacks from the compressed (at most 264 bytes from 3).
+  * Reads the header and, for binary_compressed, 8 bytes more. */
+bool
+checkPcdHeader (const std::string& path, std::string& error)
+{
+  std::error_code size_error;
+  const std::uint64_t file_size = std::filesystem::file_size (path, size_error);
+  if (size_error)
+    return true;  // unreadableFile let it through: PCL's reader reports it
+  std::ifstream in (path, std::ios::binary);
+  std::vector<std::string> names;
+  std::vector<std::uint64_t> sizes, counts;  // per field, as FIELDS defaults them (4, 1)
+  std::uint64_t point_step = 0, width = 0, height = 0, points = 0, set_aside = 0;
+  bool has_width = false, has_height = false, has_points = false;
+  std::size_t points_line = 0;
+  std::string line;
+  std::vector<std::string> w;
+  for (std::size_t number = 1; std::getline (in, line); ++number)
+  {
+    if (line.empty ())
+      continue;
+    w.clear ();
+    std::istringstream split (line);
+    for (std::string word; split >> word;)
+      w.push_back (word);
+    if (w.empty ())
+      break;  // blanks: no keyword, the end of PCL's header
+    const std::string& key = w[0];
+    const auto is = [&key] (const char* keyword) { return key.compare (0, std::strlen (keyword), keyword) == 0; };
+    const std::string where = "'" + path + "' line " + std::to_string (number) + ": ";
+    if (key[0] == '#' || is ("VERSION") || is ("TYPE"))
+      continue;
+    if (is ("FIELDS") || is ("COLUMNS"))
+    {
+      names.assign (w.begin () + 1, w.end ());
+      sizes.assign (names.size (), 4);
+      counts.assign (names.size (), 1);
+      point_step = 4 * names.size ();
+      continue;
+    }
+    if (is ("SIZE") || is ("COUNT"))
+    {
+      const bool size = is ("SIZE");
+      for (std::size_t k = 1; k < w.size (); ++k)
+      {
+        std::uint64_t v = 0;
+        if (!headerNumber (w[k], std::numeric_limits<int>::max (), v))  // PCL reads an int
+        {
+          error = where + (size ? "SIZE" : "COUNT") + " value " + std::to_string (k) + " '" + w[k] +
+                  "' is not a whole number >= 0";
+          return false;
+        }
+        if (k - 1 < names.size ())
+          (size ? sizes : counts)[k - 1] = v;
+      }
+      // PCL's point bytes: the SIZEs summed, then at COUNT each SIZE x COUNT.
+      point_step = 0;
+      for (std::size_t i = 0; i < names.size (); ++i)
+        point_step += sizes[i] * (size ? 1 : counts[i]);
+      continue;
+    }
+    if (is ("WIDTH") || is ("HEIGHT") || is ("POINTS"))
+    {
+      const bool point_count = is ("POINTS");
+      const std::string value = w.size () > 1 ? w[1] : std::string ();
+      std::uint64_t v = 0;
+      if (!headerNumber (value, point_count ? std::numeric_limits<std::uint64_t>::max () : 4294967295u, v))
+      {
+        error = where + (point_count ? "POINTS" : is ("WIDTH") ? "WIDTH" : "HEIGHT") + " '" + value +
+                "' is not a whole number " + (point_count ? ">= 0" : "from 0 to 4294967295");
+        return false;
+      }
+      if (point_count)
+      {
+        has_points = true;
+        points = v;
+        points_line = number;
+        set_aside = std::max (set_aside, product (points, point_step));
+      }
+      else if (is ("WIDTH"))
+      {
+        has_width = true;
+        width = v;
+      }
+      else
+      {
+        has_height = true;
+        height = v;
+      }
+      continue;
+    }
+    if (is ("VIEWPOINT"))
+    {
+      if (!checkViewpoint (path, number, w, error))
+        return false;
+      continue;
+    }
+    if (!is ("DATA"))
+    {
+      error = "'" + path + "' is not a PCD file (line " + std::to_string (number) +
+              ", before any DATA line, is not a PCD header line)";
+      return false;
+    }
+    const std::string type = w.size () > 1 ? w[1] : std::string ();
+    if (type != "ascii" && type != "binary" && type != "binary_compressed")
+    {
+      error = where + "DATA '" + type + "' is not ascii, binary or binary_compressed";
+      return false;
+    }
+    // PCL takes HEIGHT 1 when it is not given (and WIDTH = POINTS when neither is); HEIGHT
+    // without WIDTH it refuses itself.
+    const std::uint64_t rows = has_height ? height : 1;
+    if (has_points && has_width && product (width, rows) != points)
+    {
+      error = "'" + path + "' line " + std::to_string (points_line) + ": POINTS " + std::to_string (points) +
+              " is not WIDTH x HEIGHT, " + std::to_string (width) + " x " + std::to_string (rows) + " = " +
+              std::to_string (product (width, rows));
+      return false;
+    }
+    const std::streamoff at = in.tellg ();  // -1 at the end of the file
+    const std::uint64_t bytes = at < 0 ? 0 : file_size - static_cast<std::uint64_t> (at);
+    const std::uint64_t data = product (points, point_step);
+    set_aside = std::max (set_aside, data);
+    const std::string announces = "'" + path + "' is truncated or corrupt: its header announces " + std::to_string (points) +
+                                  " points (" + std::to_string (set_aside) + " bytes)";
+    if (type == "binary" && set_aside > bytes)
+    {
+      error = announces + " but " + std::to_string (bytes) + " bytes follow it";
+      return false;
+    }
+    if (type == "ascii")
+    {
+      std::uint64_t values = 0;  // at least, a line (padding fields' values may be left out)
+      for (std::size_t i = 0; i < names.size (); ++i)
+        values += names[i] == "_" ? 0 : counts[i];
+      // A value takes a character at least, and a separator this bound leaves out: a file a line
+      // or so short is left to checkAsciiValues, which names the line.
+      const std::uint64_t least = product (points, std::max<std::uint64_t> (values, 1));
+      if (least > bytes)
+      {
+        error = "'" + path + "' is truncated or corrupt: its header announces " + std::to_string (points) +
+                " points of " + std::to_string (values) + " values (at least " + std::to_string (least) +
+                " bytes as ascii) but " + std::to_string (bytes) + " bytes follow it";
+        return false;
+      }
+      if (set_aside > product (bytes, 8))
+      {
+        error = announces + " but " + std::to_string (bytes) + " bytes of ascii follow it (8 bytes a character at most)";
+        return false;
+      }
+    }
+    if (type == "binary_compressed")
+    {
+      unsigned char sizes_read[8] = {};
+      if (bytes < 8 || !in.read (reinterpret_cast<char*> (sizes_read), 8))
+      {
+        error = announces + " but its binary_compressed data end before their sizes (" + std::to_string (bytes) +
+                " bytes follow it)";
+        return false;
+      }
+      const auto le32 = [&sizes_read] (int at) {
+        return std::uint64_t{sizes_read[at]} | std::uint64_t{sizes_read[at + 1]} << 8 |
+               std::uint64_t{sizes_read[at + 2]} << 16 | std::uint64_t{sizes_read[at + 3]} << 24;
+      };
+      const std::uint64_t compressed = le32 (0), uncompressed = le32 (4);
+      if (uncompressed != data)
+      {
+        error = "'" + path + "' is truncated or corrupt: its header announces " + std::to_string (points) + " points (" +
+                std::to_string (data) + " bytes) but its binary_compressed data unpack to " +
+                std::to_string (uncompressed) + " bytes";
+        return false;
+      }
+      if (compressed > bytes - 8)
+      {
+        error = "'" + path + "' is truncated or corrupt: its binary_compressed data announce " +
+                std::to_string (compressed) + " compressed bytes but " + std::to_string (bytes - 8) + " bytes follow";
+        return false;
+      }
+      if (set_aside > product (compressed, 88))
+      {
+        error = announces + " but " + std::to_string (compressed) +
+                " bytes of binary_compressed data unpack to at most 88 times as many (LZF)";
+        return false;
+      }
+    }
+    return true;
+  }
+  error = "'" + path + "' is not a PCD file (its header has no DATA line)";
+  return false;
 }
 
 bool
@@ -548,6 +879,9 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
   }
   else
   {
+    // Checked before PCL's readHeader, which sets aside memory for the points its header claims.
+    if (!checkPcdHeader (path, error))
+      return false;
     // readHeader() sizes blob.data for the points (and read() reuses it): on memory offered to
     // huge pages, the file's size being the binary data's (a 5,000,000-point floor: 15,000
     // faults at about 11 us fewer, detail/huge_pages.h). Other encodings may outgrow it. Only a
@@ -577,13 +911,7 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
       error = "'" + path + "' is not a PCD file (no FIELDS in its header)";
       return false;
     }
-    if (!checkViewpoint (path, error))
-      return false;
-    std::size_t values = 0, padding = 0;
-    for (const pcl::PCLPointField& f : blob.fields)
-      (f.name == "_" ? padding : values) += std::max<std::size_t> (1, f.count);
-    if (data_type == 0 &&
-        !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, values + padding, values, error))
+    if (data_type == 0 && !checkAsciiValues (path, static_cast<std::size_t> (blob.width) * blob.height, blob.fields, error))
       return false;
   }
   if (static_cast<std::size_t> (blob.width) * blob.height == 0)
@@ -654,11 +982,16 @@ readCloudFile (const std::string& path, bool want_normals, CloudFile& file, std:
 }
 
 /** \brief x y z of every point, converted from whatever numeric type the file has; organization
-  * kept. rounding, when given, gets what the conversion to float cost. */
+  * kept. rounding, when given, gets what the conversion to float cost. False, the cloud cleared,
+  * with the file and the point when a finite coordinate is beyond the float range (a float64
+  * 2e299 became Inf, and the point was skipped as non-finite without a word). */
 template <typename PointT>
-void
-copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud, XyzRounding* rounding)
+bool
+copyXyz (const CloudFile& file, const std::string& path, pcl::PointCloud<PointT>& cloud, XyzRounding* rounding,
+         std::string& error)
 {
+  // From here a double rounds to Inf as a float: FLT_MAX and half its last place.
+  constexpr double kFloatOverflow = 0x1.ffffffp+127;
   pcl_probcollision::detail::reserveHugePages (cloud.points, file.size);
   cloud.resize (file.size);
   XyzRounding cost;
@@ -666,6 +999,16 @@ copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud, XyzRounding* rou
     for (int i = 0; i < 3; ++i)
     {
       const double stored = file.value (j, file.xyz[i]);
+      if (std::abs (stored) >= kFloatOverflow && std::isfinite (stored))
+      {
+        std::ostringstream s;
+        s.precision (9);  // enough to tell it from FLT_MAX (3.40282347e+38)
+        s << "'" << path << "': point " << j << "'s " << "xyz"[i] << " = " << stored
+          << " is beyond the float range of the points PCL holds";
+        error = s.str ();
+        cloud.clear ();
+        return false;
+      }
       const float kept = static_cast<float> (stored);
       cloud[j].data[i] = kept;
       if (std::isfinite (stored))
@@ -678,6 +1021,7 @@ copyXyz (const CloudFile& file, pcl::PointCloud<PointT>& cloud, XyzRounding* rou
   cloud.height = file.blob.height;
   if (rounding)
     *rounding = cost;
+  return true;
 }
 
 /** \brief Whether the file stores x y z as float32, which PCL's points hold exactly. */
@@ -718,8 +1062,8 @@ loadCloud (const std::string& path, pcl::PointCloud<pcl::PointXYZ>& cloud, std::
   pcl_probcollision::detail::reserveHugePages (cloud.points, std::size_t{file.blob.width} * file.blob.height);
   if (xyzAreFloat (file))
     pcl::fromPCLPointCloud2 (file.blob, cloud);
-  else
-    copyXyz (file, cloud, rounding);
+  else if (!copyXyz (file, path, cloud, rounding, error))
+    return false;
   finishCloud (file, cloud);
   return true;
 }
@@ -735,7 +1079,8 @@ loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>
   CloudFile file;
   if (!readCloudFile (path, true, file, error))
     return false;
-  copyXyz (file, cloud, xyzAreFloat (file) ? nullptr : rounding);
+  if (!copyXyz (file, path, cloud, xyzAreFloat (file) ? nullptr : rounding, error))
+    return false;
   has_normals = file.normal[0] >= 0;
   const float nan = std::numeric_limits<float>::quiet_NaN ();
   for (std::size_t j = 0; j < file.size; ++j)
@@ -755,7 +1100,7 @@ loadCloudWithNormals (const std::string& path, pcl::PointCloud<pcl::PointNormal>
     }
     // No usable direction (non-finite or zero): NaN, which the surface model orients from the
     // point's neighbours.
-    if (!n.allFinite () || n.isZero ())
+    if (!n.allFinite () || (n.array () == 0.0f).all ())  // exactly 0: Eigen's isZero () took any length under 1e-5 for none
       n.setConstant (nan);
     cloud[j].getNormalVector3fMap () = n;
     cloud[j].curvature = 0.0f;
