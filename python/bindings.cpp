@@ -37,8 +37,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <future>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -529,6 +529,17 @@ poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool
   return T;
 }
 
+/** An (M, 4, 4) array of poses: TypeError for what is no numeric array, ValueError naming the shape
+  * of one that is not (M, 4, 4). */
+py::array_t<double, py::array::forcecast>
+poseArray (const py::object& obj)
+{
+  const auto a = realArray (obj, "poses", "a numeric array of shape (M, 4, 4)");
+  if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
+    throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
+  return a;
+}
+
 /** Runs work (a batch given the `ready` callback collideBatch calls after each pose) on a thread of
   * its own, while the calling thread waits without the GIL and checks for signals every 50 ms:
   * Ctrl-C stops the batch at its next pose (ready throws) and raises KeyboardInterrupt here, where
@@ -590,9 +601,7 @@ std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
              int threads)
 {
-  const auto poses = realArray (poses_obj, "poses", "a numpy array of shape (M, 4, 4)");
-  if (poses.ndim () != 3 || poses.shape (1) != 4 || poses.shape (2) != 4)
-    throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (poses));
+  const auto poses = poseArray (poses_obj);
   checkThreads (threads);
   const CollisionRequest request = requestOf (request_obj);
   const auto p = poses.unchecked<3> ();
@@ -889,17 +898,6 @@ posesFromXyzRpy (const py::object& obj)
         o (k, i, j) = T.matrix () (i, j);
   }
   return out;
-}
-
-/** An (M, 4, 4) array of poses: TypeError for what is no numeric array, ValueError naming the shape
-  * of one that is not (M, 4, 4). */
-py::array_t<double, py::array::forcecast>
-poseArray (const py::object& obj)
-{
-  const auto a = realArray (obj, "poses", "a numeric array of shape (M, 4, 4)");
-  if (a.ndim () != 3 || a.shape (1) != 4 || a.shape (2) != 4)
-    throw py::value_error ("poses: expected shape (M, 4, 4), got " + shapeOf (a));
-  return a;
 }
 
 /** (M, 4, 4) rigid transforms -> their inverses, as Eigen::Isometry3d::inverse() computes them. */

@@ -110,22 +110,28 @@ parseUint64 (const std::string& text, std::uint64_t& value)
   return true;
 }
 
+std::vector<std::string>
+splitCommas (const std::string& text)
+{
+  std::vector<std::string> items (1);
+  for (const char c : text)
+    if (c == ',')
+      items.emplace_back ();
+    else
+      items.back ().push_back (c);
+  return items;
+}
+
 bool
 parseDoubleList (const std::string& text, std::size_t count, std::vector<double>& values)
 {
   values.clear ();
-  std::size_t start = 0;
-  while (true)
+  for (const std::string& item : splitCommas (text))
   {
-    const std::size_t comma = text.find (',', start);
-    const std::string item = text.substr (start, comma == std::string::npos ? std::string::npos : comma - start);
     double v = 0.0;
     if (!parseDouble (item, v))
       return false;
     values.push_back (v);
-    if (comma == std::string::npos)
-      break;
-    start = comma + 1;
   }
   return values.size () == count;
 }
@@ -457,12 +463,7 @@ parseCommandLine (const std::vector<std::string>& args)
       if (!parseDoubleList (v, 6, vals))
       {
         // Six values, one of them no number: name it (-pose 0,0,0,0,0,nan has six numbers' shape).
-        std::vector<std::string> items (1);
-        for (const char c : v)
-          if (c == ',')
-            items.emplace_back ();
-          else
-            items.back ().push_back (c);
+        const std::vector<std::string> items = splitCommas (v);
         double unused = 0.0;
         for (std::size_t i = 0; items.size () == 6 && i < 6; ++i)
           if (!parseDouble (items[i], unused))

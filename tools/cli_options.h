@@ -207,6 +207,8 @@ InputKind inputKindOf (const std::string& path);
 bool parseDouble (const std::string& text, double& value);
 bool parseInt (const std::string& text, int& value);
 bool parseUint64 (const std::string& text, std::uint64_t& value);
+/** \brief The items between commas, empty ones included ("1,,2" has three). */
+std::vector<std::string> splitCommas (const std::string& text);
 /** \brief Splits on ',' (the CLI forms, e.g. -pose 0,0,0.1,0,0,0) and parses each as a double. */
 bool parseDoubleList (const std::string& text, std::size_t count, std::vector<double>& values);
 

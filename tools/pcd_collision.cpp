@@ -21,14 +21,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cerrno>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <future>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <string>

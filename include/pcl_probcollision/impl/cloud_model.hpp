@@ -18,8 +18,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <future>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <system_error>
