@@ -244,7 +244,8 @@ checkAsciiValues (const std::string& path, std::size_t points, const std::vector
   * numbers within the float range (tx ty tz qw qx qy qz). PCL's reader stops at a value it cannot
   * read ("nan", "inf", "1e39") and leaves the sensor origin at 0 0 0 and the rest of the
   * quaternion uninitialised, without a word: the orientation toward the viewpoint and `-o`'s
-  * header then rest on garbage; with fewer than seven it refuses the whole header, unexplained. */
+  * header then rest on garbage; with fewer than seven it refuses the whole header, unexplained.
+  * The quaternion must not be 0 0 0 0. */
 bool
 checkViewpoint (const std::string& path, std::size_t line_number, const std::vector<std::string>& words,
                 std::string& error)
@@ -264,6 +265,14 @@ checkViewpoint (const std::string& path, std::size_t line_number, const std::vec
   {
     error = "'" + path + "' line " + std::to_string (line_number) + ": VIEWPOINT has " + std::to_string (words.size () - 1) +
             " values, expected 7 (tx ty tz qw qx qy qz)";
+    return false;
+  }
+  // A quaternion of zeros is no rotation; PCL would hand it on and the viewpoint's axis
+  // would be a guess. An unrotated sensor is 1 0 0 0.
+  if (std::all_of (words.begin () + 4, words.end (), [] (const std::string& word) { return std::strtod (word.c_str (), nullptr) == 0.0; }))
+  {
+    error = "'" + path + "' line " + std::to_string (line_number) +
+            ": VIEWPOINT quaternion qw qx qy qz is 0 0 0 0, which is no rotation (an unrotated sensor is 1 0 0 0)";
     return false;
   }
   return true;

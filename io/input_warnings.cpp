@@ -113,7 +113,14 @@ noiseWarning (const InputFacts& in)
   if (!in.cloud || in.sensor != "isotropic" || in.finite < kScaleWarningMinPoints)
     return {};
   const double sigma = in.sigma, diagonal = in.diagonal;
-  if (!(sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal) && sigma < kNoiseWarningRatio * diagonal))
+  if (!(sigma > 0.0 && diagonal > 0.0 && std::isfinite (diagonal)))
+    return {};
+  if (sigma > kLargeNoiseWarningRatio * diagonal)
+    return formatted ("the noise sigma %.6g of '%s' is %.2g times its size (bounding-box diagonal %.6g), so every "
+                      "point's spread covers the whole cloud; sigma is in the data's units, so give -sigma in the "
+                      "cloud's units (e.g. -sigma 0.005 for 5 mm in metres)",
+                      sigma, in.path.c_str (), sigma / diagonal, diagonal);
+  if (!(sigma < kNoiseWarningRatio * diagonal))
     return {};
   return formatted ("the noise sigma %.6g of '%s' is %.2g of its size (bounding-box diagonal %.6g); sigma is in the "
                     "data's units (the default 0.005 is 5 mm in metres), so give -sigma in the cloud's units (e.g. "

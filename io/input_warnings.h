@@ -32,6 +32,11 @@ constexpr std::size_t kScaleWarningMinPoints = 50;
   * 5 um there, 2.8e-6 of a piano's diagonal. A cloud's rounding to float is judged against it
   * too under a depth sensor's model. */
 constexpr double kNoiseWarningRatio = 1e-5;
+/** \brief An isotropic sigma above this multiple of its cloud's bounding-box diagonal gets a
+  * units warning too. A cloud drawn with a noise sigma spreads over several sigmas, so a sigma
+  * beyond its whole extent was not its noise: most likely millimetres given to a cloud in metres
+  * (-sigma 5 on a 1 m scan). */
+constexpr double kLargeNoiseWarningRatio = 1.0;
 
 /** \brief What the warnings judge of one input, as the command line read it. */
 struct InputFacts
@@ -68,7 +73,9 @@ std::string scaleWarning (const InputFacts& a, const InputFacts& b);
 
 /** \brief The warning when a cloud's isotropic sigma is below kNoiseWarningRatio of its size
   * (most likely the default, 0.005 in metres, given to a cloud in millimetres: the answer is
-  * then for a near noise-free cloud), else empty. */
+  * then for a near noise-free cloud) or above kLargeNoiseWarningRatio of it (a sigma in
+  * millimetres given to a cloud in metres: every point's spread then covers the whole object),
+  * else empty. */
 std::string noiseWarning (const InputFacts& in);
 
 /** \brief The warning when holding a cloud file's x y z in PCL's float points (24 bits: about

@@ -34,6 +34,29 @@ namespace
 char g_temp_path[4096];
 volatile sig_atomic_t g_temp_active = 0;
 
+/** \brief The file that writing `path` should replace: the end of its chain of symbolic links
+  * (a dangling link's target), else `path`. The atomic rename would otherwise replace the link
+  * itself, where a shell's `>` writes through it. False, naming `path`, on a loop of links. */
+bool
+followLinks (const std::string& path, std::filesystem::path& target, std::string& error)
+{
+  namespace fs = std::filesystem;
+  constexpr int kMaxLinks = 40; // Linux's own limit (ELOOP)
+  target = path;
+  std::error_code ec;
+  for (int hops = 0; fs::is_symlink (fs::symlink_status (target, ec)); ++hops)
+  {
+    const fs::path next = fs::read_symlink (target, ec);
+    if (ec || hops == kMaxLinks)
+    {
+      error = "cannot write '" + path + "': " + (ec ? ec.message () : std::strerror (ELOOP));
+      return false;
+    }
+    target = next.is_absolute () ? next : target.parent_path () / next;
+  }
+  return true;
+}
+
 extern "C" void
 removeTempAndDie (int sig)
 {
@@ -166,7 +189,9 @@ writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sid
   blob.is_dense = dense;
 
   namespace fs = std::filesystem;
-  const fs::path target (path);
+  fs::path target;
+  if (!followLinks (path, target, error))
+    return false;
   const fs::path dir = target.has_parent_path () ? target.parent_path () : fs::path (".");
   std::string tmpl = (dir / ("." + target.filename ().string () + ".tmp-XXXXXX")).string ();
   std::vector<char> buf (tmpl.begin (), tmpl.end ());
@@ -217,7 +242,7 @@ writeResultCloud (const std::string& path, const std::vector<LabelledCloud>& sid
   {
     // Rename and unregister as one step: afterwards the temporary name must not be removed.
     BlockInterrupts block;
-    renamed = std::rename (tmp.c_str (), path.c_str ());
+    renamed = std::rename (tmp.c_str (), target.c_str ());
     e = errno;
     if (renamed == 0)
       setTempPath (nullptr);

@@ -414,7 +414,8 @@ TEST_F (CloudInput, PointsTheDataCannotHoldAreRefusedBeforeReading)
 // The header's numbers and DATA type as PCL's reader takes them: POINTS -5 ended in
 // "vector::_M_default_append" (no file named), a negative COUNT in a bad_alloc, POINTS other than
 // WIDTH x HEIGHT in "malformed or missing header", "binaryX" was read as binary and "foo" as
-// ascii, a header without DATA as points at the origin; a short VIEWPOINT got the generic message.
+// ascii, a header without DATA as points at the origin; a short VIEWPOINT got the generic message
+// and a quaternion of zeros was taken for no rotation.
 TEST_F (CloudInput, PcdHeaderNumbersAndDataTypeAreChecked)
 {
   const std::string data = "0 0 0\n1 0 0\n2 0 0\n";
@@ -438,6 +439,8 @@ TEST_F (CloudInput, PcdHeaderNumbersAndDataTypeAreChecked)
        " is not a PCD file (its header has no DATA line)"},
       {"viewpoint.pcd", kXyzFields + "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 1\nPOINTS 3\nDATA ascii\n" + data,
        " line 8: VIEWPOINT has 3 values, expected 7 (tx ty tz qw qx qy qz)"},
+      {"no_rotation.pcd", kXyzFields + "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 1 0 -0 0.0 0e5\nPOINTS 3\nDATA ascii\n" + data,
+       " line 8: VIEWPOINT quaternion qw qx qy qz is 0 0 0 0, which is no rotation (an unrotated sensor is 1 0 0 0)"},
   };
   for (const auto& c : cases)
   {
@@ -447,6 +450,8 @@ TEST_F (CloudInput, PcdHeaderNumbersAndDataTypeAreChecked)
   // A header as PCL writes it (and one with only POINTS, which PCL takes for WIDTH) loads.
   writeFile (dir_ / "fine.pcd", pcd ("3", "3", "ascii") + data);
   writeFile (dir_ / "old.pcd", kXyzFields + "POINTS 3\nDATA ascii\n" + data);
+  writeFile (dir_ / "half_turn.pcd", kXyzFields + "WIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 0 1 0 0\nPOINTS 3\nDATA ascii\n" + data);
+  EXPECT_EQ (loadError (path ("half_turn.pcd")), "");
   EXPECT_EQ (loadError (path ("fine.pcd")), "");
   EXPECT_EQ (loadError (path ("old.pcd")), "");
 }

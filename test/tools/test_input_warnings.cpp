@@ -73,6 +73,18 @@ TEST (InputWarnings, AnIsotropicSigmaFarBelowTheCloudsSizeIsWarnedOf)
   EXPECT_EQ (noiseWarning (cloud ("few.pcd", 1000.0, kScaleWarningMinPoints - 1)), "");
 }
 
+TEST (InputWarnings, AnIsotropicSigmaBeyondTheCloudsSizeIsWarnedOf)
+{
+  // -sigma 5 (millimetres) on a 1 m cloud in metres: five times its size.
+  const std::string w = noiseWarning (cloud ("m.pcd", 1.0, 1000, 5.0));
+  EXPECT_TRUE (said (w, "the noise sigma 5 of 'm.pcd' is 5 times its size (bounding-box diagonal 1)")) << w;
+  EXPECT_TRUE (said (w, "-sigma 0.005")) << w;
+  EXPECT_EQ (noiseWarning (cloud ("m.pcd", 1.0, 1000, kLargeNoiseWarningRatio * 1.0)), "") << "at the ratio: allowed";
+  EXPECT_EQ (noiseWarning (cloud ("mug.pcd", 0.1, 1000, 0.015)), "") << "stereo noise on a mug is legitimate";
+  EXPECT_EQ (noiseWarning (cloud ("few.pcd", 1.0, kScaleWarningMinPoints - 1, 5.0)), "");
+  EXPECT_EQ (noiseWarning (cloud ("point.pcd", 0.0, 1000, 5.0)), "") << "points all in one place have no size";
+}
+
 TEST (InputWarnings, RoundingToFloatIsJudgedAgainstTheSigmaOrTheSize)
 {
   InputFacts far = cloud ("far.pcd", 0.75, 1000, 0.002);

@@ -1087,6 +1087,39 @@ TEST_F (PcdCollisionTool, AtomicWriteLeavesNoTempFileAndReplacesOldOutput)
   EXPECT_EQ (fs::status (out).permissions () & fs::perms::owner_read, fs::perms::owner_read);
 }
 
+TEST_F (PcdCollisionTool, AnOutputThroughASymbolicLinkReplacesTheFileItNames)
+{
+  // As a shell's `>` does: the link stays and its target gets the result (the atomic rename
+  // replaced the link itself before), a dangling link's target is created, a loop is refused.
+  writeFile (dir_ / "real.pcd", "old contents");
+  fs::create_symlink ("real.pcd", dir_ / "link.pcd");
+  fs::create_directories (dir_ / "sub");
+  fs::create_symlink (fs::path ("..") / "link.pcd", dir_ / "sub" / "chain.pcd");
+  fs::create_symlink ("new.pcd", dir_ / "dangling.pcd");
+  const std::vector<std::string> query = {kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-o"};
+  for (const fs::path& out : {dir_ / "link.pcd", dir_ / "sub" / "chain.pcd", dir_ / "dangling.pcd"})
+  {
+    std::vector<std::string> args = query;
+    args.push_back (out.string ());
+    const ToolRun r = run (args);
+    ASSERT_EQ (r.status, 0) << out << ": " << r.err;
+    EXPECT_TRUE (fs::is_symlink (out)) << out;
+  }
+  EXPECT_FALSE (fs::is_symlink (dir_ / "real.pcd"));
+  EXPECT_EQ (readFile (dir_ / "real.pcd").rfind ("# .PCD", 0), 0u);
+  EXPECT_EQ (readFile (dir_ / "new.pcd").rfind ("# .PCD", 0), 0u);
+
+  fs::create_symlink ("loop_b.pcd", dir_ / "loop_a.pcd");
+  fs::create_symlink ("loop_a.pcd", dir_ / "loop_b.pcd");
+  std::vector<std::string> args = query;
+  args.push_back ((dir_ / "loop_a.pcd").string ());
+  const ToolRun r = run (args);
+  EXPECT_EQ (r.status, 1);
+  EXPECT_NE (r.err.find ("loop_a.pcd"), std::string::npos) << r.err;
+  EXPECT_NE (lowercase (r.err).find ("symbolic links"), std::string::npos) << r.err;
+  EXPECT_TRUE (fs::is_symlink (dir_ / "loop_a.pcd"));
+}
+
 TEST_F (PcdCollisionTool, OutputNeverOverwritesAnInput)
 {
   fs::copy_file (kScene, dir_ / "scene.pcd");
