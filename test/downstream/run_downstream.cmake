@@ -14,4 +14,19 @@ run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/test/downstream" -B "${WORK_DIR}/build"
     -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 run("${WORK_DIR}/build/downstream")
-message(STATUS "downstream consumer built and ran against ${prefix}")
+message(STATUS "downstream consumer built with find_package and ran against ${prefix}")
+
+# The same consumer built without CMake, from the installed pkg-config file alone (moved with the
+# prefix: its paths are relative to the file).
+file(GLOB pc_dirs "${prefix}/lib*/pkgconfig" "${prefix}/lib/*/pkgconfig")
+list(JOIN pc_dirs ":" pc_path)
+set(ENV{PKG_CONFIG_PATH} "${pc_path}")
+execute_process(COMMAND ${PKG_CONFIG} --cflags --libs pcl_probcollision RESULT_VARIABLE rc OUTPUT_VARIABLE flags
+                ERROR_VARIABLE err OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "pkg-config --cflags --libs pcl_probcollision failed (${rc}) with PKG_CONFIG_PATH ${pc_path}:\n${err}")
+endif()
+separate_arguments(flags UNIX_COMMAND "${flags}")
+run(${CXX} -std=c++17 -O1 "${SOURCE_DIR}/test/downstream/main.cpp" -o "${WORK_DIR}/downstream_pkg_config" ${flags})
+run("${WORK_DIR}/downstream_pkg_config")
+message(STATUS "downstream consumer built with pkg-config and ran against ${prefix}")
