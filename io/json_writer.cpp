@@ -2,10 +2,49 @@
 #include "json_writer.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
+#include <string>
 
 namespace pcl_probcollision::io
 {
+namespace
+{
+/** \brief Length of the well-formed UTF-8 sequence starting at s[i] (a lead byte >= 0x80), or 0
+  * when there is none: a stray continuation byte, a sequence cut short, an overlong form, a
+  * surrogate or a code point above U+10FFFF (the Unicode standard's table 3-7). */
+std::size_t
+utf8SequenceLength (const std::string& s, std::size_t i)
+{
+  const auto byte = [&s] (std::size_t k) { return static_cast<unsigned char> (s[k]); };
+  const unsigned char c = byte (i);
+  std::size_t length = 0;
+  unsigned char low = 0x80, high = 0xbf;  // the range of the second byte
+  if (c >= 0xc2 && c <= 0xdf)
+    length = 2;
+  else if (c >= 0xe0 && c <= 0xef)
+  {
+    length = 3;
+    low = c == 0xe0 ? 0xa0 : 0x80;
+    high = c == 0xed ? 0x9f : 0xbf;
+  }
+  else if (c >= 0xf0 && c <= 0xf4)
+  {
+    length = 4;
+    low = c == 0xf0 ? 0x90 : 0x80;
+    high = c == 0xf4 ? 0x8f : 0xbf;
+  }
+  else
+    return 0;
+  if (i + length > s.size () || byte (i + 1) < low || byte (i + 1) > high)
+    return 0;
+  for (std::size_t k = 2; k < length; ++k)
+    if (byte (i + k) < 0x80 || byte (i + k) > 0xbf)
+      return 0;
+  return length;
+}
+} // namespace
+
 void
 JsonWriter::beforeValue ()
 {
@@ -129,9 +168,29 @@ void
 JsonWriter::quoted (const std::string& s)
 {
   out_ << '"';
-  for (const char ch : s)
+  const std::size_t n = s.size ();
+  for (std::size_t i = 0; i < n;)
   {
-    const auto c = static_cast<unsigned char> (ch);
+    const auto c = static_cast<unsigned char> (s[i]);
+    if (c >= 0x80)
+    {
+      // JSON text must be UTF-8 (RFC 8259, 8.1); a byte outside a well-formed sequence is
+      // kept recoverable as surrogateescape's \udcXX.
+      const std::size_t length = utf8SequenceLength (s, i);
+      if (length == 0)
+      {
+        char buf[8];
+        std::snprintf (buf, sizeof (buf), "\\udc%02x", c);
+        out_ << buf;
+        ++i;
+      }
+      else
+      {
+        out_.write (s.data () + i, static_cast<std::streamsize> (length));
+        i += length;
+      }
+      continue;
+    }
     switch (c)
     {
       case '"': out_ << "\\\""; break;
@@ -147,8 +206,9 @@ JsonWriter::quoted (const std::string& s)
           out_ << buf;
         }
         else
-          out_ << ch;
+          out_ << static_cast<char> (c);
     }
+    ++i;
   }
   out_ << '"';
 }

@@ -17,7 +17,9 @@ namespace pcl_probcollision::io
   *
   * Numbers are printed with "%.10g"; NaN and Inf, which JSON cannot hold, become null (the
   * library's "not computed"). Strings are escaped per RFC 8259 (quote, backslash, control
-  * characters); other bytes, UTF-8 included, are copied unchanged.
+  * characters); well-formed UTF-8 is copied unchanged, and any other byte (a file name that is
+  * not UTF-8) is written \udcXX, Python's surrogateescape: the text stays UTF-8, and
+  * os.fsencode() of the string Python's json parses gives the bytes back.
   *
   * \code
   * JsonWriter j;

@@ -46,3 +46,32 @@ TEST (JsonWriter, StringsAreEscaped)
   const mini_json::Value v = mini_json::parse (j.text ());
   EXPECT_EQ (v["q\"k"].text, "a\"b\\c\nd\re\tf\x01g\x7fh/\xc3\xa9");
 }
+
+// A file name need not be UTF-8, but JSON text must be (a byte 0xff made Python's json.loads fail
+// on the whole line). Well-formed sequences are copied; each other byte becomes \udcXX.
+TEST (JsonWriter, BytesThatAreNotUtf8BecomeSurrogateEscapes)
+{
+  const std::string valid = "\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 \xf4\x8f\xbf\xbf";  // U+00E9, U+20AC, U+1F600, U+10FFFF
+  JsonWriter ok;
+  ok.string (valid);
+  EXPECT_EQ (ok.text (), "\"" + valid + "\"");
+  const struct
+  {
+    std::string bytes, json;
+  } cases[] = {
+      {"x\xff.pcd", "\"x\\udcff.pcd\""},                 // never a UTF-8 byte
+      {"\x80", "\"\\udc80\""},                            // a stray continuation byte
+      {"\xc0\xaf", "\"\\udcc0\\udcaf\""},                 // an overlong '/'
+      {"\xe2\x82", "\"\\udce2\\udc82\""},                 // cut short
+      {"\xe2\x82.", "\"\\udce2\\udc82.\""},               // cut short before ASCII
+      {"\xed\xa0\x80", "\"\\udced\\udca0\\udc80\""},      // an encoded surrogate
+      {"\xf4\x90\x80\x80", "\"\\udcf4\\udc90\\udc80\\udc80\""},  // above U+10FFFF
+      {"\xe9t\xc3\xa9", "\"\\udce9t\xc3\xa9\""},              // Latin-1 beside UTF-8
+  };
+  for (const auto& c : cases)
+  {
+    JsonWriter j;
+    j.string (c.bytes);
+    EXPECT_EQ (j.text (), c.json) << c.bytes;
+  }
+}

@@ -528,6 +528,18 @@ TEST_F (PcdCollisionTool, AResultThatCannotBeWrittenFailsTheRun)
   }
 }
 
+TEST_F (PcdCollisionTool, JsonOfAFileNameThatIsNotUtf8IsUtf8)
+{
+  // The path's byte 0xff was copied into the line, which no JSON parser then read.
+  const fs::path odd = dir_ / "scene\xff.pcd";
+  fs::copy_file (kScene, odd);
+  const ToolRun r = run ({kGripper.string (), odd.string (), "-pose", "0.1,0,0.25,0,0,0", "-json"});
+  ASSERT_EQ (r.status, 0) << r.err;
+  EXPECT_EQ (r.out.find ('\xff'), std::string::npos) << r.out;
+  EXPECT_NE (r.out.find ("scene\\udcff.pcd\""), std::string::npos) << r.out;
+  EXPECT_NO_THROW (mini_json::parse (r.out.substr (0, r.out.find ('\n'))));
+}
+
 TEST_F (PcdCollisionTool, JsonNeverPrintsNanWhenNothingIsNear)
 {
   // Far apart: no leaf pair, no witness; every field must still be valid JSON.
