@@ -719,7 +719,8 @@ helpText ()
        "Pose of <a> (p' = Rz(yaw) Ry(pitch) Rx(roll) p + t; data units and radians):\n"
        "  -pose tx,ty,tz,roll,pitch,yaw   = 0,0,0,0,0,0\n"
        "  -poses FILE     batch mode: one pose per line, six numbers separated by spaces or commas,\n"
-       "                  '#' comments and blank lines allowed; hierarchies are built once\n"
+       "                  '#' comments and blank lines allowed; hierarchies are built once;\n"
+       "                  FILE '-' reads the poses from standard input, to its end\n"
        "  -threads N      = "
     << D::threads
     << "       threads building the models and answering -poses (0: one per hardware\n"

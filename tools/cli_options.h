@@ -82,7 +82,7 @@ struct Options
 
   /** \brief -pose (single query); identity when absent. */
   std::optional<Pose> pose;
-  /** \brief -poses FILE (batch mode). */
+  /** \brief -poses FILE (batch mode); kStandardInput reads the poses from stdin. */
   std::optional<std::string> poses_file;
   /** \brief -threads N: threads of the build (covariances, hierarchies) and of the poses, >= 0,
     * 0 = one per hardware thread. The output is the same whatever N (timings aside). */
@@ -216,6 +216,9 @@ bool parseDoubleList (const std::string& text, std::size_t count, std::vector<do
   * '#' starts a comment. Returns 1 with the pose, 0 for a blank or comment-only line, -1 with
   * a reason in error for a malformed line. */
 int parsePoseLine (const std::string& line, Pose& pose, std::string& error);
+
+/** \brief The -poses name of standard input, as Unix filters spell it. */
+inline constexpr const char* kStandardInput = "-";
 
 /** \brief A whole -poses file; false with "NAME:LINE: reason" in error on the first malformed
   * line, or when it holds no pose at all. Lines end at '\n' alone. The one reader of the

@@ -28,6 +28,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <future>
 #include <limits>
 #include <mutex>
@@ -197,7 +198,7 @@ checkOutput (const Options& o)
     return;
   const fs::path out (*o.output);
   std::vector<std::string> inputs = {o.input_a, o.input_b};
-  if (o.poses_file)
+  if (o.poses_file && *o.poses_file != kStandardInput)
     inputs.push_back (*o.poses_file);
   std::error_code ec;
   for (const std::string& in : inputs)
@@ -525,7 +526,15 @@ run (int argc, char** argv)
   // Poses first: a malformed file fails before the (slow) loading.
   std::vector<Pose> poses;
   const bool batch = o.poses_file.has_value ();
-  if (batch)
+  if (batch && *o.poses_file == kStandardInput)
+  {
+    // A pipe from a pose generator: read to its end, so that a malformed line still fails
+    // before any query, as in a file.
+    std::string error;
+    if (!parsePoses (std::cin, "standard input", poses, error))
+      throw Failure{kRuntimeFailure, error};
+  }
+  else if (batch)
   {
     std::string error = pcl_probcollision::io::unreadableFile (*o.poses_file);
     std::ifstream f (*o.poses_file);

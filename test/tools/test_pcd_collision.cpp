@@ -101,12 +101,15 @@ protected:
     fs::create_directories (io_);
   }
 
-  ToolRun run (const std::vector<std::string>& args) const
+  /** \brief Runs the tool with args, its stdin /dev/null, or piped from `piped_stdin` (through
+    * `cat`, so that it is a pipe, not a file). */
+  ToolRun run (const std::vector<std::string>& args, const fs::path& piped_stdin = {}) const
   {
     std::string cmd = quote (kExe);
     for (const auto& a : args)
       cmd += " " + quote (a);
-    cmd += " > " + quote ((io_ / "stdout").string ()) + " 2> " + quote ((io_ / "stderr").string ()) + " < /dev/null";
+    cmd += " > " + quote ((io_ / "stdout").string ()) + " 2> " + quote ((io_ / "stderr").string ());
+    cmd = piped_stdin.empty () ? cmd + " < /dev/null" : "cat " + quote (piped_stdin.string ()) + " | " + cmd;
     const int w = std::system (cmd.c_str ());
     ToolRun r;
     r.status = WIFEXITED (w) ? WEXITSTATUS (w) : 1000;
@@ -954,6 +957,31 @@ TEST_F (PcdCollisionTool, BatchEqualsSingleRunsPoseByPose)
   // Hierarchies are built once: every pose after the first reuses them.
   for (std::size_t i = 1; i < batch.size (); ++i)
     EXPECT_EQ (batch[i]["build_ms"].number, 0.0) << i;
+}
+
+// -poses -: a pose generator's pipe is read as the file would be.
+TEST_F (PcdCollisionTool, PosesFromStandardInputAreAnsweredAsFromAFile)
+{
+  const std::vector<std::string> args = {kGripper.string (), kScene.string (), "-poses"};
+  std::vector<std::string> from_file = args, from_stdin = args;
+  from_file.push_back (kPoses.string ());
+  from_stdin.push_back ("-");
+  const ToolRun f = run (from_file), p = run (from_stdin, kPoses);
+  ASSERT_EQ (f.status, 0) << f.err;
+  ASSERT_EQ (p.status, 0) << p.err;
+  std::vector<std::string> expected, got;
+  for (const auto& l : lines (f.out))
+    expected.push_back (withoutTimings (l));
+  for (const auto& l : lines (p.out))
+    got.push_back (withoutTimings (l));
+  ASSERT_EQ (expected.size (), 3u);
+  EXPECT_EQ (got, expected);
+
+  writeFile (dir_ / "bad.txt", "0 0 0 0 0 0\n0 0 0 0 0\n");
+  const ToolRun bad = run (from_stdin, dir_ / "bad.txt");
+  EXPECT_EQ (bad.status, 1);
+  EXPECT_EQ (bad.out, "");
+  EXPECT_NE (bad.err.find ("standard input:2: expected 6 numbers"), std::string::npos) << bad.err;
 }
 
 // -threads: every line the same as one thread's, in pose order, timings aside; n threads answer
