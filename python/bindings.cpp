@@ -18,6 +18,7 @@
 #include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/organized_sensor_pose.h>
 #include <pcl_probcollision/sensor_noise.h>
+#include <pcl_probcollision/version.h>
 #include <pcl_probcollision/detail/input_checks.h>
 #include <pcl_probcollision/detail/parallel.h>
 
@@ -52,7 +53,83 @@ using namespace pcl_probcollision;
 
 namespace
 {
+/** \brief A `threads` argument: any Python integer (operator.index), kept whole so that
+  * checkThreads refuses a huge one with its ValueError; pybind11's int caster refuses an int
+  * beyond C int with the TypeError of a wrong type (threads=10**12). */
+struct ThreadsArg
+{
+  long long value = 0;  // saturated at long long's range, which text then says exactly
+  std::string text;     // str() of the Python int
+};
+} // namespace
+
+namespace pybind11::detail
+{
+template <>
+struct type_caster<ThreadsArg>
+{
+  PYBIND11_TYPE_CASTER (ThreadsArg, const_name ("int"));
+
+  bool
+  load (handle src, bool)
+  {
+    // As pybind11's int caster: a float (and a str) is no count, a TypeError.
+    if (PyFloat_Check (src.ptr ()) || !PyIndex_Check (src.ptr ()))
+      return false;
+    const object index = reinterpret_steal<object> (PyNumber_Index (src.ptr ()));
+    if (!index)
+    {
+      PyErr_Clear ();
+      return false;
+    }
+    int overflow = 0;
+    const long long v = PyLong_AsLongLongAndOverflow (index.ptr (), &overflow);
+    if (v == -1 && PyErr_Occurred ())
+    {
+      PyErr_Clear ();
+      return false;
+    }
+    value.value = overflow > 0 ? std::numeric_limits<long long>::max ()
+                               : overflow < 0 ? std::numeric_limits<long long>::min () : v;
+    value.text = str (index);
+    return true;
+  }
+
+  static handle
+  cast (const ThreadsArg& t, return_value_policy, handle)
+  {
+    return PyLong_FromLongLong (t.value);
+  }
+};
+} // namespace pybind11::detail
+
+namespace
+{
 using ModelPtr = std::shared_ptr<CloudModel>;
+
+/** \brief s as Python text: bytes that are not UTF-8 (a path's, os.fsencode of a name that is
+  * not) as \xNN escapes, Python's backslashreplace. PyErr_SetString and pybind11 read C++
+  * strings as UTF-8: a message naming such a path was an empty ValueError. */
+std::string
+utf8Text (const std::string& s)
+{
+  const py::object text = py::reinterpret_steal<py::object> (
+      PyUnicode_DecodeUTF8 (s.data (), static_cast<py::ssize_t> (s.size ()), "backslashreplace"));
+  if (!text)
+    throw py::error_already_set ();
+  return text.cast<std::string> ();
+}
+
+/** \brief ValueError naming `name` when it holds a NUL: the messages naming the cloud (PCL's
+  * exceptions, PyErr_SetString, warnings) are C strings, which a NUL would cut. */
+void
+checkName (const std::string& name)
+{
+  if (const auto nul = name.find ('\0'); nul != std::string::npos)
+    throw py::value_error ("name: contains a NUL character (at index " + std::to_string (nul) +
+                           "), which would cut the messages naming the cloud, got " +
+                           std::string (py::repr (py::str (name))));
+}
 
 std::string
 shapeOf (const py::array& a)
@@ -203,6 +280,7 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
             const std::string& name, const py::object& viewpoint = py::none (),
             const py::object& normals = py::none (), bool any_length_normals = false)
 {
+  checkName (name);
   // An (H, W, 3) image of points is an organized cloud, W x H: its rows and columns say where its
   // sensor was (organizedSensorPose), as a file's WIDTH and HEIGHT do for load_model. Its
   // covariances and normals come per pixel, (H, W, 3, 3) and (H, W, 3), or flattened.
@@ -293,9 +371,15 @@ requireRegularFile (const std::filesystem::path& path)
   if (!directory && std::filesystem::exists (status))
     throw py::value_error ("path: '" + path.string () + "' is not a regular file");
   PyObject* type = directory ? PyExc_IsADirectoryError : PyExc_FileNotFoundError;
+  // The file name as os.fsdecode gives it (what open() puts in filename): a name that is not
+  // UTF-8 keeps its bytes as surrogates, where a UTF-8 cast raised UnicodeDecodeError.
+  const py::object filename = py::reinterpret_steal<py::object> (
+      PyUnicode_DecodeFSDefaultAndSize (path.native ().data (), static_cast<py::ssize_t> (path.native ().size ())));
+  if (!filename)
+    throw py::error_already_set ();
   py::object err = py::reinterpret_borrow<py::object> (type) (directory ? 21 : 2,
                                                                 std::string (directory ? "Is a directory" : "No such file"),
-                                                                path.string ());
+                                                                filename);
   PyErr_SetObject (type, err.ptr ());
   throw py::error_already_set ();
 }
@@ -316,7 +400,8 @@ loadModel (const std::filesystem::path& path, const py::object& params_obj, cons
   if (ext != ".pcd" && ext != ".ply")
     throw py::value_error ("path: only .pcd and face-less .ply files are read, got '" + path.string () + "'");
   const CloudModelParams params = params_obj.is_none () ? CloudModelParams () : castArgument<CloudModelParams> (params_obj, "params", "CloudModelParams");
-  const std::string name = name_obj.is_none () ? path.filename ().string () : castArgument<std::string> (name_obj, "name", "str");
+  const std::string name = name_obj.is_none () ? utf8Text (path.filename ().string ()) : castArgument<std::string> (name_obj, "name", "str");
+  checkName (name);
 
   // io::loadCloud is pcd_collision's reader: every check a file of unknown origin needs (PCL
   // 1.13's PCDReader crashes on a header without FIELDS), messages naming the file. With a
@@ -456,13 +541,16 @@ collideOne (const ModelPtr& a, const ModelPtr& b, const py::object& pose, const 
   return result;
 }
 
-/** \brief ValueError naming `threads` for a count pcd_collision's -threads refuses (above the
-  * library's kMaxThreads, or negative): one rule, detail::threadsRangeError. */
-void
-checkThreads (int threads)
+/** \brief The count, or ValueError naming `threads` for one pcd_collision's -threads refuses
+  * (above the library's kMaxThreads, or negative, however large): one rule, detail::threadsRangeError. */
+int
+checkThreads (const ThreadsArg& threads)
 {
-  if (const std::string why = detail::threadsRangeError (threads); !why.empty ())
-    throw py::value_error ("threads: " + why + ", got " + std::to_string (threads));
+  const bool in_int = threads.value >= std::numeric_limits<int>::min () && threads.value <= std::numeric_limits<int>::max ();
+  const int count = in_int ? static_cast<int> (threads.value) : (threads.value < 0 ? -1 : detail::kMaxThreads + 1);
+  if (const std::string why = detail::threadsRangeError (count); !why.empty ())
+    throw py::value_error ("threads: " + why + ", got " + threads.text);
+  return count;
 }
 
 /** CloudModelParams.noise_resolution_gate by name (the constructor and the attribute). */
@@ -599,10 +687,10 @@ runInterruptibly (Work&& work)
 
 std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
-             int threads)
+             const ThreadsArg& threads_arg)
 {
   const auto poses = poseArray (poses_obj);
-  checkThreads (threads);
+  const int threads = checkThreads (threads_arg);
   const CollisionRequest request = requestOf (request_obj);
   const auto p = poses.unchecked<3> ();
   std::vector<Eigen::Isometry3d> T (static_cast<std::size_t> (p.shape (0)));
@@ -1062,15 +1150,29 @@ PYBIND11_MODULE (_core, m)
     }
     catch (const pcl::BadArgumentException& e)
     {
-      PyErr_SetString (PyExc_ValueError, errorMessage (e).c_str ());
+      PyErr_SetString (PyExc_ValueError, utf8Text (errorMessage (e)).c_str ());
     }
     catch (const pcl::IOException& e)
     {
-      PyErr_SetString (PyExc_OSError, errorMessage (e).c_str ());
+      PyErr_SetString (PyExc_OSError, utf8Text (errorMessage (e)).c_str ());
     }
     catch (const pcl::PCLException& e)
     {
-      PyErr_SetString (PyExc_RuntimeError, errorMessage (e).c_str ());
+      PyErr_SetString (PyExc_RuntimeError, utf8Text (errorMessage (e)).c_str ());
+    }
+  });
+  // Every ValueError of this module's functions: a message naming a path that is not UTF-8 (the
+  // readers' "path: ..." messages) keeps it as \xNN escapes; pybind11's own translation made it
+  // an empty ValueError. Local: other pybind11 modules' exceptions are theirs.
+  py::register_local_exception_translator ([] (std::exception_ptr p) {
+    try
+    {
+      if (p)
+        std::rethrow_exception (p);
+    }
+    catch (const py::value_error& e)
+    {
+      PyErr_SetString (PyExc_ValueError, utf8Text (e.what ()).c_str ());
     }
   });
 
@@ -1146,7 +1248,7 @@ PYBIND11_MODULE (_core, m)
       "so a propagated orientation, once checked by the winding number, says where the inside is.")
       .def (py::init ([] (int k, const SensorNoiseModel& noise, bool surface_projection, int n_max, std::optional<int> n_min,
                           double sigma_max, double epsilon, double k_sigma, bool surface, NormalOrientation orientation,
-                          bool closed_objects, int threads, std::optional<double> noise_resolution, const std::string& noise_resolution_gate,
+                          bool closed_objects, const ThreadsArg& threads, std::optional<double> noise_resolution, const std::string& noise_resolution_gate,
                           bool keep_full_resolution, double noise_stop, const std::string& split, int n_noise_max,
                           const std::string& leakage_bound) {
               CloudModelParams p;
@@ -1163,8 +1265,7 @@ PYBIND11_MODULE (_core, m)
               p.hierarchy.sigma_max = sigma_max;
               p.hierarchy.epsilon = epsilon;
               p.hierarchy.k_sigma = k_sigma;
-              checkThreads (threads);
-              p.threads = threads;
+              p.threads = checkThreads (threads);
               p.noise_resolution = noise_resolution;
               setResolutionGate (p, noise_resolution_gate);
               p.keep_full_resolution = keep_full_resolution;
@@ -1236,10 +1337,7 @@ PYBIND11_MODULE (_core, m)
                       "leaning to collision (P >= 0.5) is asked again at full resolution within 256 leaf-pair fits,\n"
                       "and its collision stands (CollisionResult.full_resolution). Default True.")
       .def_property ("threads", [] (const CloudModelParams& p) { return p.threads; },
-                     [] (CloudModelParams& p, int v) {
-                       checkThreads (v);
-                       p.threads = v;
-                     },
+                     [] (CloudModelParams& p, const ThreadsArg& v) { p.threads = checkThreads (v); },
                      "Threads of the build (covariance estimation and hierarchy), in [0, MAX_THREADS]; default 0:\n"
                      "one per hardware thread. The model is the same for any count. ValueError outside that range,\n"
                      "as pcd_collision refuses -threads.")
@@ -1710,7 +1808,7 @@ PYBIND11_MODULE (_core, m)
            const CloudModel::ConstPtr model = loadModel (path, params, name, file_warning);
            if (file_warning.empty ())
              return warnedModel (model);
-           if (PyErr_WarnEx (PyExc_RuntimeWarning, file_warning.c_str (), 1) < 0)
+           if (PyErr_WarnEx (PyExc_RuntimeWarning, utf8Text (file_warning).c_str (), 1) < 0)
              throw py::error_already_set ();
            return std::const_pointer_cast<CloudModel> (model);
          },
@@ -1729,6 +1827,7 @@ PYBIND11_MODULE (_core, m)
          "    so far from the origin that their rounding to float passes a tenth of an isotropic sigma (under another\n"
          "    noise model, 1e-5 of the cloud's size), as pcd_collision warns; otherwise it carries CloudModel.warning,\n"
          "    as build_model's.");
+  m.attr ("__version__") = std::string (libraryVersion ());  // project(VERSION), as pcd_collision -version
   m.attr ("MAX_COORDINATE") = detail::kMaxCoordinate;  // the library's coordinate and translation bound
   m.attr ("MAX_THREADS") = detail::kMaxThreads;         // the library's cap on a thread count
   // pcd_collision's own defaults (pcd_collision::Defaults), which the Dask command line shares.

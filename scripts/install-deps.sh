@@ -2,7 +2,7 @@
 # Installs the Debian packages pcl_probcollision needs to build, test and benchmark, plus any
 # extra package names given as arguments. Idempotent: does nothing when all are installed.
 set -euo pipefail
-packages=(cmake make g++ pkg-config libpcl-dev libeigen3-dev libflann-dev libboost-dev
+packages=(cmake make g++ pkg-config doxygen libpcl-dev libeigen3-dev libflann-dev libboost-dev
           libgtest-dev libbenchmark-dev libfcl-dev liboctomap-dev gnuplot-nox
           pybind11-dev python3-dev python3-numpy python3-pytest python3-dask python3-distributed
           python3-open3d "$@")

@@ -362,10 +362,10 @@ parseCommandLine (const std::vector<std::string>& args)
   {
     if (a == "--")
       break;
-    if (a == "-h" || a == "--help" || a == "-help")
+    if (a == "-h" || a == "--help" || a == "-help" || a == "-version" || a == "--version")
     {
       ParseResult r;
-      r.kind = ParseResult::Kind::Help;
+      r.kind = a.find ("version") != std::string::npos ? ParseResult::Kind::Version : ParseResult::Kind::Help;
       return r;
     }
   }
@@ -830,6 +830,7 @@ helpText ()
        "  -json           one JSON object per query on stdout (one line each); human text to stderr\n"
        "  -v              also show PCL's and VTK's own messages\n"
        "  -h, -help, --help  this help\n"
+       "  -version, --version  the tool's, the library's and PCL's versions\n"
        "\n"
        "Exit status: 0 the query ran (whatever the verdict), 1 runtime failure (unreadable or\n"
        "malformed file, including a malformed -poses line; no finite point; write failure; query\n"

@@ -158,8 +158,9 @@ struct ParseResult
   enum class Kind
   {
     Run,    ///< options are valid
-    Help,   ///< -h / --help: print the help and exit 0
-    Error   ///< usage error: print `error` and exit 2
+    Help,     ///< -h / --help: print the help and exit 0
+    Version,  ///< -version / --version: print the versions and exit 0
+    Error     ///< usage error: print `error` and exit 2
   };
   Kind kind = Kind::Error;
   Options options;

@@ -12,9 +12,11 @@
 
 #include <pcl_probcollision/error_message.h>
 #include <pcl_probcollision/probabilistic_collision.h>
+#include <pcl_probcollision/version.h>
 
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
+#include <pcl/pcl_config.h>
 
 #include <unistd.h>
 
@@ -28,8 +30,8 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <future>
+#include <iostream>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -506,6 +508,12 @@ run (int argc, char** argv)
   if (parsed.kind == ParseResult::Kind::Help)
   {
     std::fputs (helpText ().c_str (), stdout);
+    return 0;
+  }
+  if (parsed.kind == ParseResult::Kind::Version)
+  {
+    std::printf ("pcd_collision %s (library %s, PCL %s)\n", PCL_PROBCOLLISION_VERSION_STRING,
+                 pcl_probcollision::libraryVersion (), PCL_VERSION_PRETTY);
     return 0;
   }
   if (parsed.kind == ParseResult::Kind::Error)

@@ -32,7 +32,9 @@ enum class Loss
   */
 struct ClassifierParams
 {
+  /** \brief Which separating surface to fit (default Ladder). */
   KernelMode kernel = KernelMode::Ladder;
+  /** \brief How the covariances enter training (default Robust). */
   TrainingMode training = TrainingMode::Robust;
   /** \brief kappa, the per-point chance-constraint level in (0.5, 1); gamma = Phi^-1(kappa)
     * (1.2816 for 0.9). */
@@ -79,6 +81,7 @@ struct ClassifierParams
 
   /** \brief Field-wise equality (every field, loss included). */
   bool operator== (const ClassifierParams& other) const;
+  /** \brief The negation of operator==. */
   bool operator!= (const ClassifierParams& other) const { return !(*this == other); }
 };
 

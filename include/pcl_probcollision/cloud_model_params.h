@@ -153,6 +153,7 @@ struct CloudModelParams
     WhereNoiseExceedsSpacing,
     WholeCloud
   };
+  /** \brief Where noise_resolution merges (see ResolutionGate; default WholeCloud). */
   ResolutionGate noise_resolution_gate = ResolutionGate::WholeCloud;
   /** \brief Where noise_resolution merged samples, also keep the unmerged model
     * (CloudModel::fullResolution()): a query whose merged answer is the separators' contact

@@ -51,6 +51,8 @@ struct CollisionRequest
   /** \brief Fill the timings of the result. */
   bool enable_timings = false;
 
+  /** \brief How the traversal treats node pairs whose boxes are disjoint (default
+    * ExpectedWeight). */
   TraversalMode traversal = TraversalMode::ExpectedWeight;
   /** \brief ExpectedWeight: prune once the reach weight falls below this; [0, 1]. Default 1e-3. */
   double rho_min = 1e-3;
@@ -169,6 +171,7 @@ struct CollisionRequest
   }
   /** \brief Every member equal (the classifier's parameters included). */
   bool operator== (const CollisionRequest& o) const;
+  /** \brief The negation of operator==. */
   bool operator!= (const CollisionRequest& o) const { return !(*this == o); }
 };
 } // namespace pcl_probcollision

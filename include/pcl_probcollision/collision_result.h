@@ -45,9 +45,15 @@ struct CollisionResult
     InvalidInput,     ///< see message: no cloud, no finite point, non-finite pose, ...
     NumericalFailure  ///< see message: a classifier produced no usable separator
   };
+  /** \brief Ok when the query answered, otherwise why not (InvalidInput until a query sets
+    * it). */
   Status status = Status::InvalidInput;
+  /** \brief Why the query failed; after a success empty, or the models' warnings (e.g. that
+    * the separators answered a surface request), joined by "; ". */
   std::string message;
 
+  /** \brief The verdict of P under the request's free_below and collision_above; Unknown
+    * when the query failed. */
   Verdict verdict = Verdict::Unknown;
   /** \brief Whose answer P is. Separators also when CollisionRequest::surface is set but a model
     * carries no surface model (CloudModelParams::surface off): the request then falls back to the
@@ -83,6 +89,7 @@ struct CollisionResult
   /** \brief With sample_distance, the two nearest samples, A's (the input's for
     * ProbabilisticCollision) and B's, in the query frame (as witness_point); NaN otherwise. */
   Eigen::Vector3d nearest_point_a = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  /** \brief B's nearest sample (see nearest_point_a). */
   Eigen::Vector3d nearest_point_b = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   /** \brief True when the traversal stopped early: P is then a lower bound (the verdict is
     * InCollision and final, unless budget_exhausted, or pooled: CollisionRequest::surface_pooled
@@ -140,6 +147,8 @@ struct CollisionResult
     * one object wholly inside the other), that of the other's sample nearest the point: the way
     * out (NaN where that sample has no normal). */
   Eigen::Vector3d witness_point = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
+  /** \brief The unit normal at witness_point, toward A's side: the separator's or the
+    * surface layer's (see witness_point, also for when it is NaN). */
   Eigen::Vector3d witness_normal = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
 
   // Counters.
@@ -160,6 +169,7 @@ struct CollisionResult
   /** \brief Milliseconds; NaN unless request.enable_timings. build covers covariance
     * estimation and hierarchies (0 when they were reused), query the traversal. */
   double build_ms = std::numeric_limits<double>::quiet_NaN ();
+  /** \brief Milliseconds of the traversal; NaN unless request.enable_timings. */
   double query_ms = std::numeric_limits<double>::quiet_NaN ();
 
   /** \brief Per-point P_i when request.per_point, index-aligned with each input cloud (its
@@ -167,6 +177,7 @@ struct CollisionResult
     * for points that were not used (non-finite, outside the indices) or that no tested leaf
     * pair contained (the traversal never came near them). */
   std::vector<float> probabilities_a;
+  /** \brief Per-point P_i of the target cloud (B), as probabilities_a. */
   std::vector<float> probabilities_b;
 
   /** \brief True when the query answered (status Ok). */

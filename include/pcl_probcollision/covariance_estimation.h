@@ -41,8 +41,11 @@ template <typename PointInT, typename PointOutT = Covariance>
 class CovarianceEstimation : public pcl::Feature<PointInT, PointOutT>
 {
 public:
+  /** \brief Shared pointer to an estimator. */
   using Ptr = pcl::shared_ptr<CovarianceEstimation<PointInT, PointOutT>>;
+  /** \brief Shared pointer to a const estimator. */
   using ConstPtr = pcl::shared_ptr<const CovarianceEstimation<PointInT, PointOutT>>;
+  /** \brief The output cloud: one PointOutT (a Covariance by default) per input point. */
   using PointCloudOut = typename pcl::Feature<PointInT, PointOutT>::PointCloudOut;
 
   CovarianceEstimation ()
@@ -54,6 +57,7 @@ public:
   /** \brief Number of nearest neighbours k >= 1 (default 10). Throws
     * pcl::BadArgumentException otherwise. */
   void setKSearch (int k);
+  /** \brief The number of nearest neighbours k. */
   int getKSearch () const { return this->k_; }
 
   /** \brief Global kernel scale tau > 0 (tau_i = tau r_i / sqrt(k)); unset means 2 sqrt(k).
@@ -64,15 +68,19 @@ public:
 
   /** \brief Whether Psi_i (the discretisation term) is added (default true). */
   void setUseDiscretization (bool use) { use_discretization_ = use; }
+  /** \brief Whether the discretisation term is added. */
   bool getUseDiscretization () const { return use_discretization_; }
 
   /** \brief The sensor noise added to every point (default none). */
   void setSensorNoise (const SensorNoiseModel& model) { noise_ = model; }
+  /** \brief The sensor noise model in use. */
   const SensorNoiseModel& getSensorNoise () const { return noise_; }
 
   /** \brief Sensor pose in the input cloud's frame for the depth models; unset means the
     * input's sensor_origin_ and sensor_orientation_. */
   void setSensorPose (const SensorPose& pose) { sensor_pose_ = pose; }
+  /** \brief The sensor pose in use: the one set, else the input cloud's viewpoint fields
+    * (SensorPose::fromViewpoint), else the default pose when there is no input. */
   SensorPose getSensorPose () const;
 
   /** \brief After compute(): r_i, the distance of each output point to its k-th neighbour
@@ -103,6 +111,7 @@ public:
     * position, k_eff = (sum w)^2 / sum w^2 the neighbours' effective number. Without a sensor
     * noise model nothing changes. getSurfaceDisplacements() returns x'_i - x_i. */
   void setSurfaceProjection (bool project) { project_ = project; }
+  /** \brief Whether surface projection is on. */
   bool getSurfaceProjection () const { return project_; }
   /** \brief After compute() with projection on: x'_i - x_i per output point (zero when
     * projection is off or moved nothing, NaN for non-finite points); empty otherwise. Kept as
@@ -112,11 +121,13 @@ public:
   /** \brief Also record, for the surface model (CloudModel), each point's unoriented normal
     * and its neighbours (default off: costs one eigen solve a point and k indices a point). */
   void setComputeSurface (bool compute) { compute_surface_ = compute; }
+  /** \brief Whether normals and neighbours are recorded for the surface model. */
   bool getComputeSurface () const { return compute_surface_; }
   /** \brief With setComputeSurface(true), whether to fit each point's normal (default on). Off
     * when the caller has a normal for every point: the neighbours are still recorded, without
     * the eigen solve a point, and getNormals() stays empty. */
   void setComputeNormals (bool compute) { compute_normals_ = compute; }
+  /** \brief Whether each point's normal is fitted (with setComputeSurface(true)). */
   bool getComputeNormals () const { return compute_normals_; }
   /** \brief After compute() with setComputeSurface(true) (and setComputeNormals, the default):
     * the unit normal of the plane fitted
@@ -133,6 +144,7 @@ public:
     * search (no setSearchMethod), whose concurrent queries are known to be safe. Throws
     * pcl::BadArgumentException for a negative count. */
   void setNumberOfThreads (int threads);
+  /** \brief The thread count as set (0 = one per hardware thread). */
   int getNumberOfThreads () const { return threads_; }
 
   /** \brief pcl::Feature::compute(), with the output sized beside the k-d tree's build where
@@ -142,7 +154,12 @@ public:
   void compute (PointCloudOut& output);
 
 protected:
+  /** \brief pcl::Feature::initCompute() after this class's checks: fails with a PCL_ERROR for a
+    * radius search, k < 1 or a sensor pose the noise model cannot use; defaults the search to
+    * a k-d tree (Euclidean, also for organized clouds). */
   bool initCompute () override;
+  /** \brief Computes the covariance of every input point (or indexed point) into output,
+    * and the per-point outputs the settings ask for. */
   void computeFeature (PointCloudOut& output) override;
 
 private:

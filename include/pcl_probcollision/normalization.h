@@ -26,10 +26,12 @@ struct UnitCubeTransform
   Eigen::Vector3d shift = Eigen::Vector3d::Zero ();   ///< m
   Eigen::Vector3d offset = Eigen::Vector3d::Zero ();  ///< o
 
+  /** \brief Maps a point into the unit cube: S (x - m) + o. */
   Eigen::Vector3d apply (const Eigen::Vector3d& x) const
   {
     return scale.cwiseProduct (x - shift) + offset;
   }
+  /** \brief Maps a unit-cube point back: S^-1 (y - o) + m. */
   Eigen::Vector3d applyInverse (const Eigen::Vector3d& y) const
   {
     return (y - offset).cwiseQuotient (scale) + shift;
@@ -50,6 +52,7 @@ struct UnitCubeTransform
          xz, yz, sz * sz * sigma (2, 2);
     return m;
   }
+  /** \brief Maps a unit-cube covariance back: S^-1 Sigma S^-1 (not symmetrised). */
   Eigen::Matrix3d applyInverseToCovariance (const Eigen::Matrix3d& sigma) const
   {
     const Eigen::Vector3d inv = scale.cwiseInverse ();

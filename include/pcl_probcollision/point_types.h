@@ -29,6 +29,18 @@ namespace pcl_probcollision
   */
 struct Covariance
 {
+  /** \var xx
+    * \brief Variance along x (PCD field cov_xx).
+    * \var xy
+    * \brief Covariance of x and y (PCD field cov_xy).
+    * \var xz
+    * \brief Covariance of x and z (PCD field cov_xz).
+    * \var yy
+    * \brief Variance along y (PCD field cov_yy).
+    * \var yz
+    * \brief Covariance of y and z (PCD field cov_yz).
+    * \var zz
+    * \brief Variance along z (PCD field cov_zz). */
   float xx = 0.f, xy = 0.f, xz = 0.f, yy = 0.f, yz = 0.f, zz = 0.f;
 
   Covariance () = default;

@@ -57,10 +57,15 @@ template <typename PointT>
 class ProbabilisticCollision : public pcl::FilterIndices<PointT>
 {
 public:
+  /** \brief Shared pointer to a ProbabilisticCollision. */
   using Ptr = pcl::shared_ptr<ProbabilisticCollision<PointT>>;
+  /** \brief Shared pointer to a const ProbabilisticCollision. */
   using ConstPtr = pcl::shared_ptr<const ProbabilisticCollision<PointT>>;
+  /** \brief The type of both clouds. */
   using PointCloud = pcl::PointCloud<PointT>;
+  /** \brief Shared pointer to a const cloud. */
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  /** \brief Shared pointer to a const cloud of per-point covariances. */
   using CovarianceCloudConstPtr = pcl::PointCloud<Covariance>::ConstPtr;
 
   /** \brief No clouds yet; both models' parameters and the request are their defaults
@@ -85,9 +90,11 @@ public:
 
   /** \brief Object B; marks its model for rebuild (even for the same pointer). */
   void setTargetCloud (const PointCloudConstPtr& target) { target_ = target; markTarget (); }
+  /** \brief Object B (null before setTargetCloud()). */
   PointCloudConstPtr getTargetCloud () const { return target_; }
   /** \brief Restricts B to these indices (all points by default); marks its model for rebuild. */
   void setTargetIndices (const pcl::IndicesConstPtr& indices) { target_indices_ = indices; markTarget (); }
+  /** \brief B's indices (null: all points). */
   pcl::IndicesConstPtr getTargetIndices () const { return target_indices_; }
 
   /** \brief Covariances of A, index-aligned with the whole input cloud (not its indices);
@@ -99,27 +106,36 @@ public:
   /** \brief Sensor noise added to A's estimated covariances (CloudModelParams::noise, default
     * none). The depth models read the input cloud's sensor_origin_ / sensor_orientation_. */
   void setInputNoise (const SensorNoiseModel& noise) { input_params_.noise = noise; markInput (); }
+  /** \brief A's sensor noise model. */
   const SensorNoiseModel& getInputNoise () const { return input_params_.noise; }
   /** \brief Sensor noise added to B's estimated covariances (default none). */
   void setTargetNoise (const SensorNoiseModel& noise) { target_params_.noise = noise; markTarget (); }
+  /** \brief B's sensor noise model. */
   const SensorNoiseModel& getTargetNoise () const { return target_params_.noise; }
 
   /** \brief k of the covariance estimation for both clouds, >= 1 (CloudModelParams::k);
     * throws otherwise. */
   void setKSearch (int k);
+  /** \brief k of A's model parameters (setKSearch() sets both clouds'). */
   int getKSearch () const { return input_params_.k; }
   /** \brief Locally denoised point positions for both clouds
     * (CloudModelParams::surface_projection, default on). */
   void setSurfaceProjection (bool project);
+  /** \brief Surface projection of A's model parameters (setSurfaceProjection() sets both
+    * clouds'). */
   bool getSurfaceProjection () const { return input_params_.surface_projection; }
   /** \brief Hierarchy parameters, used for both clouds (CloudModelParams::hierarchy); validated. */
   void setHierarchyParams (const BVHParams& params);
+  /** \brief Hierarchy parameters of A's model parameters (setHierarchyParams() sets both
+    * clouds'). */
   const BVHParams& getHierarchyParams () const { return input_params_.hierarchy; }
   /** \brief Everything a model of A is built from but the cloud; validated. */
   void setInputModelParams (const CloudModelParams& params) { params.validate (); input_params_ = params; markInput (); }
+  /** \brief Everything a model of A is built from but the cloud. */
   const CloudModelParams& getInputModelParams () const { return input_params_; }
   /** \brief Everything a model of B is built from but the cloud; validated. */
   void setTargetModelParams (const CloudModelParams& params) { params.validate (); target_params_ = params; markTarget (); }
+  /** \brief Everything a model of B is built from but the cloud. */
   const CloudModelParams& getTargetModelParams () const { return target_params_; }
 
   /** \brief Uses a prebuilt model of A instead of building one from the input cloud (null:
@@ -130,6 +146,7 @@ public:
   /** \brief The models of the last successful compute (null before): share them with
     * collide() from other threads. */
   CloudModel::ConstPtr getInputModel () const { return input_model_; }
+  /** \brief B's counterpart of getInputModel(). */
   CloudModel::ConstPtr getTargetModel () const { return target_model_; }
   /** \brief Rebuilds the models built from clouds at the next query: for clouds changed in place
     * without being set again. Prebuilt models are kept. */
@@ -140,6 +157,7 @@ public:
     * (CloudModelParams::surface) if they lack it; a model set by setInputModel() or setTargetModel()
     * is used as given. */
   void setRequest (const CollisionRequest& request);
+  /** \brief The query parameters. */
   const CollisionRequest& getRequest () const { return request_; }
   /** \brief Verdict thresholds on P: Free below free_below, InCollision above collision_above. */
   void setThresholds (double free_below, double collision_above);
@@ -148,6 +166,7 @@ public:
 
   /** \brief Minimum P_i kept by filter(), in [0, 1] (default 0.5); throws otherwise. */
   void setProbabilityThreshold (double p);
+  /** \brief The minimum P_i filter() keeps. */
   double getProbabilityThreshold () const { return probability_threshold_; }
 
   /** \brief Query with both clouds in their own frames as given (identity pose). */
@@ -185,9 +204,13 @@ public:
   /** \brief Like pcl::Filter::filter, but the output is cleared first, so a failed call never
     * leaves stale points behind. */
   void filter (PointCloud& output) { output.clear (); pcl::FilterIndices<PointT>::filter (output); }
+  /** \brief Like pcl::Filter::filter for indices, with indices cleared first. */
   void filter (pcl::Indices& indices) { indices.clear (); pcl::FilterIndices<PointT>::filter (indices); }
 
 protected:
+  /** \brief Runs an exhaustive per-point query and keeps the indices of A whose P_i reaches
+    * the probability threshold (the others with setNegative()); empty, with a PCL_ERROR, when
+    * the query fails or the input model is not the input cloud's. */
   void applyFilter (pcl::Indices& indices) override;
   using pcl::FilterIndices<PointT>::applyFilter;
 

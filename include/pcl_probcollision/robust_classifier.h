@@ -33,7 +33,10 @@ enum class Rung
   * features (RFF, RFFLarge). f > 0 on A's side. */
 struct SeparatorModel
 {
+  /** \brief Which model f is (None: nothing fitted, the model is empty). */
   Rung rung = Rung::None;
+  /** \brief The centre the unit-cube map subtracts (input frame; the centroid of both point
+    * sets). */
   Eigen::Vector3d centroid = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   double scale = std::numeric_limits<double>::quiet_NaN ();  ///< 1 / (2 r_c), 1 when r_c = 0
   Eigen::VectorXd weights;  ///< w: 3 entries (Linear) or D entries (RFF)
@@ -48,7 +51,10 @@ struct ClassifierResult
   /** \brief No rung was fitted: the start plane's maximum was at most the caller's
     * skip_at_or_below (classify() with a kernel mode). */
   bool dominated = false;
+  /** \brief Why the classification failed (ok false): an unusable input or a non-finite
+    * separator; empty otherwise. */
   std::string message;
+  /** \brief The rung kept (None when nothing was fitted: a failure, or dominated). */
   Rung rung = Rung::None;
   /** \brief Every solve of the kept rung met its tolerance: Newton |grad J| <= 1e-10
     * max(1, |J|) or an accepted step below 1e-12 (METHOD.md 5.3); L-BFGS |grad J| <= 1e-9
@@ -128,6 +134,7 @@ public:
   /** \brief Validates the parameters (throws pcl::BadArgumentException) and draws the RFF map. */
   explicit RobustClassifier (const ClassifierParams& params = ClassifierParams ());
 
+  /** \brief The parameters this classifier was built with. */
   const ClassifierParams& getParams () const { return params_; }
 
   /** \brief Fits the separator and fills per-point probabilities.

@@ -13,7 +13,9 @@ namespace pcl_probcollision
   * axis = sensor_orientation_ * (0, 0, 1). */
 struct SensorPose
 {
+  /** \brief The optical centre (default the origin). */
   Eigen::Vector3d origin = Eigen::Vector3d::Zero ();
+  /** \brief The optical axis, a unit vector (default +z). */
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ ();
 
   /** \brief From PCL's viewpoint fields (sensor_origin_, sensor_orientation_). A zero
@@ -68,6 +70,7 @@ struct LidarNoiseParams
 class SensorNoiseModel
 {
 public:
+  /** \brief The kind of noise model. */
   enum class Type
   {
     None,         ///< no sensor noise
@@ -78,8 +81,11 @@ public:
     Lidar         ///< range sigma_r, angular sigma_phi
   };
 
+  /** \brief Parameters of kinect(). */
   using KinectParams = KinectNoiseParams;
+  /** \brief Parameters of stereo(). */
   using StereoParams = StereoNoiseParams;
+  /** \brief Parameters of lidar(). */
   using LidarParams = LidarNoiseParams;
 
   /** \brief No sensor noise (the default). */
@@ -123,7 +129,10 @@ public:
   /** \brief Axial and lateral standard deviations at a point (metres for the depth models).
     * \param[in] point the measured point in the cloud's frame
     * \param[in] normal unit surface normal (only KinectV1 reads it; zero means facing the ray)
-    * \param[in] sensor the sensor pose in the cloud's frame */
+    * \param[in] sensor the sensor pose in the cloud's frame
+    * \param[out] sigma_axial standard deviation along the viewing ray (0 for None and
+    *             Anisotropic, sigma for Isotropic)
+    * \param[out] sigma_lateral standard deviation across the viewing ray (likewise) */
   void sigmas (const Eigen::Vector3d& point, const Eigen::Vector3d& normal, const SensorPose& sensor,
                double& sigma_axial, double& sigma_lateral) const;
 

@@ -66,8 +66,11 @@ public:
     * an oriented sample has radius -1 (empty()). */
   struct Dipole
   {
+    /** \brief Area-weighted centre of the node's oriented samples (local frame). */
     Eigen::Vector3f center = Eigen::Vector3f::Zero ();
+    /** \brief Sum of those samples' area-weighted unit normals. */
     Eigen::Vector3f moment = Eigen::Vector3f::Zero ();
+    /** \brief Bound on those samples' distance from center; -1 for a node without one. */
     float radius = -1.0f;
 
     /** \brief True when the node holds no oriented sample (it adds nothing to the winding
@@ -169,7 +172,8 @@ public:
     * slant, and one may be empty), behind the viewpoint, or for a surface not seen from one
     * viewpoint. The space behind a scan was never observed: the
     * query reads a part there, clear of the surface, as unknown (docs/SURFACE.md, step 6).
-    * \param[in] bvh the hierarchy this model was built over */
+    * \param[in] bvh the hierarchy this model was built over
+    * \param[in] x the point, in the local frame */
   double behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x) const;
   /** \brief False when no point in the convex hull of `corners` (local frame) can lie more than
     * margin behind what the viewpoint saw (behindView() > margin): its farthest corner is nearer
@@ -217,6 +221,7 @@ public:
     * on a part thinner than the offset come out of the solid (a noisy box sampled 6 mm apart: 89 %
     * inside), and on a plate all of them: then the orientation cannot be checked there. */
   static constexpr double kMinClosedShare = 0.9;
+  /** \brief The solidShare() a propagated orientation needs (see kMinClosedShare). */
   static constexpr double kMinSolidShare = 0.5;
   /** \brief Where Inputs::closed_objects asked for it and the orientation was propagated: the
     * share of the probed samples (at most 1,024, evenly spread over the oriented ones) in front
@@ -249,7 +254,8 @@ public:
     * inside a closed surface, 0 outside, +-1/2 on either side of an open sheet (Barill et al.
     * 2018, point version: each sample a disc of area a_i; nodes farther than twice their radius
     * are taken as one dipole).
-    * \param[in] bvh the hierarchy this model was built over */
+    * \param[in] bvh the hierarchy this model was built over
+    * \param[in] q the query point, in the local frame */
   double windingNumber (const ProbabilisticBVH& bvh, const Eigen::Vector3d& q) const;
 
   /** \brief Memory held in bytes. */
@@ -291,8 +297,12 @@ private:
       * (zero where the sample has none), set once the model's normals are final. */
     struct Nearest
     {
+      /** \brief The sample's distance from the view (NaN where the bin holds none). */
       float range = std::numeric_limits<float>::quiet_NaN ();
+      /** \brief The sample's point index (-1 where the bin holds none). */
       std::int32_t index = -1;
+      /** \brief Unit normal of the plane behindView() takes there, toward the view (zero
+        * where the sample has none). */
       Eigen::Vector3f normal = Eigen::Vector3f::Zero ();
     };
     std::vector<Key> keys;          ///< sorted

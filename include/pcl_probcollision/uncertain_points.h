@@ -18,7 +18,9 @@ namespace pcl_probcollision
   */
 struct UncertainCloud
 {
+  /** \brief Mean of each point's Gaussian (data units). */
   std::vector<Eigen::Vector3d> means;
+  /** \brief Covariance of each point, index-aligned with means (units squared). */
   std::vector<Eigen::Matrix3d> covariances;
   /** \brief Surface area each point stands for, up to a common factor: r_k^2 with r_k the
     * distance to the k-th neighbour (METHOD.md 8.4). Empty means equal weights. */
@@ -26,7 +28,9 @@ struct UncertainCloud
   /** \brief Index of each point in the caller's input cloud (finite points only are kept). */
   std::vector<int> source_indices;
 
+  /** \brief Number of points (of means). */
   std::size_t size () const { return means.size (); }
+  /** \brief True when there is no point (no mean). */
   bool empty () const { return means.empty (); }
 };
 
@@ -38,6 +42,18 @@ struct UncertainCloud
   * uncertainty. Arithmetic on the entries is in double. */
 struct PackedCovariance
 {
+  /** \var xx
+    * \brief Variance along x.
+    * \var xy
+    * \brief Covariance of x and y.
+    * \var xz
+    * \brief Covariance of x and z.
+    * \var yy
+    * \brief Variance along y.
+    * \var yz
+    * \brief Covariance of y and z.
+    * \var zz
+    * \brief Variance along z. */
   float xx = 0.0f, xy = 0.0f, xz = 0.0f, yy = 0.0f, yz = 0.0f, zz = 0.0f;
 
   PackedCovariance () = default;
@@ -73,15 +89,22 @@ struct PackedCovariance
 /** \brief A non-owning view of n points with covariances, as the classifier consumes them. */
 struct PointSetView
 {
+  /** \brief The n means (not owned). */
   const Eigen::Vector3d* means = nullptr;
+  /** \brief The n covariances, index-aligned with means (not owned). */
   const Eigen::Matrix3d* covariances = nullptr;
+  /** \brief Number of points n. */
   std::size_t size = 0;
 
   PointSetView () = default;
+  /** \brief A view of n means at m and n covariances at c. */
   PointSetView (const Eigen::Vector3d* m, const Eigen::Matrix3d* c, std::size_t n)
     : means (m), covariances (c), size (n) {}
+  /** \brief A view of the vectors' data, of the shorter vector's size; valid while neither is
+    * resized or destroyed. */
   PointSetView (const std::vector<Eigen::Vector3d>& m, const std::vector<Eigen::Matrix3d>& c)
     : means (m.data ()), covariances (c.data ()), size (m.size () < c.size () ? m.size () : c.size ()) {}
+  /** \brief A view of a cloud's means and covariances (as the vector constructor). */
   explicit PointSetView (const UncertainCloud& cloud)
     : PointSetView (cloud.means, cloud.covariances) {}
 };

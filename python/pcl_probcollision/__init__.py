@@ -11,6 +11,7 @@ Build a model per cloud once, then query pairs of models under poses::
 The compiled core is pcl_probcollision._core; everything public is re-exported here.
 Pose batches over Dask workers: pcl_probcollision.dask (needs python3-distributed).
 """
+from ._core import __version__  # noqa: F401
 from ._core import (  # noqa: F401
     AnsweredBy,
     ClassifierParams,

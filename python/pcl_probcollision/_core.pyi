@@ -1,37 +1,57 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Type stub of the compiled extension pcl_probcollision._core (python/bindings.cpp).
 # Defaults shown as "..." are the C++ structs' own defaults (see help() for their values).
-import enum
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, ClassVar, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 _Pose = Union[npt.ArrayLike, Tuple[npt.ArrayLike, npt.ArrayLike]]
+# A file path: str, bytes, or os.PathLike, as os.fsencode takes it (a name that is not UTF-8 too).
+_Path = Union[str, bytes, os.PathLike]
 
-class Verdict(enum.IntEnum):
-    Unknown: int
-    Free: int
-    InContact: int
-    InCollision: int
+class _Enum:
+    """Not a runtime class: what every enum of the module has. They are pybind11 enums (py::enum_
+    of pybind11 2.10, which has no py::native_enum), not enum.Enum: no int subclass, no iteration;
+    == compares with the same enum only (Verdict.Free != 1), int(x) and operator.index(x) give the
+    value, Verdict(1) gives the member, __members__ maps names to members in declaration order."""
+    __members__: ClassVar[Dict[str, Any]]
+    def __init__(self, value: int) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
+    def __int__(self) -> int: ...
+    def __index__(self) -> int: ...
+    def __getstate__(self) -> int: ...
+    def __setstate__(self, state: int) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def value(self) -> int: ...
 
-class AnsweredBy(enum.IntEnum):
-    Unknown: int
-    Separators: int
-    SurfaceLayer: int
-    Pooled: int
+class Verdict(_Enum):
+    Unknown: ClassVar[Verdict]
+    Free: ClassVar[Verdict]
+    InContact: ClassVar[Verdict]
+    InCollision: ClassVar[Verdict]
 
-class TraversalMode(enum.IntEnum):
-    ExpectedWeight: int
-    Stochastic: int
-    ExpandedBV: int
+class AnsweredBy(_Enum):
+    Unknown: ClassVar[AnsweredBy]
+    Separators: ClassVar[AnsweredBy]
+    SurfaceLayer: ClassVar[AnsweredBy]
+    Pooled: ClassVar[AnsweredBy]
 
-class NormalOrientation(enum.IntEnum):
-    Auto: int
-    PointNormals: int
-    Viewpoint: int
-    Propagate: int
+class TraversalMode(_Enum):
+    ExpectedWeight: ClassVar[TraversalMode]
+    Stochastic: ClassVar[TraversalMode]
+    ExpandedBV: ClassVar[TraversalMode]
+
+class NormalOrientation(_Enum):
+    Auto: ClassVar[NormalOrientation]
+    PointNormals: ClassVar[NormalOrientation]
+    Viewpoint: ClassVar[NormalOrientation]
+    Propagate: ClassVar[NormalOrientation]
 
 class SensorNoiseModel:
     def __init__(self) -> None: ...
@@ -86,18 +106,18 @@ class CloudModelParams:
         # n_min None: min(8, n_max), as pcd_collision's -nmax sets it.
     def validate(self) -> None: ...
 
-class KernelMode(enum.IntEnum):
-    Linear: int
-    RFF: int
-    Ladder: int
+class KernelMode(_Enum):
+    Linear: ClassVar[KernelMode]
+    RFF: ClassVar[KernelMode]
+    Ladder: ClassVar[KernelMode]
 
-class TrainingMode(enum.IntEnum):
-    Standard: int
-    Robust: int
+class TrainingMode(_Enum):
+    Standard: ClassVar[TrainingMode]
+    Robust: ClassVar[TrainingMode]
 
-class Loss(enum.IntEnum):
-    SquaredHinge: int
-    Huber: int
+class Loss(_Enum):
+    SquaredHinge: ClassVar[Loss]
+    Huber: ClassVar[Loss]
 
 class ClassifierParams:
     """The separators' leaf-pair classifier (METHOD.md 5.7); CollisionRequest.classifier."""
@@ -150,10 +170,10 @@ class CollisionRequest:
     def validate(self) -> None: ...
 
 class CollisionResult:
-    class Status(enum.IntEnum):
-        Ok: int
-        InvalidInput: int
-        NumericalFailure: int
+    class Status(_Enum):
+        Ok: ClassVar[CollisionResult.Status]
+        InvalidInput: ClassVar[CollisionResult.Status]
+        NumericalFailure: ClassVar[CollisionResult.Status]
     def __init__(self) -> None: ...
     @property
     def status(self) -> CollisionResult.Status: ...
@@ -276,6 +296,7 @@ class CloudModel:
     def surface_normals_off_surface(self) -> Optional[bool]: ...
     def __len__(self) -> int: ...
 
+__version__: str  # the library's version, "MAJOR.MINOR.PATCH" (pcd_collision -version)
 MAX_COORDINATE: float  # the library's coordinate and pose-translation bound (1e15)
 MAX_THREADS: int  # the library's cap on a thread count (1024; pcd_collision -threads, collide_batch's threads
                   # and CloudModelParams.threads refuse more with a ValueError)
@@ -289,7 +310,7 @@ def build_model(points: npt.NDArray[np.floating], covariances: Optional[npt.NDAr
                 normals: Optional[npt.NDArray[np.floating]] = None, *,
                 any_length_normals: bool = False, warn: bool = True) -> CloudModel: ...
 def organized_sensor_pose(points: npt.NDArray[np.floating]) -> Optional[Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]: ...
-def load_model(path: Union[str, os.PathLike], params: Optional[CloudModelParams] = None,
+def load_model(path: _Path, params: Optional[CloudModelParams] = None,
                name: Optional[str] = None) -> CloudModel: ...
 def collide(a: CloudModel, b: CloudModel, pose: _Pose, request: Optional[CollisionRequest] = None) -> CollisionResult: ...
 # threads: in [0, MAX_THREADS] (0: one per hardware thread); ValueError naming threads outside it.
@@ -297,8 +318,8 @@ def collide_batch(a: CloudModel, b: CloudModel, poses: npt.ArrayLike, request: O
                   threads: int = 0) -> List[CollisionResult]: ...
 def verdict_for(probability: float, request: CollisionRequest) -> Verdict: ...
 # rounding=True appends (largest change of a coordinate, largest |coordinate|) to the tuple.
-def read_cloud(path: Union[str, os.PathLike], *, rounding: bool = False) -> Tuple[Any, ...]: ...
-def read_cloud_with_normals(path: Union[str, os.PathLike], *, rounding: bool = False) -> Tuple[Any, ...]: ...
+def read_cloud(path: _Path, *, rounding: bool = False) -> Tuple[Any, ...]: ...
+def read_cloud_with_normals(path: _Path, *, rounding: bool = False) -> Tuple[Any, ...]: ...
 class InputFacts:
     def __init__(self, *, path: str, cloud: bool = True, finite: int = 0, diagonal: float = 0.0,
                  rounding: Tuple[float, float] = (0.0, 0.0), sensor: str = "isotropic", sigma: float = 0.0) -> None: ...
@@ -320,8 +341,8 @@ def noise_warning(input: InputFacts) -> str: ...
 def rounding_warning(input: InputFacts) -> str: ...
 def model_warning(input: InputFacts, model_warning: str) -> str: ...
 def between_samples_warning(both_meshes: bool, free: bool, leaf_pairs_tested: int, where: str, spacing: float) -> str: ...
-def is_faceless_ply(path: Union[str, os.PathLike]) -> bool: ...
-def read_mesh(path: Union[str, os.PathLike]) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
+def is_faceless_ply(path: _Path) -> bool: ...
+def read_mesh(path: _Path) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
 def sample_mesh(vertices: npt.ArrayLike, triangles: npt.ArrayLike, spacing: float, seed: int = 20111) -> npt.NDArray[np.float32]: ...
 def sample_mesh_with_normals(vertices: npt.ArrayLike, triangles: npt.ArrayLike, spacing: float,
                              seed: int = 20111) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
@@ -345,7 +366,7 @@ def pcd_collision_input_usage_error(flags: Sequence[str], mesh_a: bool, mesh_b: 
 def pcd_collision_json_lines(flags: Sequence[str], input_a: Dict[str, Any], input_b: Dict[str, Any],
                              fields: Dict[str, npt.ArrayLike], poses: npt.ArrayLike, build_ms: float) -> List[str]:
     """pcd_collision's -json lines, by its own writer, for answers held as columns."""
-def read_poses(path: Union[str, os.PathLike]) -> npt.NDArray[np.float64]: ...
+def read_poses(path: _Path) -> npt.NDArray[np.float64]: ...
 def poses_from_xyzrpy(poses: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
 def check_poses(poses: npt.ArrayLike) -> None: ...
 def invert_poses(poses: npt.ArrayLike) -> npt.NDArray[np.float64]: ...

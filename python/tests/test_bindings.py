@@ -851,6 +851,39 @@ def test_thread_counts_above_the_cap_are_refused_as_pcd_collision_refuses_them()
     assert p.threads == limit and len(pc.build_model(GOOD, params=p)) == len(pc.build_model(GOOD))
 
 
+def test_huge_thread_counts_are_refused_as_any_other_out_of_range_count():
+    # threads=10**12 raised pybind11's TypeError of a wrong type (beyond C int), where 1025 and -1
+    # raise the ValueError naming threads (docs/RELIABILITY.md): a Python int of any size now gets
+    # that ValueError, saying the count given, in each place threads is taken; a non-integer is
+    # still a TypeError.
+    a = pc.build_model(GOOD)
+    limit = pc._core.MAX_THREADS
+    for threads in (2**31, 10**12, -10**12, 10**100, -2**63 - 1):
+        message = rf"^threads: must be in \[0, {limit}\] \(0: one per hardware thread\), got {threads}$"
+        with pytest.raises(ValueError, match=message):
+            pc.collide_batch(a, a, np.eye(4)[None], threads=threads)
+        with pytest.raises(ValueError, match=message):
+            pc.CloudModelParams(threads=threads)
+        p = pc.CloudModelParams()
+        with pytest.raises(ValueError, match=message):
+            p.threads = threads
+    for wrong in (1.5, "2", None):
+        with pytest.raises(TypeError):
+            pc.collide_batch(a, a, np.eye(4)[None], threads=wrong)
+        with pytest.raises(TypeError):
+            pc.CloudModelParams(threads=wrong)
+        with pytest.raises(TypeError):
+            p.threads = wrong
+    # Integers that are not int (numpy's, a bool) still count, as pybind11's int caster took them.
+    p.threads = np.int64(2)
+    assert p.threads == 2 and pc.CloudModelParams(threads=np.uint8(3)).threads == 3
+    assert len(pc.collide_batch(a, a, np.eye(4)[None], threads=np.int32(1))) == 1
+    p.threads = True
+    assert p.threads == 1
+    p.threads = limit
+    assert p.threads == limit and len(pc.build_model(GOOD, params=p)) == len(pc.build_model(GOOD))
+
+
 @pytest.mark.parametrize("pose, exc, words", [
     (np.diag([2.0, 1, 1, 1]), ValueError, "rotation"),                     # scaled: not rigid
     (np.array([[1.0, 0.1, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]), ValueError, "rotation"),  # sheared
@@ -1129,6 +1162,15 @@ def test_load_model_reads_a_faceless_ply_as_pcd_collision_does(tmp_path):
         pc.load_model(mesh)
 
 
+def test_the_version_is_the_projects():
+    # project(VERSION) in CMakeLists.txt is the one owner; pcd_collision -version prints it too.
+    import re
+    cmake = (pathlib.Path(__file__).resolve().parents[2] / "CMakeLists.txt").read_text()
+    version = re.search(r"project\(pcl_probcollision VERSION (\d+\.\d+\.\d+)", cmake).group(1)
+    assert pc.__version__ == version
+    assert pc._core.__version__ == version
+
+
 def test_the_stub_names_what_the_module_has():
     # _core.pyi lacked full_resolution, sample_distance, nearest_point_a/_b and
     # keeps_full_resolution (a probe, 2026-12-03): every public name of the module and of each of
@@ -1148,17 +1190,61 @@ def test_the_stub_names_what_the_module_has():
                 out |= {t.id for t in node.targets if isinstance(t, ast.Name)}
         return out
 
-    top = names(tree.body) - {"_Pose"}
+    top = {n for n in names(tree.body) if not n.startswith("_")}  # _Pose, _Path, _Enum: the stub's own
     assert top == {n for n in dir(core) if not n.startswith("_")}
-    enum_members = {"name", "value"}  # the stub's enum.IntEnum has them
-    classes = [node for node in tree.body if isinstance(node, ast.ClassDef)]
+    classes = [node for node in tree.body if isinstance(node, ast.ClassDef) and not node.name.startswith("_")]
+    enum_base = next(node for node in tree.body if isinstance(node, ast.ClassDef) and node.name == "_Enum")
     assert len(classes) >= 8
     for node in classes:
         have = {n for n in dir(getattr(core, node.name)) if not n.startswith("_")}
         stub = names(node.body) - {"__init__", "__len__"}
-        if any(isinstance(b, ast.Name) and b.id == "enum" or isinstance(b, ast.Attribute) for b in node.bases):
-            have -= enum_members
+        if any(isinstance(b, ast.Name) and b.id == "_Enum" for b in node.bases):
+            stub |= {n for n in names(enum_base.body) if not n.startswith("_")}  # name, value
         assert have == stub, (node.name, sorted(have - stub), sorted(stub - have))
+
+
+def test_the_stub_describes_the_enums_the_module_has():
+    # The stub declared the enums enum.IntEnum; the module's are pybind11's py::enum_ (pybind11 2.10
+    # has no py::native_enum): no int subclass, == only with their own kind (docs/RELIABILITY.md).
+    # The stub now says so (its _Enum), and what it says holds: each enum's members, in order, are
+    # its __members__, each has what _Enum declares, and a member is its value to int() and index().
+    import ast
+    import enum
+    import operator
+    core = pc._core
+    tree = ast.parse(pathlib.Path(pc.__file__).with_name("_core.pyi").read_text())
+    stub = {}
+
+    def walk(body, prefix):
+        for node in body:
+            if isinstance(node, ast.ClassDef):
+                bases = [ast.unparse(b) for b in node.bases]
+                if bases in (["enum.IntEnum"], ["_Enum"]):
+                    stub[prefix + node.name] = bases[0], [n.target.id for n in node.body if isinstance(n, ast.AnnAssign)]
+                walk(node.body, prefix + node.name + ".")
+
+    walk(tree.body, "")
+    runtime = {}
+    for name, cls in vars(core).items():
+        if isinstance(cls, type):
+            runtime.update({name: cls} if "__members__" in vars(cls) else {})
+            runtime.update({name + "." + n: c for n, c in vars(cls).items() if isinstance(c, type) and "__members__" in vars(c)})
+    assert len(runtime) == 8 and set(stub) == set(runtime)
+    for name, (claimed_base, members) in stub.items():
+        assert issubclass(runtime[name], enum.IntEnum) == (claimed_base == "enum.IntEnum"), (name, claimed_base)
+        assert members == list(runtime[name].__members__), name
+    base = next(node for node in tree.body if isinstance(node, ast.ClassDef) and node.name == "_Enum")
+    declared = [n.name if isinstance(n, ast.FunctionDef) else n.target.id for n in base.body
+                if isinstance(n, (ast.FunctionDef, ast.AnnAssign))]
+    assert {"__int__", "__index__", "__members__", "name", "value"} <= set(declared)
+    for name, cls in runtime.items():
+        assert [attr for attr in declared if not hasattr(cls, attr)] == [], name
+        for member_name, member in cls.__members__.items():
+            assert member.name == member_name and getattr(cls, member_name) == member
+            assert int(member) == operator.index(member) == member.value and cls(member.value) == member
+    # As _Enum's docstring says: not an int, equal to its own kind only, an index all the same.
+    assert not isinstance(pc.Verdict.Free, int) and pc.Verdict.Free != 1 and int(pc.Verdict.Free) == 1
+    assert ["a", "b"][pc.Verdict.Free] == "b"
 
 
 def test_the_stub_gives_each_function_the_module_s_parameters():
@@ -1203,10 +1289,15 @@ def test_the_stub_gives_each_function_the_module_s_parameters():
 
     checked = 0
 
+    enums = [v for v in vars(core).values() if isinstance(v, type) and hasattr(v, "__members__")]
+
     def check(body, owner, where):
         nonlocal checked
         for node in body:
-            if isinstance(node, ast.ClassDef):
+            if isinstance(node, ast.ClassDef) and node.name == "_Enum":  # stub-only: every enum's methods
+                for e in enums + [core.CollisionResult.Status]:
+                    check(node.body, e, where + e.__name__ + ".")
+            elif isinstance(node, ast.ClassDef):
                 check(node.body, getattr(owner, node.name), where + node.name + ".")
             elif isinstance(node, ast.FunctionDef) and not any(
                     isinstance(d, ast.Name) and d.id == "property" for d in node.decorator_list):
@@ -1217,6 +1308,64 @@ def test_the_stub_gives_each_function_the_module_s_parameters():
 
     check(tree.body, core, "")
     assert checked >= 40, checked
+
+
+def test_a_path_that_is_not_utf8_is_read_and_named_in_its_errors(tmp_path):
+    # A path whose bytes are not UTF-8 (bytes, or a str holding them as surrogates, os.fsdecode)
+    # gave an empty ValueError, a missing one UnicodeDecodeError (docs/RELIABILITY.md). Each reader
+    # now raises what it raises for any path: FileNotFoundError and IsADirectoryError with the
+    # filename os.fsdecode gives (as open()), ValueError naming it with \xNN; and such a file reads.
+    raw = os.fsencode(tmp_path) + b"/x\xff"
+    readers = (pc.load_model, pc.read_cloud, pc._core.read_cloud_with_normals, pc.read_mesh, pc.read_poses,
+               pc.is_faceless_ply)
+    os.mkdir(raw + b".d")
+    for f in readers:
+        for given in (bytes, os.fsdecode, lambda p: pathlib.Path(os.fsdecode(p))):
+            with pytest.raises(FileNotFoundError) as missing:
+                f(given(raw + b".pcd"))
+            assert missing.value.filename == os.fsdecode(raw + b".pcd")
+            with pytest.raises(IsADirectoryError) as directory:
+                f(given(raw + b".d"))
+            assert directory.value.filename == os.fsdecode(raw + b".d")
+    escaped = os.fsdecode(raw).replace("\udcff", "\\xff")  # the name as the messages spell it
+    bad = raw + b"_bad.pcd"
+    with open(bad, "wb") as f:
+        f.write(b"not a point cloud\n")
+    for f in (pc.load_model, pc.read_cloud, pc._core.read_cloud_with_normals, pc.read_mesh, pc.read_poses):
+        with pytest.raises(ValueError) as refused:
+            f(bad)
+        assert escaped + "_bad.pcd" in str(refused.value), (f.__name__, str(refused.value))
+    os.rename(bad, raw + b"_bad.txt")
+    with pytest.raises(ValueError, match=r"only \.pcd and face-less \.ply files are read, got '.*x\\xff_bad\.txt'"):
+        pc.load_model(raw + b"_bad.txt")
+    # Such a file reads as under any name; the model's default name and the file's warning say it.
+    points = sheet()
+    write_pcd(os.fsdecode(raw + b".pcd"), points)
+    write_pcd(tmp_path / "plain.pcd", points)
+    for given in (raw + b".pcd", os.fsdecode(raw + b".pcd")):
+        assert np.array_equal(pc.read_cloud(given)[0], pc.read_cloud(tmp_path / "plain.pcd")[0])
+        assert len(pc.load_model(given)) == len(pc.load_model(tmp_path / "plain.pcd"))
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
+    write_pcd_double(os.fsdecode(raw + b"_far.pcd"), points.astype(np.float64) + np.array([1e4, 0.0, 0.0]))
+    with pytest.warns(RuntimeWarning) as caught:
+        pc.load_model(raw + b"_far.pcd", params=params)
+    assert [escaped + "_far.pcd' stores x y z in double precision" in str(w.message) for w in caught] == [True]
+    write_pcd(os.fsdecode(raw + b"_f32.pcd"), points.astype(np.float64) + np.array([1e5, 0.0, 0.0]))
+    with pytest.warns(RuntimeWarning, match=r"^x\\xff_f32\.pcd: .*float spacing"):
+        pc.load_model(raw + b"_f32.pcd", params=params)
+
+
+def test_a_name_holding_a_nul_is_refused():
+    # A NUL in name cut the messages naming the cloud ("ab\0cd" gave ValueError('ab'), a probe):
+    # build_model and load_model refuse it, naming name, rather than cut a message later.
+    message = r"^name: contains a NUL character \(at index 2\), which would cut the messages naming the cloud, got 'ab\\x00cd'$"
+    with pytest.raises(ValueError, match=message):
+        pc.build_model(GOOD, name="ab\0cd")
+    with pytest.raises(ValueError, match=message):
+        pc.build_model(np.zeros((0, 3)), name="ab\0cd")  # before the points' own error, which names it
+    with pytest.raises(ValueError, match=message):
+        pc.load_model(DATA / "table_mug.pcd", name="ab\0cd")
+    assert len(pc.build_model(GOOD, name="ab cd")) == len(pc.build_model(GOOD))
 
 
 def test_missing_mesh_files_raise_file_not_found():

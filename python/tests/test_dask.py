@@ -703,12 +703,17 @@ def test_cli_reads_options_as_pcd_collision_does(tmp_path, capsys):
     assert cli._as_flag_message("option threads: must be >= 0") == "option -threads: must be >= 0"
     with pytest.raises(SystemExit):  # -h wins over an unknown option, as in pcd_collision
         cli.parse(["-sigm", "-h"])
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as version:  # so does -version, naming the library's
+        cli.parse(["-sigm", "-version"])
+    assert version.value.code == 0
+    assert capsys.readouterr().out == f"pcl_probcollision.dask {pc.__version__} (library {pc.__version__})\n"
     with pytest.raises(ValueError, match="threads"):
         pcd.resolve_options({"threads": pc._core.MAX_THREADS + 1})
     # The flags this command passes on are pcd_collision's, all of them but -pose, -poses and -o
     # (its help names each): a flag added there and not here would be refused as unknown.
     shown = subprocess.run([_pcd_collision(), "-h"], capture_output=True, text=True).stdout
-    flags = set(re.findall(r"(?:^|[ ,])(-[a-z_]+)\b", shown, re.M)) - {"-h", "-help", "-pose", "-poses", "-o"}
+    flags = set(re.findall(r"(?:^|[ ,])(-[a-z_]+)\b", shown, re.M)) - {"-h", "-help", "-version", "-pose", "-poses", "-o"}
     assert flags == {"-" + name for name in (*cli._VALUES, *cli._SWITCH)}
     # Both command lines refuse the same arguments as usage errors (exit 2), before any work, in
     # the same words: pcd_collision's parser judges its flags for both (before, the Dask command

@@ -2,11 +2,13 @@
 // A consumer of the installed package, as a PCL user writes one: every point type the library is
 // compiled for links without PCL_NO_PRECOMPILE, and the issue #15 checks hold through the
 // installed headers and library (models rebuilt when a cloud changed in place is set again;
-// the same answer for a scene exactly shifted by about 1 km). Exits non-zero on any failure.
+// the same answer for a scene exactly shifted by about 1 km), and the installed version header
+// agrees with the library. Exits non-zero on any failure.
 #include <pcl_probcollision/cloud_model.h>
 #include <pcl_probcollision/collision.h>
 #include <pcl_probcollision/covariance_estimation.h>
 #include <pcl_probcollision/probabilistic_collision.h>
+#include <pcl_probcollision/version.h>
 
 #include <pcl/common/transforms.h>
 #include <pcl/point_cloud.h>
@@ -14,6 +16,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 namespace
@@ -95,6 +98,12 @@ sheetsApart (const Eigen::Vector3d& offset)
 int
 main ()
 {
+  // The installed headers and library are one install's; a version that can be tested in #if.
+  check (std::strcmp (pcl_probcollision::libraryVersion (), PCL_PROBCOLLISION_VERSION_STRING) == 0,
+         "libraryVersion() is the headers' PCL_PROBCOLLISION_VERSION_STRING");
+#if PCL_PROBCOLLISION_VERSION < 100
+#error "PCL_PROBCOLLISION_VERSION is not 100000 MAJOR + 100 MINOR + PATCH"
+#endif
   inPlaceCheck<pcl::PointXYZ> ("PointXYZ");
   inPlaceCheck<pcl::PointXYZI> ("PointXYZI");
   inPlaceCheck<pcl::PointXYZRGB> ("PointXYZRGB");

@@ -7,6 +7,7 @@
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/common/io.h>
 #include <pcl/io/pcd_io.h>
+#include <pcl/pcl_config.h>
 
 #include <Eigen/Core>
 
@@ -231,6 +232,19 @@ TEST_F (PcdCollisionTool, HelpGoesToStdoutAndExitsZero)
   }
   // -h wins over anything else on the line, even malformed options.
   EXPECT_EQ (run ({"-sigma", "1O", "-h"}).status, 0);
+}
+
+TEST_F (PcdCollisionTool, VersionNamesTheToolsTheLibrarysAndPcls)
+{
+  for (const char* flag : {"-version", "--version"})
+  {
+    const ToolRun r = run ({"-sigma", "1O", flag});
+    EXPECT_EQ (r.status, 0) << r.err;
+    EXPECT_EQ (r.err, "");
+    // project(VERSION) of CMakeLists.txt, the one owner of the version.
+    EXPECT_EQ (r.out, std::string ("pcd_collision ") + PROJECT_VERSION_STRING + " (library " + PROJECT_VERSION_STRING +
+                          ", PCL " + PCL_VERSION_PRETTY + ")\n");
+  }
 }
 
 TEST_F (PcdCollisionTool, HumanSummaryOnStdoutDiagnosticsOnStderr)

@@ -33,6 +33,8 @@ JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
   -epsilon -split -mesh_density -json (accepted; the output is always JSON lines) -v. A value is
   the next argument or follows '='. -surface (experimental) adds the signed distance between the
   surfaces.
+  -h, -help, --help              this help
+  -version, --version            the versions of this command and of the library
 
 On a terminal, stderr shows pcd_collision's progress line ([answered/total poses]) while the batch
 runs; its warnings (units, rounding far from the origin, ...) are printed in its words.
@@ -97,9 +99,12 @@ def parse(argv):
     rules, the same words); this command adds its own options, which take two dashes, and its
     third argument, the poses file."""
     positional, options, own, seen = [], {}, {"scheduler": None, "timeout": 10.0, "chunk-size": None}, set()
-    # -h wins over every other argument, as in pcd_collision (an unknown option beside it too).
-    if any(a in ("-h", "-help", "--help") for a in argv[:argv.index("--") if "--" in argv else len(argv)]):
+    # -h and -version win over every other argument, as in pcd_collision (an unknown option beside them too).
+    options_part = argv[:argv.index("--") if "--" in argv else len(argv)]
+    if any(a in ("-h", "-help", "--help") for a in options_part):
         raise SystemExit(print(USAGE, end="") or 0)
+    if any(a in ("-version", "--version") for a in options_part):
+        raise SystemExit(print(f"pcl_probcollision.dask {core.__version__} (library {core.__version__})") or 0)
     flags, values = [], {}  # pcd_collision's flags as given; their values, by name
     i, only_positional = 0, False
     while i < len(argv):

@@ -1,0 +1,21 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Runs Doxygen over the public headers (docs/api/Doxyfile.in) and fails on any warning it logs:
+# an undocumented public member, a parameter list documented in part, an unknown command.
+file(REMOVE "${WARNINGS}")
+execute_process(COMMAND "${DOXYGEN}" "${DOXYFILE}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "doxygen failed (${rc}):\n${out}\n${err}")
+endif()
+if(NOT EXISTS "${WARNINGS}")
+  message(FATAL_ERROR "doxygen wrote no warning log at ${WARNINGS}")
+endif()
+file(READ "${WARNINGS}" warnings)
+if(NOT warnings STREQUAL "")
+  message(FATAL_ERROR "the public API has Doxygen warnings:\n${warnings}")
+endif()
+file(GLOB pages "${HTML_DIR}/*.html")
+list(LENGTH pages n)
+if(n LESS 20)
+  message(FATAL_ERROR "doxygen wrote only ${n} HTML pages into ${HTML_DIR}")
+endif()
+message(STATUS "API reference: ${n} pages, no warning")
