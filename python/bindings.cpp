@@ -945,6 +945,18 @@ cloudArray (const pcl::PointCloud<pcl::PointXYZ>& cloud)
   return points;
 }
 
+/** Poses as (M, 6) tx ty tz roll pitch yaw. */
+py::array_t<double>
+poseRows (const std::vector<pcd_collision::Pose>& poses)
+{
+  py::array_t<double> out ({static_cast<py::ssize_t> (poses.size ()), static_cast<py::ssize_t> (6)});
+  auto o = out.mutable_unchecked<2> ();
+  for (std::size_t k = 0; k < poses.size (); ++k)
+    for (int d = 0; d < 6; ++d)
+      o (static_cast<py::ssize_t> (k), d) = poses[k][static_cast<std::size_t> (d)];
+  return out;
+}
+
 /** pcd_collision's -poses file (pcd_collision::parsePoses, the one reader of the format) as (M, 6)
   * tx ty tz roll pitch yaw. */
 py::array_t<double>
@@ -956,12 +968,20 @@ readPoses (const std::filesystem::path& path)
   std::ifstream f (path);
   if (!error.empty () || !pcd_collision::parsePoses (f, path.string (), poses, error))
     throw py::value_error ("path: " + error);
-  py::array_t<double> out ({static_cast<py::ssize_t> (poses.size ()), static_cast<py::ssize_t> (6)});
-  auto o = out.mutable_unchecked<2> ();
-  for (std::size_t k = 0; k < poses.size (); ++k)
-    for (int d = 0; d < 6; ++d)
-      o (static_cast<py::ssize_t> (k), d) = poses[k][static_cast<std::size_t> (d)];
-  return out;
+  return poseRows (poses);
+}
+
+/** The text of a -poses file (pcd_collision -poses -'s standard input) as readPoses reads a file,
+  * its messages naming `name` for the file. */
+py::array_t<double>
+parsePoses (const py::bytes& text, const std::string& name)
+{
+  std::istringstream in (std::string (text), std::ios::binary);
+  std::vector<pcd_collision::Pose> poses;
+  std::string error;
+  if (!pcd_collision::parsePoses (in, name, poses, error))
+    throw py::value_error ("text: " + error);
+  return poseRows (poses);
 }
 
 /** (M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), by pcd_collision's rule (poseTransform). */
@@ -2085,6 +2105,9 @@ PYBIND11_MODULE (_core, m)
          "and/or one comma, '#' comments and blank lines allowed.\n\n"
          "Returns (M, 6) float64. FileNotFoundError or IsADirectoryError for a path that is no file; ValueError with\n"
          "pcd_collision's message (\"path: FILE:LINE: reason\") for a malformed line or a file without a pose.");
+  m.def ("parse_poses", &parsePoses, py::arg ("text"), py::arg ("name") = "standard input",
+         "Reads the bytes of a -poses file (pcd_collision -poses - reads them from standard input) as read_poses\n"
+         "reads the file. Returns (M, 6) float64; ValueError with pcd_collision's message (\"text: NAME:LINE: reason\").");
   m.def ("poses_from_xyzrpy", &posesFromXyzRpy, py::arg ("poses"),
          "(M, 6) tx ty tz roll pitch yaw -> (M, 4, 4), R = Rz(yaw) Ry(pitch) Rx(roll), as pcd_collision's -pose.\n\n"
          "Such a pose moves <a> into <b>'s frame (T_b_a); collide(a, b, T) and collide_batch take T_a_b, so pass\n"

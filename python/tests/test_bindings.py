@@ -1162,6 +1162,17 @@ def test_load_model_reads_a_faceless_ply_as_pcd_collision_does(tmp_path):
         pc.load_model(mesh)
 
 
+def test_parse_poses_reads_text_as_read_poses_reads_a_file(tmp_path):
+    text = b"# poses\n0 0 0.1 0 0 0\n1,2,3,0.1,0.2,0.3\n"
+    f = tmp_path / "p.txt"
+    f.write_bytes(text)
+    assert np.array_equal(pc.parse_poses(text), pc.read_poses(f))
+    with pytest.raises(ValueError, match=r"^text: standard input:2: expected 6 numbers"):
+        pc.parse_poses(b"0 0 0 0 0 0\n1 2 3\n")
+    with pytest.raises(ValueError, match=r"^text: pipe: no pose in the file"):
+        pc.parse_poses(b"# nothing\n", "pipe")
+
+
 def test_the_version_is_the_projects():
     # project(VERSION) in CMakeLists.txt is the one owner; pcd_collision -version prints it too.
     import re

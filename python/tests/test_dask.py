@@ -529,6 +529,14 @@ def test_cli_errors_match_pcd_collision(tmp_path):
         assert (py.returncode, py.stdout) == (cpp.returncode, "") == (1, ""), (py.stderr, cpp.stderr)
         if poses is not ok:  # refused with its line, before any query, in the same words
             assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1]
+    # "-" reads the poses from standard input in both, with the same message for a malformed line.
+    stdin_text = bad.read_text()
+    cpp = subprocess.run([_pcd_collision(), *args, "-poses", "-", "-json"], input=stdin_text, capture_output=True, text=True)
+    py = subprocess.run([PYTHON, "-m", "pcl_probcollision.dask", *args, "-", "--scheduler", "local:1"],
+                        input=stdin_text, capture_output=True, text=True, timeout=120)
+    assert (py.returncode, py.stdout) == (cpp.returncode, "") == (1, ""), (py.stderr, cpp.stderr)
+    assert cpp.stderr.strip().split("error: ", 1)[1] == py.stderr.strip().split("error: ", 1)[1] == \
+        "standard input:2: expected 6 numbers (tx ty tz roll pitch yaw), got 5"
 
 
 def _warnings(stderr):

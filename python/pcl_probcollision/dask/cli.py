@@ -17,8 +17,8 @@ from . import _MESH_EXTENSIONS, _SWITCHES, _VALUES, InputWarning, check_input_ki
 
 USAGE = """usage: python3 -m pcl_probcollision.dask <a> <b> <poses.txt> --scheduler ADDRESS|local[:N] [options]
 
-Answers every pose of <poses.txt> (pcd_collision's -poses format) on Dask workers and prints the
-JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
+Answers every pose of <poses.txt> (pcd_collision's -poses format; - reads standard input) on Dask
+workers and prints the JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -json`.
 
   --scheduler ADDRESS|local[:N]  a running scheduler (tcp://host:8786) or a LocalCluster of N
                                  single-threaded worker processes (default N = cores)
@@ -229,7 +229,8 @@ def main(argv):
         except (TypeError, ValueError) as e:
             raise Usage(_as_flag_message(str(e))) from None
         try:
-            pose_rows = core.read_poses(poses_path)  # a malformed file fails before the (slow) loading
+            # A malformed file fails before the (slow) loading; "-" is standard input, as for pcd_collision.
+            pose_rows = core.parse_poses(sys.stdin.buffer.read()) if poses_path == "-" else core.read_poses(poses_path)
             # -surface without -ignore_normals: a cloud file's stored normals, as pcd_collision reads them.
             stored = bool(options.get("surface") or options.get("surface_pooled") or options.get("surface_ladder")) and not options.get("ignore_normals")
             # Named as pcd_collision names its models (a model's messages say which).
@@ -244,7 +245,7 @@ def main(argv):
         except FileNotFoundError as e:
             raise Failure(f"cannot read '{e.filename}': No such file or directory") from None
         except ValueError as e:
-            raise Failure(str(e).removeprefix("path: ")) from None
+            raise Failure(str(e).removeprefix("path: ").removeprefix("text: ")) from None
         t0 = time.perf_counter()
         client = connect(own["scheduler"], timeout=own["timeout"])
         print(f"Scheduler {own['scheduler']} [done, {(time.perf_counter() - t0) * 1e3:.1f} ms : "
