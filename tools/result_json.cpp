@@ -5,6 +5,7 @@
 #include "json_writer.h"
 
 #include <pcl_probcollision/cloud_model.h>
+#include <pcl_probcollision/version.h>
 
 namespace pcd_collision
 {
@@ -202,6 +203,8 @@ resultJson (const Options& o, const InputSummary& a, const InputSummary& b, cons
     j.key ("points").unsignedInteger (points_written);
     j.endObject ();
   }
+  // Which release answered: a logged line stays traceable after an upgrade changed answers.
+  j.key ("version").string (pcl_probcollision::libraryVersion ());
   j.endObject ();
   return j.text ();
 }
