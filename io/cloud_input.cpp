@@ -250,6 +250,7 @@ bool
 checkViewpoint (const std::string& path, std::size_t line_number, const std::vector<std::string>& words,
                 std::string& error)
 {
+  double rotation_norm = 0.0;  // |qw| + |qx| + |qy| + |qz|, as read
   for (std::size_t column = 1; column < words.size (); ++column)
   {
     double value = 0.0;
@@ -260,6 +261,8 @@ checkViewpoint (const std::string& path, std::size_t line_number, const std::vec
               " '" + word + "' is not a finite number (VIEWPOINT tx ty tz qw qx qy qz)";
       return false;
     }
+    if (column >= 4)
+      rotation_norm += std::abs (value);
   }
   if (words.size () != 8)
   {
@@ -269,7 +272,7 @@ checkViewpoint (const std::string& path, std::size_t line_number, const std::vec
   }
   // A quaternion of zeros is no rotation; PCL would hand it on and the viewpoint's axis
   // would be a guess. An unrotated sensor is 1 0 0 0.
-  if (std::all_of (words.begin () + 4, words.end (), [] (const std::string& word) { return std::strtod (word.c_str (), nullptr) == 0.0; }))
+  if (rotation_norm == 0.0)
   {
     error = "'" + path + "' line " + std::to_string (line_number) +
             ": VIEWPOINT quaternion qw qx qy qz is 0 0 0 0, which is no rotation (an unrotated sensor is 1 0 0 0)";

@@ -362,10 +362,11 @@ parseCommandLine (const std::vector<std::string>& args)
   {
     if (a == "--")
       break;
-    if (a == "-h" || a == "--help" || a == "-help" || a == "-version" || a == "--version")
+    const bool help = a == "-h" || a == "--help" || a == "-help";
+    if (help || a == "-version" || a == "--version")
     {
       ParseResult r;
-      r.kind = a.find ("version") != std::string::npos ? ParseResult::Kind::Version : ParseResult::Kind::Help;
+      r.kind = help ? ParseResult::Kind::Help : ParseResult::Kind::Version;
       return r;
     }
   }
