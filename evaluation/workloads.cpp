@@ -115,6 +115,11 @@ oursSettings (bool full, const std::vector<double>& merge, const std::vector<dou
     capped.request.max_leaf_fits = static_cast<std::size_t> (n);
     capped.name = "cap" + std::to_string (capped.request.max_leaf_fits);
     s.push_back (capped);
+    // The ladder with its surface rung capped at about n leaf pairs (max_surface_pairs).
+    OursSetting ladder_capped = ladder;
+    ladder_capped.request.max_surface_pairs = static_cast<std::size_t> (n);
+    ladder_capped.name = "ladder-cap" + std::to_string (ladder_capped.request.max_surface_pairs);
+    s.push_back (ladder_capped);
   }
   if (!full)
     return s;

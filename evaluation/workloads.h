@@ -76,7 +76,8 @@ struct OursSetting
   * "surface-cloudmerge<c>", the same merge of a whole cloud where it is sampled finer than its
   * noise (ResolutionGate::WholeCloud); each c of stop "stop<c>" and "surface-stop<c>",
   * the hierarchy not split within the noise (BVHParams::noise_stop = c). Each n of cap adds
-  * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2). W2 adds
+  * "cap<n>": classifier with CollisionRequest::max_leaf_fits = n (issue #17 item 2), and
+  * "ladder-cap<n>": ladder with CollisionRequest::max_surface_pairs = n. W2 adds
   * "surface-closed" itself (CloudModelParams::closed_objects on its solids, Solids). */
 std::vector<OursSetting> oursSettings (bool full, const std::vector<double>& merge = {},
                                        const std::vector<double>& gate = {}, const std::vector<double>& stop = {},

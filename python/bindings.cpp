@@ -1484,6 +1484,8 @@ PYBIND11_MODULE (_core, m)
       "per_point: fill probabilities_a/_b; enable_timings: fill build_ms/query_ms; traversal, rho_min, seed,\n"
       "expanded_k_sigma: the traversal (TraversalMode); defer_kernel_fits: the ladder classifier;\n"
       "max_leaf_fits: at most this many leaf pairs tested a query, nearest first (0 = no cap; result.budget_exhausted);\n"
+      "max_surface_pairs: with surface, the surface layer's cap, about this many leaf pairs a query (0 = no cap;\n"
+      "result.budget_exhausted; ValueError without surface);\n"
       "surface: the surface layer (experimental, issue #16): each object's points tested against the other's\n"
       "oriented surface, filling CollisionResult.signed_distance; needs both models built with\n"
       "CloudModelParams(surface=True), otherwise the separators answer and signed_distance stays NaN;\n"
@@ -1501,7 +1503,8 @@ PYBIND11_MODULE (_core, m)
       "classifier: the separators' leaf-pair classifier (ClassifierParams; default: the C++ defaults).")
       .def (py::init ([] (double free_below, double collision_above, bool exhaustive, bool per_point,
                           bool enable_timings, TraversalMode traversal, double rho_min, std::uint64_t seed,
-                          double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits, bool surface,
+                          double expanded_k_sigma, bool defer_kernel_fits, std::size_t max_leaf_fits,
+                          std::size_t max_surface_pairs, bool surface,
                           bool surface_pooled, bool surface_ladder, bool surface_calibrated, bool distance,
                           const ClassifierParams& classifier) {
               CollisionRequest r;
@@ -1516,6 +1519,7 @@ PYBIND11_MODULE (_core, m)
               r.expanded_k_sigma = expanded_k_sigma;
               r.defer_kernel_fits = defer_kernel_fits;
               r.max_leaf_fits = max_leaf_fits;
+              r.max_surface_pairs = max_surface_pairs;
               r.surface = surface;
               r.surface_pooled = surface_pooled;
               r.surface_ladder = surface_ladder;
@@ -1529,7 +1533,8 @@ PYBIND11_MODULE (_core, m)
             py::arg ("enable_timings") = dr.enable_timings, py::arg ("traversal") = dr.traversal,
             py::arg ("rho_min") = dr.rho_min, py::arg ("seed") = dr.seed,
             py::arg ("expanded_k_sigma") = dr.expanded_k_sigma, py::arg ("defer_kernel_fits") = dr.defer_kernel_fits,
-            py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
+            py::arg ("max_leaf_fits") = dr.max_leaf_fits, py::arg ("max_surface_pairs") = dr.max_surface_pairs,
+            py::arg ("surface") = dr.surface, py::arg ("surface_pooled") = dr.surface_pooled,
             py::arg ("surface_ladder") = dr.surface_ladder,
             py::arg ("surface_calibrated") = dr.surface_calibrated, py::arg ("distance") = dr.distance,
             py::arg ("classifier") = dr.classifier,
@@ -1546,6 +1551,10 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("defer_kernel_fits", &CollisionRequest::defer_kernel_fits)
       .def_readwrite ("max_leaf_fits", &CollisionRequest::max_leaf_fits,
                       "At most this many leaf pairs tested (fitted, passed over unfitted, or set aside) a query, nearest first; 0 = no cap.")
+      .def_readwrite ("max_surface_pairs", &CollisionRequest::max_surface_pairs,
+                      "With surface: the surface layer stops before its next query leaf once this many leaf pairs were\n"
+                      "tested (both sides); P is then a lower bound (result.budget_exhausted), and the ladder keeps the\n"
+                      "separators' contact. 0 = no cap. Without surface, ValueError.")
       .def_readwrite ("surface", &CollisionRequest::surface,
                       "The surface layer (experimental): fill signed_distance; needs both models built with surface=True.")
       .def_readwrite ("surface_pooled", &CollisionRequest::surface_pooled,
@@ -1577,6 +1586,7 @@ PYBIND11_MODULE (_core, m)
                ", expanded_k_sigma=" + num (r.expanded_k_sigma) +
                ", defer_kernel_fits=" + (r.defer_kernel_fits ? "True" : "False") +
                ", max_leaf_fits=" + std::to_string (r.max_leaf_fits) +
+               ", max_surface_pairs=" + std::to_string (r.max_surface_pairs) +
                ", surface=" + (r.surface ? "True" : "False") +
                ", surface_pooled=" + (r.surface_pooled ? "True" : "False") +
                ", surface_ladder=" + (r.surface_ladder ? "True" : "False") +
@@ -1618,7 +1628,8 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("nearest_point_b", [] (const CollisionResult& r) { return vec3 (r.nearest_point_b); })
       .def_readonly ("lower_bound", &CollisionResult::lower_bound)
       .def_readonly ("budget_exhausted", &CollisionResult::budget_exhausted,
-                     "True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound.")
+                     "True when the query stopped at request.max_leaf_fits (or the surface layer at request.max_surface_pairs)\n"
+                     "with leaf pairs left: P is a lower bound.")
       .def_readonly ("full_resolution", &CollisionResult::full_resolution,
                      "True when the answer is the unmerged models' (CloudModelParams.keep_full_resolution): the merged\n"
                      "ones read contact at P >= 0.5 and the unmerged ones found a collision.")

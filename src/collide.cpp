@@ -151,7 +151,8 @@ collideSurface (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3
   result.signed_distance_std = s.signed_distance_std;
   result.unobserved = s.unobserved;
   result.no_leaf_tested = !s.reached;
-  result.lower_bound = s.stopped_early;
+  result.lower_bound = s.stopped_early || s.budget_exhausted;
+  result.budget_exhausted = s.budget_exhausted;
   // Leaf pairs whose boxes met within reach but whose points all lay beyond it tested nothing:
   // with no_leaf_tested they count as node tests alone (bv_tests), as the ladder counts a
   // surface layer that reached nothing. Counted, they read "leaf pairs 1" beside "no leaf pair
@@ -335,12 +336,25 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
       surface_ran = true;
       surface_reached = !result.no_leaf_tested;
       pooled = separators.probability < request.free_below;
-      if (!surface_reached)
+      if (answer.budget_exhausted && !pooled)
+      {
+        // Capped in the separators' contact band (max_surface_pairs): a partial surface layer
+        // could only lower their answer toward free on the leaves it saw; theirs stands.
+        separators.bv_tests += result.bv_tests;
+        separators.leaf_pairs_tested += result.leaf_pairs_tested;
+        result = std::move (separators);
+        result.budget_exhausted = result.lower_bound = true;
+        from_surface = false;
+      }
+      else if (!surface_reached)
       {
         // No point within the surface layer's reach: it has nothing to say, and its P = 0 would
         // turn the separators' contact into "free" (two coincident clouds of two points read free).
+        // Capped, it may not have reached the leaves that would have said something.
         separators.bv_tests += result.bv_tests;
         result = std::move (separators);
+        result.budget_exhausted = result.budget_exhausted || answer.budget_exhausted;
+        result.lower_bound = result.lower_bound || answer.budget_exhausted;
         from_surface = pooled = false;
       }
       else if (pooled)
@@ -381,6 +395,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         result.signed_distance_std = surface_answer.signed_distance_std;
         result.bv_tests += surface_answer.bv_tests;
         result.leaf_pairs_tested += surface_answer.leaf_pairs_tested;
+        // A capped surface layer's distance is its leaves' so far, a bound.
+        result.budget_exhausted = result.budget_exhausted || surface_answer.budget_exhausted;
       }
     }
   }
@@ -408,7 +424,10 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
       if (defer)
       {
         separators.bv_tests += result.bv_tests;
+        const bool capped = result.budget_exhausted;
         result = std::move (separators);
+        result.budget_exhausted = result.budget_exhausted || capped;
+        result.lower_bound = result.lower_bound || capped;
         from_surface = pooled = false;
       }
       else

@@ -32,9 +32,12 @@ CollisionRequest::validate () const
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, where << "traversal mode " << static_cast<int> (traversal) << " is unknown");
   // Each of these changes how the surface layer's answer is used: without it they would change
   // nothing, and the answer would be the separators' under a request that names the surface.
-  if (!surface && (surface_pooled || surface_ladder || surface_calibrated))
+  if (!surface && (surface_pooled || surface_ladder || surface_calibrated || max_surface_pairs > 0))
     PCL_THROW_EXCEPTION (pcl::BadArgumentException,
-                         where << (surface_pooled ? "surface_pooled" : surface_ladder ? "surface_ladder" : "surface_calibrated")
+                         where << (surface_pooled    ? "surface_pooled"
+                                   : surface_ladder  ? "surface_ladder"
+                                   : surface_calibrated ? "surface_calibrated"
+                                                        : "max_surface_pairs")
                                << " needs surface: set surface too (pcd_collision's -surface_pooled and "
                                   "-surface_ladder imply -surface)");
   if (surface_pooled && surface_ladder)
@@ -50,7 +53,8 @@ CollisionRequest::operator== (const CollisionRequest& o) const
   return free_below == o.free_below && collision_above == o.collision_above && exhaustive == o.exhaustive &&
          per_point == o.per_point && enable_timings == o.enable_timings && traversal == o.traversal &&
          rho_min == o.rho_min && seed == o.seed && expanded_k_sigma == o.expanded_k_sigma && classifier == o.classifier &&
-         defer_kernel_fits == o.defer_kernel_fits && max_leaf_fits == o.max_leaf_fits && surface == o.surface &&
+         defer_kernel_fits == o.defer_kernel_fits && max_leaf_fits == o.max_leaf_fits &&
+         max_surface_pairs == o.max_surface_pairs && surface == o.surface &&
          surface_pooled == o.surface_pooled &&
          surface_ladder == o.surface_ladder && surface_calibrated == o.surface_calibrated && distance == o.distance;
 }

@@ -1033,7 +1033,7 @@ shadowDepth (const CloudModel& surface, const Eigen::Vector3d& x, double margin)
 void
 testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface, const Eigen::Isometry3d& T_s,
           const std::vector<std::pair<std::int32_t, std::int32_t>>& groups, Scratch& scratch, int side,
-          std::vector<float>* per_point, double stop_z, SurfaceAnswer& answer, double& best_z)
+          std::vector<float>* per_point, double stop_z, std::size_t max_pairs, SurfaceAnswer& answer, double& best_z)
 {
   const ProbabilisticBVH& q_bvh = query.hierarchy ();
   const ProbabilisticBVH& s_bvh = surface.hierarchy ();
@@ -1109,13 +1109,18 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       answer.stopped_early = true;
       return;
     }
+    if (max_pairs > 0 && answer.pairs_tested >= max_pairs)
+    {
+      answer.budget_exhausted = true;
+      return;
+    }
     const std::int32_t q_leaf = groups[g].first;
     // The pool: every sample of the surface leaves paired with this query leaf, once.
     const std::uint32_t pool_stamp = scratch.next ();
     // Keyed by distance from the query leaf's centre (sorted as the searches need).
     const Eigen::Vector3d center = T_q * q_bvh.node (q_leaf).box.center;
     scratch.pool.clear ();
-    for (; g < groups.size () && groups[g].first == q_leaf; ++g)
+    for (; g < groups.size () && groups[g].first == q_leaf; ++g, ++answer.pairs_tested)
       for (const int j : s_bvh.indices (s_bvh.node (groups[g].second)))
       {
         const std::size_t sj = static_cast<std::size_t> (j);
@@ -1564,7 +1569,7 @@ reachParams (double spacing)
   params.exhaustive = true;
   params.skip_dominated = false;
   params.nearest_first = false;  // every pair is enumerated: the order is of no use here
-  params.max_leaf_tests = 0;      // the separators' cap (max_leaf_fits) is not this layer's
+  params.max_leaf_tests = 0;      // the separators' cap (max_leaf_fits) is not this layer's; testSide applies max_surface_pairs
   params.box_margin = std::isfinite (spacing) ? std::max (spacing, 0.0) : 0.0;
   return params;
 }
@@ -1612,16 +1617,26 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   if (!pairs.empty ())
   {
     groupByFirst (pairs, bvh_a.nodes ().size (), scratch);
-    testSide (a, Eigen::Isometry3d::Identity (), b, T_a_b, pairs, scratch, +1, per_point_a, stop_z, answer, best_z);
+    testSide (a, Eigen::Isometry3d::Identity (), b, T_a_b, pairs, scratch, +1, per_point_a, stop_z, request.max_surface_pairs,
+              answer, best_z);
     for (auto& p : pairs)
       std::swap (p.first, p.second);
     groupByFirst (pairs, bvh_b.nodes ().size (), scratch);
-    if (!answer.stopped_early)
-      testSide (b, T_a_b, a, Eigen::Isometry3d::Identity (), pairs, scratch, -1, per_point_b, stop_z, answer, best_z);
+    if (!answer.stopped_early && !answer.budget_exhausted)
+      testSide (b, T_a_b, a, Eigen::Isometry3d::Identity (), pairs, scratch, -1, per_point_b, stop_z,
+                request.max_surface_pairs, answer, best_z);
   }
   if (answer.stopped_early)
   {
     answer.probability = normalCdf (-best_z);
+    return answer;
+  }
+  // Capped (CollisionRequest::max_surface_pairs): the largest P of the leaves tested, a lower
+  // bound; what lies beyond reach is not judged either (its walks cost as much again).
+  if (answer.budget_exhausted)
+  {
+    answer.leaf_pairs = answer.pairs_tested;
+    answer.probability = answer.reached ? normalCdf (-best_z) : 0.0;
     return answer;
   }
   // Out of reach of each other's surface: parts of one object deep inside the other (a piano

@@ -57,7 +57,11 @@ struct SurfaceAnswer
     * collinear or too few points has no surface there): its points were not judged, so a P of
     * 0 with reached false does not mean "far". */
   bool unjudged = false;
-  std::size_t leaf_pairs = 0;    ///< leaf pairs within reach (their boxes; collide() counts them where a point was reached)
+  /** \brief Stopped at CollisionRequest::max_surface_pairs with query leaves left untested: P
+    * and the distance are bounds, and nothing beyond reach was judged. */
+  bool budget_exhausted = false;
+  std::size_t leaf_pairs = 0;    ///< leaf pairs within reach (their boxes; collide() counts them where a point was reached); with budget_exhausted, the pairs tested
+  std::size_t pairs_tested = 0;  ///< leaf pairs tested, both sides (what max_surface_pairs counts)
   std::size_t points_tested = 0; ///< point-against-surface evaluations, both sides
   std::size_t bv_tests = 0;      ///< node pairs tested by its traversal
 };

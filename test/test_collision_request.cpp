@@ -132,6 +132,20 @@ TEST (CollisionRequest, ValidateRefusesSurfaceSwitchesWithoutSurface)
     r.surface = true;
     EXPECT_NO_THROW (r.validate ()) << name;
   }
+  // The surface layer's cap caps nothing without it.
+  CollisionRequest capped;
+  capped.max_surface_pairs = 64;
+  try
+  {
+    capped.validate ();
+    ADD_FAILURE () << "max_surface_pairs without surface did not throw";
+  }
+  catch (const pcl::BadArgumentException& e)
+  {
+    EXPECT_NE (std::string (e.what ()).find ("max_surface_pairs needs surface"), std::string::npos) << e.what ();
+  }
+  capped.surface = true;
+  EXPECT_NO_THROW (capped.validate ());
 }
 
 TEST (CollisionRequest, ValidateMessageCarriesTheMethodPrefix)
@@ -240,6 +254,7 @@ TEST (CollisionRequest, EqualityComparesEveryMember)
       {"expanded_k_sigma", [] (CollisionRequest& r) { r.expanded_k_sigma = 2.0; }},
       {"defer_kernel_fits", [] (CollisionRequest& r) { r.defer_kernel_fits = true; }},
       {"max_leaf_fits", [] (CollisionRequest& r) { r.max_leaf_fits = 7; }},
+      {"max_surface_pairs", [] (CollisionRequest& r) { r.max_surface_pairs = 7; }},
       {"surface", [] (CollisionRequest& r) { r.surface = true; }},
       {"surface_pooled", [] (CollisionRequest& r) { r.surface_pooled = true; }},
       {"surface_ladder", [] (CollisionRequest& r) { r.surface_ladder = true; }},

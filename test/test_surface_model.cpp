@@ -578,6 +578,57 @@ TEST (SurfaceLayer, TheSeparatorsCapDoesNotCutTheSurfaceLayer)
   }
 }
 
+// The surface layer's own cap (max_surface_pairs) stops it before its next query leaf and flags
+// the answer: P is then a lower bound of the uncapped one, and the ladder keeps the separators'
+// contact where its capped rung could not finish. A cap it never reaches changes nothing. A ball
+// 1 mm (one deviation) over the table: the separators read contact, the surface layer free after
+// visiting every leaf pair within reach (its slowest kind of answer).
+TEST (SurfaceLayer, ItsCapStopsItFlaggedAndTheLadderKeepsTheSeparatorsContact)
+{
+  const auto table = buildCloudModel (sheet (0.4, 0.01, 0.0, Eigen::Vector3f (0, 0, 1)), noisy (0.001));
+  const auto ball = buildCloudModel (sphere (800, 0.05, Eigen::Vector3d (0, 0, 0.05)), noisy (0.001));
+  CollisionRequest alone;
+  alone.surface = true;
+  CollisionRequest ladder = alone;
+  ladder.surface_ladder = true;
+  CollisionRequest separators;
+  CollisionResult full, full_ladder, theirs;
+  const Eigen::Isometry3d pose = shift (0, 0, -0.001);
+  ASSERT_TRUE (collide (*ball, *table, pose, alone, full)) << full.message;
+  ASSERT_TRUE (collide (*ball, *table, pose, ladder, full_ladder)) << full_ladder.message;
+  ASSERT_TRUE (collide (*ball, *table, pose, separators, theirs)) << theirs.message;
+  ASSERT_FALSE (full.budget_exhausted);
+  ASSERT_FALSE (full.lower_bound);
+  ASSERT_GT (full.leaf_pairs_tested, 20u);
+  ASSERT_EQ (theirs.verdict, Verdict::InContact);  // the ladder's surface rung runs
+  ASSERT_EQ (full_ladder.answered_by, AnsweredBy::SurfaceLayer);
+  for (const std::size_t cap : {std::size_t (1), std::size_t (8)})
+  {
+    alone.max_surface_pairs = ladder.max_surface_pairs = cap;
+    CollisionResult r, l;
+    ASSERT_TRUE (collide (*ball, *table, pose, alone, r)) << r.message;
+    EXPECT_TRUE (r.budget_exhausted) << cap;
+    EXPECT_TRUE (r.lower_bound) << cap;
+    EXPECT_LE (r.probability, full.probability) << cap;
+    EXPECT_LT (r.leaf_pairs_tested, full.leaf_pairs_tested) << cap;
+    ASSERT_TRUE (collide (*ball, *table, pose, ladder, l)) << l.message;
+    EXPECT_TRUE (l.budget_exhausted) << cap;
+    EXPECT_EQ (l.answered_by, AnsweredBy::Separators) << cap;
+    EXPECT_EQ (l.probability, theirs.probability) << cap;
+    EXPECT_EQ (l.verdict, Verdict::InContact) << cap;
+  }
+  alone.max_surface_pairs = ladder.max_surface_pairs = 1000000;
+  CollisionResult r, l;
+  ASSERT_TRUE (collide (*ball, *table, pose, alone, r)) << r.message;
+  ASSERT_TRUE (collide (*ball, *table, pose, ladder, l)) << l.message;
+  EXPECT_FALSE (r.budget_exhausted);
+  EXPECT_EQ (r.probability, full.probability);
+  EXPECT_EQ (r.signed_distance, full.signed_distance);
+  EXPECT_EQ (r.leaf_pairs_tested, full.leaf_pairs_tested);
+  EXPECT_FALSE (l.budget_exhausted);
+  EXPECT_EQ (l.probability, full_ladder.probability);
+}
+
 // A distance asked for far apart is the nearest samples' whichever way the pair is answered:
 // two 3 cm patches 5 m apart are single leaves, whose pair the separators' weighted traversal
 // still fits (it is not "no leaf tested" for them), but the surface layer reaches nothing, so

@@ -45,7 +45,7 @@ fmt (double v)
 const std::set<std::string> kValueFlags = {
   "-pose", "-poses", "-sigma", "-sigma_a", "-sigma_b", "-sensor", "-sensor_a", "-sensor_b", "-k", "-thresholds", "-seed",
   "-nmax", "-sigma_max", "-epsilon", "-split", "-mesh_density", "-o", "-threads", "-noise_resolution",
-  "-noise_resolution_gate", "-noise_stop", "-max_leaf_fits", "-orientation", "-orientation_a", "-orientation_b"};
+  "-noise_resolution_gate", "-noise_stop", "-max_leaf_fits", "-max_surface_pairs", "-orientation", "-orientation_a", "-orientation_b"};
 const std::set<std::string> kSwitchFlags = {"-deterministic", "-stochastic", "-exhaustive", "-defer_kernel_fits", "-json",
                                             "-measured", "-surface", "-surface_pooled", "-surface_ladder", "-surface_calibrated", "-distance", "-ignore_normals",
                                             "-closed", "-closed_a", "-closed_b", "-v"};
@@ -310,6 +310,7 @@ requestFor (const Options& o)
   r.collision_above = o.collision_above;
   r.exhaustive = o.exhaustive || o.output.has_value ();
   r.max_leaf_fits = o.max_leaf_fits;
+  r.max_surface_pairs = o.max_surface_pairs;
   r.defer_kernel_fits = o.defer_kernel_fits;
   r.surface = o.surface;
   r.surface_pooled = o.surface_pooled;
@@ -580,12 +581,12 @@ parseCommandLine (const std::vector<std::string>& args)
       if (!(o.noise_stop >= 0.0) || !std::isfinite (o.noise_stop))
         return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: off)");
     }
-    else if (a == "-max_leaf_fits")
+    else if (a == "-max_leaf_fits" || a == "-max_surface_pairs")
     {
       std::uint64_t n = 0;
       if (!parseUint64 (v, n))
         return usage (bad + "is not a non-negative integer (0: no cap)");
-      o.max_leaf_fits = static_cast<std::size_t> (n);
+      (a == "-max_leaf_fits" ? o.max_leaf_fits : o.max_surface_pairs) = static_cast<std::size_t> (n);
     }
     else if (a == "-orientation" || a == "-orientation_a" || a == "-orientation_b")
     {
@@ -643,6 +644,9 @@ parseCommandLine (const std::vector<std::string>& args)
   if ((o.closed_a || o.closed_b) && !o.surface)
     return usage ("options -closed, -closed_a and -closed_b need -surface (or -surface_pooled, -surface_ladder): they "
                   "say where the surface layer's inside is");
+  if (o.max_surface_pairs > 0 && !o.surface)
+    return usage ("option -max_surface_pairs needs -surface (or -surface_pooled, -surface_ladder): it caps the "
+                  "surface layer's work (-max_leaf_fits caps the separators')");
   if (o.surface_calibrated && !o.surface)
     return usage ("option -surface_calibrated needs -surface (or -surface_pooled, -surface_ladder): it maps the "
                   "surface layer's probability");
@@ -779,6 +783,11 @@ helpText ()
     << D::max_leaf_fits
     << "   at most N leaf pairs tested a query, nearest first (0: no cap); a capped\n"
        "                  query prints P >= and \"budget exhausted\": P is a lower bound\n"
+       "  -max_surface_pairs N   = "
+    << D::max_surface_pairs
+    << "   with -surface: the surface layer tests at most about N leaf pairs a query\n"
+       "                  (0: no cap); capped, P is a lower bound (\"budget exhausted\"), and the\n"
+       "                  ladder keeps the separators' contact; bounds its worst case\n"
        "  -surface        the surface layer (experimental, issue #16): each cloud's points against the\n"
        "                  other's oriented surface; prints the signed distance d +- std\n"
        "  -surface_pooled -surface, its P pooled with the separators' (their mean; experimental)\n"

@@ -53,6 +53,7 @@ struct Defaults
   static inline const bool exhaustive = request.exhaustive;
   static inline const bool defer_kernel_fits = request.defer_kernel_fits;
   static inline const std::size_t max_leaf_fits = request.max_leaf_fits;
+  static inline const std::size_t max_surface_pairs = request.max_surface_pairs;
   static inline const std::optional<double> noise_resolution = model.noise_resolution;
   static inline const pcl_probcollision::CloudModelParams::ResolutionGate noise_resolution_gate = model.noise_resolution_gate;
   static inline const double noise_stop = model.hierarchy.noise_stop;
@@ -116,6 +117,8 @@ struct Options
   bool defer_kernel_fits = Defaults::defer_kernel_fits;
   /** \brief -max_leaf_fits N: CollisionRequest::max_leaf_fits (0 = no cap). */
   std::size_t max_leaf_fits = Defaults::max_leaf_fits;
+  /** \brief -max_surface_pairs N: CollisionRequest::max_surface_pairs (0 = no cap). */
+  std::size_t max_surface_pairs = Defaults::max_surface_pairs;
   /** \brief -noise_resolution C: CloudModelParams::noise_resolution (0 = no merging; unset: its
     * default, CloudModelParams::noiseResolution()). */
   std::optional<double> noise_resolution = Defaults::noise_resolution;

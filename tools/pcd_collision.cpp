@@ -263,7 +263,7 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bo
   }
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";
-  const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits reached)" : "";
+  const char* capped = r.budget_exhausted ? "  (budget exhausted: -max_leaf_fits or -max_surface_pairs reached)" : "";
   // A merged cloud's contact that the unmerged models read as collision (CollisionResult::full_resolution).
   const char* full = r.full_resolution ? "  (full resolution)" : "";
   // With -surface_ladder, the rung that answered (CollisionResult::answered_by); the other

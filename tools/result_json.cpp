@@ -177,6 +177,7 @@ resultJson (const Options& o, const InputSummary& a, const InputSummary& b, cons
   j.key ("exhaustive").boolean (rq.exhaustive);
   j.key ("defer_kernel_fits").boolean (rq.defer_kernel_fits);
   j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
+  j.key ("max_surface_pairs").unsignedInteger (rq.max_surface_pairs);
   j.key ("noise_resolution").number (modelParamsFor (o, true).noiseResolution ());
   j.key ("noise_resolution_gate").string (pcl_probcollision::CloudModelParams::resolutionGateName (o.noise_resolution_gate));
   j.key ("noise_stop").number (o.noise_stop);

@@ -72,8 +72,19 @@ struct CollisionRequest
     * first (detail/bvh_traversal.h), so the pairs left over are the farther ones; a query that reaches the cap stops with P the
     * largest so far (CollisionResult::budget_exhausted, a lower bound). It bounds the worst
     * case at high noise, where inflated boxes overlap everywhere and thousands of pairs are
-    * fitted (docs/PERFORMANCE.md, issue #17). Not used by the surface layer. */
+    * fitted (docs/PERFORMANCE.md, issue #17). Not used by the surface layer
+    * (max_surface_pairs is its cap). */
   std::size_t max_leaf_fits = 0;
+  /** \brief A cap on the surface layer's work (surface, surface_pooled, surface_ladder): it
+    * stops before its next query leaf once this many leaf pairs have been tested (each query
+    * leaf's pairs on each side count; a leaf's pairs are tested together, so the count may pass
+    * the cap by one leaf's); 0 (default) = no cap. A capped answer is flagged
+    * (CollisionResult::budget_exhausted): P is the largest so far, a lower bound, and the
+    * winding-number test of parts beyond reach is skipped. In the ladder the separators' answer
+    * then stands where they read contact, and the pool takes the lower bound where they read
+    * free. It bounds the surface layer's worst case, whose contact answers visit every leaf
+    * pair within reach (docs/SURFACE.md, "A cap on the surface layer's work"). */
+  std::size_t max_surface_pairs = 0;
 
   /** \brief The surface layer (METHOD.md 10a), experimental: instead of the separators, test
     * each object's points against the other's oriented surface (a local signed distance near

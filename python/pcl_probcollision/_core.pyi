@@ -154,6 +154,7 @@ class CollisionRequest:
     expanded_k_sigma: float
     defer_kernel_fits: bool
     max_leaf_fits: int
+    max_surface_pairs: int
     surface: bool
     surface_pooled: bool
     surface_ladder: bool
@@ -163,7 +164,8 @@ class CollisionRequest:
     def __init__(self, *, free_below: float = ..., collision_above: float = ..., exhaustive: bool = ...,
                  per_point: bool = ..., enable_timings: bool = ..., traversal: TraversalMode = ...,
                  rho_min: float = ..., seed: int = ..., expanded_k_sigma: float = ...,
-                 defer_kernel_fits: bool = ..., max_leaf_fits: int = ..., surface: bool = False,
+                 defer_kernel_fits: bool = ..., max_leaf_fits: int = ...,
+                 max_surface_pairs: int = ..., surface: bool = False,
                  surface_pooled: bool = False, surface_ladder: bool = False,
                  surface_calibrated: bool = False, distance: bool = False,
                  classifier: ClassifierParams = ...) -> None: ...
@@ -196,7 +198,8 @@ class CollisionResult:
     def lower_bound(self) -> bool: ...
     @property
     def budget_exhausted(self) -> bool:
-        """True when the query stopped at request.max_leaf_fits with leaf pairs left: P is a lower bound."""
+        """True when the query stopped at request.max_leaf_fits (or the surface layer at
+        request.max_surface_pairs) with leaf pairs left: P is a lower bound."""
     @property
     def no_leaf_tested(self) -> bool: ...
     @property

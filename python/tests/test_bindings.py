@@ -486,6 +486,15 @@ def test_surface_pooled_is_the_mean_of_surface_and_separators(sheets):
         with pytest.raises(ValueError, match=switch + " needs surface"):
             pc.collide(A, B, T, pc.CollisionRequest(**{switch: True}))
     assert "surface_calibrated=False" in repr(pc.CollisionRequest(surface=True, surface_calibrated=False))
+    # The surface layer's cap: nothing to cap without it; with it, a capped answer is a flagged
+    # lower bound of the uncapped one.
+    with pytest.raises(ValueError, match="max_surface_pairs needs surface"):
+        pc.collide(A, B, T, pc.CollisionRequest(max_surface_pairs=8))
+    capped = pc.collide(A, B, T, pc.CollisionRequest(surface=True, exhaustive=True, surface_calibrated=False,
+                                                     max_surface_pairs=1))
+    assert capped.budget_exhausted and capped.lower_bound
+    assert capped.probability <= surface.probability
+    assert "max_surface_pairs=1" in repr(pc.CollisionRequest(surface=True, max_surface_pairs=1))
 
 
 def test_surface_ladder_answers_as_the_rung_it_reaches(sheets):

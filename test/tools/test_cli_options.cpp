@@ -68,6 +68,9 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (modelParamsFor (parse ({"-surface"}).options, true).noiseResolution (), 0.0);
   EXPECT_EQ (modelParamsFor (parse ({"-surface_ladder", "-noise_resolution", "2"}).options, false).noiseResolution (), 2.0);
   EXPECT_EQ (parse ({"-max_leaf_fits", "64"}).options.max_leaf_fits, 64u);
+  EXPECT_EQ (o.max_surface_pairs, 0u);  // no cap
+  EXPECT_EQ (parse ({"-surface_ladder", "-max_surface_pairs", "256"}).options.max_surface_pairs, 256u);
+  EXPECT_EQ (requestFor (parse ({"-surface", "-max_surface_pairs=256"}).options).max_surface_pairs, 256u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
   EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);
   EXPECT_EQ (parse ({"-noise_resolution", "2", "-noise_resolution_gate", "everywhere"}).options.noise_resolution_gate,
@@ -300,6 +303,8 @@ TEST (CliOptions, MalformedNumbersNameTheFlag)
   expectUsageError ({"-sigma", "1e20"}, "-sigma");  // its variance overflowed: "no finite point" (found in review)
   expectUsageError ({"-max_leaf_fits", "-1"}, "-max_leaf_fits");
   expectUsageError ({"-max_leaf_fits", "1.5"}, "-max_leaf_fits");
+  expectUsageError ({"-surface", "-max_surface_pairs", "-1"}, "-max_surface_pairs");
+  expectUsageError ({"-max_surface_pairs", "256"}, "option -max_surface_pairs needs -surface");
   expectUsageError ({"-noise_resolution", "-1"}, "-noise_resolution");
   expectUsageError ({"-noise_resolution", "inf"}, "-noise_resolution");
   expectUsageError ({"-noise_resolution_gate", "somewhere"}, "-noise_resolution_gate");

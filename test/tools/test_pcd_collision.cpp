@@ -856,6 +856,29 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
     marked += l.find ("budget exhausted") != std::string::npos && l.find ("P >=") != std::string::npos;
   EXPECT_EQ (marked, exhausted);
 
+  // -max_surface_pairs caps the ladder's surface rung: where it runs out, the separators' contact
+  // stands, flagged; uncapped, no answer is flagged.
+  const auto ladder = runJson ({kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface_ladder"});
+  const auto ladder_capped = runJson (
+      {kGripper.string (), kScene.string (), "-poses", kPoses.string (), "-surface_ladder", "-max_surface_pairs", "1"});
+  ASSERT_EQ (ladder.size (), 3u);
+  ASSERT_EQ (ladder_capped.size (), 3u);
+  std::size_t surface_exhausted = 0;
+  for (std::size_t i = 0; i < ladder_capped.size (); ++i)
+  {
+    EXPECT_FALSE (ladder[i]["budget_exhausted"].boolean) << i;
+    EXPECT_EQ (ladder[i]["parameters"]["max_surface_pairs"].number, 0.0);
+    EXPECT_EQ (ladder_capped[i]["parameters"]["max_surface_pairs"].number, 1.0);
+    if (!ladder_capped[i]["budget_exhausted"].boolean)
+      continue;
+    ++surface_exhausted;
+    EXPECT_EQ (ladder_capped[i]["answered_by"].text, "separators") << i;
+    EXPECT_EQ (ladder_capped[i]["probability"].number, plain[i]["probability"].number) << i;
+    EXPECT_EQ (ladder_capped[i]["verdict"].text, "contact") << i;
+    EXPECT_NE (ladder[i]["answered_by"].text, "separators") << i;
+  }
+  EXPECT_GT (surface_exhausted, 0u) << "no demo pose climbed past one leaf pair: the test would prove nothing";
+
   const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3",
                                 "-noise_resolution_gate", "everywhere"});
   ASSERT_EQ (merged.size (), 1u);

@@ -58,6 +58,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "defer_kernel_fits": _REQUEST.defer_kernel_fits,
     # At most this many leaf pairs tested a query, nearest first (0: no cap).
     "max_leaf_fits": _REQUEST.max_leaf_fits,
+    # With the surface layer: about this many leaf pairs tested by it a query (0: no cap).
+    "max_surface_pairs": _REQUEST.max_surface_pairs,
     # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none;
     # None: CloudModelParams' default, 2 without the surface layer and 0 with it).
     "noise_resolution": _MODEL.noise_resolution,
@@ -117,7 +119,8 @@ _SWITCHES = ("measured", "deterministic", "stochastic", "exhaustive", "defer_ker
              "surface_ladder", "surface_calibrated", "distance", "ignore_normals", "closed", "closed_a", "closed_b")
 _VALUES = {"sensor": str, "sensor_a": str, "sensor_b": str, "sigma": float, "sigma_a": float, "sigma_b": float,
            "k": int, "thresholds": "pair", "seed": "u64", "nmax": int, "sigma_max": float, "epsilon": float,
-           "split": str, "mesh_density": float, "max_leaf_fits": "u64", "noise_resolution": float,
+           "split": str, "mesh_density": float, "max_leaf_fits": "u64", "max_surface_pairs": "u64",
+           "noise_resolution": float,
            "noise_resolution_gate": str, "noise_stop": float, "orientation": str, "orientation_a": str,
            "orientation_b": str, "threads": int}
 _INTEGERS = tuple(name for name, kind in _VALUES.items() if kind in (int, "u64"))

@@ -27,7 +27,7 @@ workers and prints the JSON lines of `pcd_collision <a> <b> -poses <poses.txt> -
   -threads N                     threads of each task's batch (default 1: the workers give the
                                  parallelism; 0: one per core of the worker's machine)
   pcd_collision's options: -sensor -sensor_a -sensor_b -sigma -sigma_a -sigma_b -k -thresholds
-  -measured -deterministic -stochastic -seed -exhaustive -defer_kernel_fits -max_leaf_fits
+  -measured -deterministic -stochastic -seed -exhaustive -defer_kernel_fits -max_leaf_fits -max_surface_pairs
   -noise_resolution -noise_resolution_gate -noise_stop -surface -surface_pooled -surface_ladder -surface_calibrated -distance -ignore_normals -closed -closed_a
   -closed_b -orientation -orientation_a -orientation_b -nmax -sigma_max
   -epsilon -split -mesh_density -json (accepted; the output is always JSON lines) -v. A value is
