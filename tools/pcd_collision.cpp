@@ -65,6 +65,11 @@ struct Failure
 
 constexpr int kRuntimeFailure = 1;
 constexpr int kUsageError = 2;
+/** \brief Poses answered by one computeBatch: their transforms and results (about 0.9 KB a pose)
+  * are held for a chunk only, so that a run of millions of poses holds its parsed poses (48 bytes
+  * each) and no more (a probe: 250,000 poses held 270 MB, a million 986 MB, before any answer).
+  * Each chunk waits for its slowest pose, a few ms against the seconds a chunk takes. */
+constexpr std::size_t kPosesPerBatch = 16384;
 
 /** \brief Flushes the results' stream (stdout) and fails where they could not be written (a
   * full disk, a quota): an answer lost must not exit 0. A closed pipe ends the tool by SIGPIPE
@@ -746,14 +751,16 @@ run (int argc, char** argv)
   // so, once a run.
   const bool both_meshes = a.kind == InputKind::Mesh && b.kind == InputKind::Mesh;
   bool warned_between_samples = false;
-  // Prints pose i and its answer; throws Failure for a failed query.
-  auto emit = [&] (std::size_t i, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
+  // Prints pose i and its answer (the answer of pose `local` of its chunk's computeBatch); throws
+  // Failure for a failed query.
+  auto emit = [&] (std::size_t i, std::size_t local, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
     if (!result.ok () || shares_terminal)
       progress.clear ();
     if (!result.ok ())
     {
-      // computeBatch names the pose: the failure line names it once, after "pose i: ".
-      const std::string prefix = "pose " + std::to_string (i) + ": ";
+      // computeBatch names the pose by its place in the chunk: the failure line names it once,
+      // by its place in the run, after "pose i: ".
+      const std::string prefix = "pose " + std::to_string (local) + ": ";
       std::string message = result.message.rfind (prefix, 0) == 0 ? result.message.substr (prefix.size ()) : result.message;
       throw Failure{kRuntimeFailure, (batch ? "pose " + std::to_string (i) + ": " : std::string ()) + "query failed: " +
                                          (message.empty () ? std::string ("the query failed") : message)};
@@ -842,17 +849,22 @@ run (int argc, char** argv)
   };
   // The poses are answered on `workers` threads and each answer is printed as soon as it and every
   // pose before it are done (computeBatch's `ready`, one call at a time, on the threads that
-  // answer): the lines stream in pose order, and no thread waits for a batch's slowest pose. An
-  // answer printed is dropped (with -o it holds both clouds' per-point values).
+  // answer): the lines stream in pose order, and no thread waits for a batch's slowest pose, but
+  // at the end of each chunk of kPosesPerBatch. An answer printed is dropped (with -o it holds
+  // both clouds' per-point values).
   std::vector<Eigen::Isometry3d> transforms;
-  transforms.reserve (poses.size ());
-  for (const auto& pose : poses)
-    transforms.push_back (poseTransform (pose));
   std::vector<pcl_probcollision::CollisionResult> results;
-  pc.computeBatch (transforms, results, static_cast<int> (workers), [&] (std::size_t i) {
-    emit (i, transforms[i], results[i]);
-    results[i] = pcl_probcollision::CollisionResult ();
-  });
+  for (std::size_t first = 0; first < poses.size (); first += kPosesPerBatch)
+  {
+    const std::size_t count = std::min (kPosesPerBatch, poses.size () - first);
+    transforms.clear ();
+    for (std::size_t k = 0; k < count; ++k)
+      transforms.push_back (poseTransform (poses[first + k]));
+    pc.computeBatch (transforms, results, static_cast<int> (workers), [&] (std::size_t k) {
+      emit (first + k, k, transforms[k], results[k]);
+      results[k] = pcl_probcollision::CollisionResult ();
+    });
+  }
   progress.clear ();
   return 0;
 }

@@ -1021,9 +1021,31 @@ TEST_F (PcdCollisionTool, PosesFromStandardInputAreAnsweredAsFromAFile)
   EXPECT_NE (bad.err.find ("standard input:2: expected 6 numbers"), std::string::npos) << bad.err;
 }
 
-// -threads: every line the same as one thread's, in pose order, timings aside; n threads answer
-// in chunks of 64 n poses (printed on a thread of their own while the next chunk is answered),
-// so 300 poses cross chunk boundaries for 1 to 3 threads.
+// A run longer than one batch of poses (kPosesPerBatch, 16,384: each batch's transforms and
+// results are held only while it runs) answers every pose in order, each as alone: the demo's
+// penetrating pose, 16,388th of 16,390 (the others clear), reads as in a file of its own.
+TEST_F (PcdCollisionTool, ARunLongerThanOneBatchAnswersEachPoseInOrder)
+{
+  const std::size_t count = 16390, deep = 16388;
+  std::ostringstream poses;
+  for (std::size_t i = 0; i < count; ++i)
+    poses << (i == deep ? "-0.15 0.05 -0.02 0 0 0\n" : "0.1 0 0.25 0 0 0\n");
+  writeFile (dir_ / "many.txt", poses.str ());
+  writeFile (dir_ / "one.txt", "-0.15 0.05 -0.02 0 0 0\n");
+  const ToolRun many = run ({kGripper.string (), kScene.string (), "-poses", (dir_ / "many.txt").string (), "-threads", "2"});
+  const ToolRun one = run ({kGripper.string (), kScene.string (), "-poses", (dir_ / "one.txt").string ()});
+  ASSERT_EQ (many.status, 0) << many.err;
+  ASSERT_EQ (one.status, 0) << one.err;
+  const auto got = lines (many.out);
+  ASSERT_EQ (got.size (), count);
+  for (std::size_t i = 0; i < count; ++i)
+    ASSERT_EQ (got[i].rfind ("pose " + std::to_string (i) + ": " + (i == deep ? "" : "free"), 0), 0u) << got[i];
+  const std::string alone = withoutTimings (lines (one.out).at (0));
+  EXPECT_EQ (withoutTimings (got[deep]), "pose " + std::to_string (deep) + alone.substr (std::string ("pose 0").size ()));
+}
+
+// -threads: every line the same as one thread's, in pose order, timings aside (300 poses, 1 to 3
+// threads, streamed as the batch answers them).
 TEST_F (PcdCollisionTool, ThreadsGiveOneThreadsOutputInPoseOrder)
 {
   std::ostringstream poses;
