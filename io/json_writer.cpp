@@ -49,7 +49,7 @@ void
 JsonWriter::beforeValue ()
 {
   if (!after_key_ && need_comma_)
-    out_ << ',';
+    out_ += ',';
   after_key_ = false;
   need_comma_ = true;
 }
@@ -58,7 +58,7 @@ JsonWriter&
 JsonWriter::beginObject ()
 {
   beforeValue ();
-  out_ << '{';
+  out_ += '{';
   need_comma_ = false;
   return *this;
 }
@@ -66,7 +66,7 @@ JsonWriter::beginObject ()
 JsonWriter&
 JsonWriter::endObject ()
 {
-  out_ << '}';
+  out_ += '}';
   need_comma_ = true;
   return *this;
 }
@@ -75,7 +75,7 @@ JsonWriter&
 JsonWriter::beginArray ()
 {
   beforeValue ();
-  out_ << '[';
+  out_ += '[';
   need_comma_ = false;
   return *this;
 }
@@ -83,7 +83,7 @@ JsonWriter::beginArray ()
 JsonWriter&
 JsonWriter::endArray ()
 {
-  out_ << ']';
+  out_ += ']';
   need_comma_ = true;
   return *this;
 }
@@ -92,9 +92,9 @@ JsonWriter&
 JsonWriter::key (const std::string& name)
 {
   if (need_comma_)
-    out_ << ',';
+    out_ += ',';
   quoted (name);
-  out_ << ':';
+  out_ += ':';
   need_comma_ = false;
   after_key_ = true;
   return *this;
@@ -105,12 +105,12 @@ JsonWriter::number (double value)
 {
   beforeValue ();
   if (!std::isfinite (value))
-    out_ << "null";
+    out_ += "null";
   else
   {
     char buf[32];
     std::snprintf (buf, sizeof (buf), "%.10g", value);
-    out_ << buf;
+    out_ += buf;
   }
   return *this;
 }
@@ -128,7 +128,7 @@ JsonWriter&
 JsonWriter::integer (long long value)
 {
   beforeValue ();
-  out_ << value;
+  out_ += std::to_string (value);
   return *this;
 }
 
@@ -136,7 +136,7 @@ JsonWriter&
 JsonWriter::unsignedInteger (std::uint64_t value)
 {
   beforeValue ();
-  out_ << value;
+  out_ += std::to_string (value);
   return *this;
 }
 
@@ -144,7 +144,7 @@ JsonWriter&
 JsonWriter::boolean (bool value)
 {
   beforeValue ();
-  out_ << (value ? "true" : "false");
+  out_ += (value ? "true" : "false");
   return *this;
 }
 
@@ -152,7 +152,7 @@ JsonWriter&
 JsonWriter::null ()
 {
   beforeValue ();
-  out_ << "null";
+  out_ += "null";
   return *this;
 }
 
@@ -167,7 +167,7 @@ JsonWriter::string (const std::string& value)
 void
 JsonWriter::quoted (const std::string& s)
 {
-  out_ << '"';
+  out_ += '"';
   const std::size_t n = s.size ();
   for (std::size_t i = 0; i < n;)
   {
@@ -181,35 +181,35 @@ JsonWriter::quoted (const std::string& s)
       {
         char buf[8];
         std::snprintf (buf, sizeof (buf), "\\udc%02x", c);
-        out_ << buf;
+        out_ += buf;
         ++i;
       }
       else
       {
-        out_.write (s.data () + i, static_cast<std::streamsize> (length));
+        out_.append (s.data () + i, length);
         i += length;
       }
       continue;
     }
     switch (c)
     {
-      case '"': out_ << "\\\""; break;
-      case '\\': out_ << "\\\\"; break;
-      case '\n': out_ << "\\n"; break;
-      case '\r': out_ << "\\r"; break;
-      case '\t': out_ << "\\t"; break;
+      case '"': out_ += "\\\""; break;
+      case '\\': out_ += "\\\\"; break;
+      case '\n': out_ += "\\n"; break;
+      case '\r': out_ += "\\r"; break;
+      case '\t': out_ += "\\t"; break;
       default:
         if (c < 0x20 || c == 0x7f)
         {
           char buf[8];
           std::snprintf (buf, sizeof (buf), "\\u%04x", c);
-          out_ << buf;
+          out_ += buf;
         }
         else
-          out_ << static_cast<char> (c);
+          out_ += static_cast<char> (c);
     }
     ++i;
   }
-  out_ << '"';
+  out_ += '"';
 }
 } // namespace pcl_probcollision::io
