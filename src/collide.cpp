@@ -336,10 +336,12 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
       surface_ran = true;
       surface_reached = !result.no_leaf_tested;
       pooled = separators.probability < request.free_below;
-      if (answer.budget_exhausted && !pooled)
+      if (answer.budget_exhausted && !pooled && !(result.probability > request.collision_above))
       {
-        // Capped in the separators' contact band (max_surface_pairs): a partial surface layer
-        // could only lower their answer toward free on the leaves it saw; theirs stands.
+        // Capped in the separators' contact band (max_surface_pairs) short of a collision: the
+        // leaves it saw are no ground to move their contact toward free; theirs stands. A
+        // collision it found stands (a lower bound past the threshold: only an exhaustive or
+        // per-point query, or an asked distance, goes on past one).
         separators.bv_tests += result.bv_tests;
         separators.leaf_pairs_tested += result.leaf_pairs_tested;
         result = std::move (separators);

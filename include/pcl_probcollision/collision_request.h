@@ -81,8 +81,8 @@ struct CollisionRequest
     * the cap by one leaf's); 0 (default) = no cap. A capped answer is flagged
     * (CollisionResult::budget_exhausted): P is the largest so far, a lower bound, and the
     * winding-number test of parts beyond reach is skipped. In the ladder the separators' answer
-    * then stands where they read contact, and the pool takes the lower bound where they read
-    * free. It bounds the surface layer's worst case, whose contact answers visit every leaf
+    * then stands where they read contact (a collision the capped rung found stands instead), and
+    * the pool takes the lower bound where they read free. It bounds the surface layer's worst case, whose contact answers visit every leaf
     * pair within reach (docs/SURFACE.md, "A cap on the surface layer's work"). */
   std::size_t max_surface_pairs = 0;
 

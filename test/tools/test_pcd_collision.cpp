@@ -878,6 +878,15 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
     EXPECT_NE (ladder[i]["answered_by"].text, "separators") << i;
   }
   EXPECT_GT (surface_exhausted, 0u) << "no demo pose climbed past one leaf pair: the test would prove nothing";
+  // A collision the capped rung found stands: -exhaustive goes on past the first one, and the
+  // penetrating pose's is found within 512 pairs (found in review: the separators' contact
+  // replaced it).
+  const auto found = runJson ({kGripper.string (), kScene.string (), "-pose=-0.15,0.05,-0.02,0,0,0", "-surface_ladder",
+                               "-exhaustive", "-max_surface_pairs", "512"});
+  ASSERT_EQ (found.size (), 1u);
+  EXPECT_TRUE (found[0]["budget_exhausted"].boolean);
+  EXPECT_EQ (found[0]["verdict"].text, "collision");
+  EXPECT_EQ (found[0]["answered_by"].text, "surface");
 
   const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3",
                                 "-noise_resolution_gate", "everywhere"});
