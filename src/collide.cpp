@@ -189,6 +189,18 @@ addSeparators (CollisionResult& into, const CollisionResult& separators)
   into.degenerate_leaf_pairs = separators.degenerate_leaf_pairs;
   into.classifier_iterations = separators.classifier_iterations;
 }
+/** \brief The separators' answer stands in place of a surface layer's that said nothing usable:
+  * its work counted in; flagged capped where max_surface_pairs cut it short (the leaves left
+  * might have said something, so P is then a lower bound). */
+void
+separatorsStand (CollisionResult& result, CollisionResult&& separators, bool capped)
+{
+  separators.bv_tests += result.bv_tests;
+  separators.leaf_pairs_tested += result.leaf_pairs_tested;
+  result = std::move (separators);
+  result.budget_exhausted = result.budget_exhausted || capped;
+  result.lower_bound = result.lower_bound || capped;
+}
 
 /** \brief The surface layer's answer (into) pooled with the separators' on the same pair
   * (CollisionRequest::surface_pooled): the mean of the two probabilities, per point where both
@@ -342,21 +354,14 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         // leaves it saw are no ground to move their contact toward free; theirs stands. A
         // collision it found stands (a lower bound past the threshold: only an exhaustive or
         // per-point query, or an asked distance, goes on past one).
-        separators.bv_tests += result.bv_tests;
-        separators.leaf_pairs_tested += result.leaf_pairs_tested;
-        result = std::move (separators);
-        result.budget_exhausted = result.lower_bound = true;
+        separatorsStand (result, std::move (separators), true);
         from_surface = false;
       }
       else if (!surface_reached)
       {
         // No point within the surface layer's reach: it has nothing to say, and its P = 0 would
         // turn the separators' contact into "free" (two coincident clouds of two points read free).
-        // Capped, it may not have reached the leaves that would have said something.
-        separators.bv_tests += result.bv_tests;
-        result = std::move (separators);
-        result.budget_exhausted = result.budget_exhausted || answer.budget_exhausted;
-        result.lower_bound = result.lower_bound || answer.budget_exhausted;
+        separatorsStand (result, std::move (separators), answer.budget_exhausted);
         from_surface = pooled = false;
       }
       else if (pooled)
@@ -425,11 +430,7 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
       }
       if (defer)
       {
-        separators.bv_tests += result.bv_tests;
-        const bool capped = result.budget_exhausted;
-        result = std::move (separators);
-        result.budget_exhausted = result.budget_exhausted || capped;
-        result.lower_bound = result.lower_bound || capped;
+        separatorsStand (result, std::move (separators), result.budget_exhausted);
         from_surface = pooled = false;
       }
       else
