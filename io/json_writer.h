@@ -14,7 +14,7 @@ namespace pcl_probcollision::io
   * placed by the writer; the caller only nests begin/end pairs correctly and calls key() before
   * each member of an object.
   *
-  * Numbers are printed with "%.10g"; NaN and Inf, which JSON cannot hold, become null (the
+  * Numbers are printed as the shortest text that reads back as the same double (std::to_chars); NaN and Inf, which JSON cannot hold, become null (the
   * library's "not computed"). Strings are escaped per RFC 8259 (quote, backslash, control
   * characters); well-formed UTF-8 is copied unchanged, and any other byte (a file name that is
   * not UTF-8) is written \udcXX, Python's surrogateescape: the text stays UTF-8, and
@@ -45,6 +45,14 @@ public:
   JsonWriter& boolean (bool value);
   JsonWriter& null ();
   JsonWriter& string (const std::string& value);
+
+  /** \brief Pre-formatted members of the current object: objectMembers() of another writer,
+    * written as they are (nothing when fragment is empty). Lets a caller format the members that
+    * every line of a run repeats once. */
+  JsonWriter& members (const std::string& fragment);
+  /** \brief The members of the one object written so far, without its braces (for members());
+    * empty when the text is not one object. */
+  std::string objectMembers () const;
 
   /** \brief Everything written so far. */
   std::string text () const { return out_; }

@@ -1128,6 +1128,7 @@ pcdCollisionJsonLines (const std::vector<std::string>& flags, const py::dict& in
   };
   std::vector<std::string> lines;
   lines.reserve (m);
+  const std::string run_members = pcd_collision::runMembersJson (options, a, b);  // the same in every line
   for (std::size_t i = 0; i < m; ++i)
   {
     CollisionResult r;
@@ -1160,7 +1161,7 @@ pcdCollisionJsonLines (const std::vector<std::string>& flags, const py::dict& in
     r.witness_point = vector3 (witness_point, i);
     r.witness_normal = vector3 (witness_normal, i);
     const pcd_collision::Pose pose{rows.at (i, 0), rows.at (i, 1), rows.at (i, 2), rows.at (i, 3), rows.at (i, 4), rows.at (i, 5)};
-    lines.push_back (pcd_collision::resultJson (options, a, b, r, pose, static_cast<long long> (i)));
+    lines.push_back (pcd_collision::resultJson (options, a, b, r, pose, static_cast<long long> (i), std::nullopt, 0, &run_members));
   }
   return lines;
 }
@@ -1653,7 +1654,7 @@ PYBIND11_MODULE (_core, m)
                      "P and the verdict then say what the bridged or occupied surface implies; a planner may treat\n"
                      "such a pose as unknown. Always False without request.surface.")
       .def_readonly ("witness_side", &CollisionResult::witness_side,
-                     "Which input holds the point attaining P: +1 a (the moved one), -1 b, 0 none.")
+                     "Which input holds the point attaining P: +1 a (collide's first model), -1 b, 0 none.")
       .def_readonly ("witness_index", &CollisionResult::witness_index,
                      "That point's index in its own input (-1 when none).")
       .def_property_readonly ("witness_point", [] (const CollisionResult& r) { return vec3 (r.witness_point); })
@@ -1672,6 +1673,17 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("probabilities_a", [] (const CollisionResult& r) { return floats (r.probabilities_a); })
       .def_property_readonly ("probabilities_b", [] (const CollisionResult& r) { return floats (r.probabilities_b); })
       .def_property_readonly ("ok", &CollisionResult::ok)
+      .def ("in_frame",
+            [] (const CollisionResult& r, const py::object& pose) {
+              const auto a = poseArray (py::module_::import ("numpy").attr ("asarray") (pose).attr ("reshape") (1, 4, 4));
+              CollisionResult out = r;
+              pcl_probcollision::mapResultPoints (out, poseAt (a.unchecked<3> (), 0, true));
+              return out;
+            },
+            py::arg ("pose"),
+            "A copy with witness_point, witness_normal and (with sample_distance) the nearest points mapped by\n"
+            "pose ((4, 4) rigid): collide(a, b, T_a_b) answers in a's frame, in_frame(invert_poses(T_a_b)) in b's,\n"
+            "with the bits pcd_collision prints.")
       .def ("__repr__", [] (const CollisionResult& r) {
         // Every member but the per-point arrays: a NaN distance or timing (not computed) and a
         // flag that is False are left out, the vectors shown where they mean something.

@@ -751,6 +751,10 @@ run (int argc, char** argv)
   // so, once a run.
   const bool both_meshes = a.kind == InputKind::Mesh && b.kind == InputKind::Mesh;
   bool warned_between_samples = false;
+  // -json: both inputs' summaries and the members every line repeats, made at the first answer
+  // (the models are built then and stay): formatted for each line, they were most of its cost.
+  std::optional<InputSummary> summary_a, summary_b;
+  std::string run_members;
   // Prints pose i and its answer (the answer of pose `local` of its chunk's computeBatch); throws
   // Failure for a failed query.
   auto emit = [&] (std::size_t i, std::size_t local, const Eigen::Isometry3d& T, pcl_probcollision::CollisionResult& result) {
@@ -831,8 +835,14 @@ run (int argc, char** argv)
     const long long index = batch ? static_cast<long long> (i) : -1;
     if (o.json)
     {
-      std::fprintf (stdout, "%s\n", resultJson (o, summaryOf (a, pc.getInputModel ().get ()), summaryOf (b, pc.getTargetModel ().get ()), result, poses[i], index,
-                                                write_ms, written).c_str ());
+      if (!summary_a)
+      {
+        summary_a = summaryOf (a, pc.getInputModel ().get ());
+        summary_b = summaryOf (b, pc.getTargetModel ().get ());
+        run_members = runMembersJson (o, *summary_a, *summary_b);
+      }
+      std::fprintf (stdout, "%s\n",
+                    resultJson (o, *summary_a, *summary_b, result, poses[i], index, write_ms, written, &run_members).c_str ());
       flushResults ();
     }
     else

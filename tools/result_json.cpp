@@ -83,10 +83,66 @@ summarizeModel (const pcl_probcollision::CloudModel* model, InputSummary& summar
 }
 
 std::string
-resultJson (const Options& o, const InputSummary& a, const InputSummary& b, const pcl_probcollision::CollisionResult& r,
-            const Pose& pose, long long pose_index, const std::optional<double>& write_ms, std::size_t points_written)
+runMembersJson (const Options& o, const InputSummary& a, const InputSummary& b)
 {
   const auto& rq = requestFor (o);
+  JsonWriter j;
+  j.beginObject ();
+  j.key ("inputs").beginObject ();
+  j.key ("a");
+  inputJson (j, a);
+  j.key ("b");
+  inputJson (j, b);
+  j.endObject ();
+  j.key ("parameters").beginObject ();
+  // "sensor" is the model of both inputs, null when they differ; a mesh gets no noise.
+  j.key ("sensor");
+  o.sensor_a == o.sensor_b ? j.string (o.sensor_a) : j.null ();
+  j.key ("sensor_a");
+  !a.mesh ? j.string (o.sensor_a) : j.null ();
+  j.key ("sensor_b");
+  !b.mesh ? j.string (o.sensor_b) : j.null ();
+  j.key ("sigma_a");
+  (o.sensor_a == "isotropic" && !a.mesh) ? j.number (o.sigma_a) : j.null ();
+  j.key ("sigma_b");
+  (o.sensor_b == "isotropic" && !b.mesh) ? j.number (o.sigma_b) : j.null ();
+  j.key ("k").integer (o.k);
+  j.key ("thresholds").numbers ({o.free_below, o.collision_above});
+  j.key ("traversal").string (o.stochastic ? "stochastic" : "deterministic");
+  j.key ("positions").string (o.measured ? "measured" : "projected");
+  j.key ("seed").unsignedInteger (o.seed);
+  j.key ("exhaustive").boolean (rq.exhaustive);
+  j.key ("defer_kernel_fits").boolean (rq.defer_kernel_fits);
+  j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
+  j.key ("max_surface_pairs").unsignedInteger (rq.max_surface_pairs);
+  j.key ("noise_resolution").number (modelParamsFor (o, true).noiseResolution ());
+  j.key ("noise_resolution_gate").string (pcl_probcollision::CloudModelParams::resolutionGateName (o.noise_resolution_gate));
+  j.key ("noise_stop").number (o.noise_stop);
+  j.key ("surface").boolean (rq.surface);
+  j.key ("surface_pooled").boolean (rq.surface_pooled);
+  j.key ("surface_ladder").boolean (rq.surface_ladder);
+  j.key ("surface_calibrated").boolean (rq.surface_calibrated);
+  j.key ("distance").boolean (rq.distance);
+  j.key ("closed_a").boolean (o.closed_a);
+  j.key ("closed_b").boolean (o.closed_b);
+  j.key ("orientation_a").string (pcl_probcollision::orientationName (o.orientation_a));
+  j.key ("orientation_b").string (pcl_probcollision::orientationName (o.orientation_b));
+  const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o, true).hierarchy;
+  j.key ("nmax").integer (hierarchy.n_max);
+  j.key ("nmin").integer (hierarchy.n_min);
+  j.key ("sigma_max").number (hierarchy.sigma_max);
+  j.key ("epsilon").number (hierarchy.epsilon);
+  j.key ("split").string (o.split);
+  j.endObject ();
+  j.endObject ();
+  return j.objectMembers ();
+}
+
+std::string
+resultJson (const Options& o, const InputSummary& a, const InputSummary& b, const pcl_probcollision::CollisionResult& r,
+            const Pose& pose, long long pose_index, const std::optional<double>& write_ms, std::size_t points_written,
+            const std::string* run_members)
+{
   JsonWriter j;
   j.beginObject ();
   if (pose_index >= 0)
@@ -151,52 +207,7 @@ resultJson (const Options& o, const InputSummary& a, const InputSummary& b, cons
   if (write_ms)
     j.key ("write").number (*write_ms);
   j.endObject ();
-  j.key ("inputs").beginObject ();
-  j.key ("a");
-  inputJson (j, a);
-  j.key ("b");
-  inputJson (j, b);
-  j.endObject ();
-  j.key ("parameters").beginObject ();
-  // "sensor" is the model of both inputs, null when they differ; a mesh gets no noise.
-  j.key ("sensor");
-  o.sensor_a == o.sensor_b ? j.string (o.sensor_a) : j.null ();
-  j.key ("sensor_a");
-  !a.mesh ? j.string (o.sensor_a) : j.null ();
-  j.key ("sensor_b");
-  !b.mesh ? j.string (o.sensor_b) : j.null ();
-  j.key ("sigma_a");
-  (o.sensor_a == "isotropic" && !a.mesh) ? j.number (o.sigma_a) : j.null ();
-  j.key ("sigma_b");
-  (o.sensor_b == "isotropic" && !b.mesh) ? j.number (o.sigma_b) : j.null ();
-  j.key ("k").integer (o.k);
-  j.key ("thresholds").numbers ({o.free_below, o.collision_above});
-  j.key ("traversal").string (o.stochastic ? "stochastic" : "deterministic");
-  j.key ("positions").string (o.measured ? "measured" : "projected");
-  j.key ("seed").unsignedInteger (o.seed);
-  j.key ("exhaustive").boolean (rq.exhaustive);
-  j.key ("defer_kernel_fits").boolean (rq.defer_kernel_fits);
-  j.key ("max_leaf_fits").unsignedInteger (rq.max_leaf_fits);
-  j.key ("max_surface_pairs").unsignedInteger (rq.max_surface_pairs);
-  j.key ("noise_resolution").number (modelParamsFor (o, true).noiseResolution ());
-  j.key ("noise_resolution_gate").string (pcl_probcollision::CloudModelParams::resolutionGateName (o.noise_resolution_gate));
-  j.key ("noise_stop").number (o.noise_stop);
-  j.key ("surface").boolean (rq.surface);
-  j.key ("surface_pooled").boolean (rq.surface_pooled);
-  j.key ("surface_ladder").boolean (rq.surface_ladder);
-  j.key ("surface_calibrated").boolean (rq.surface_calibrated);
-  j.key ("distance").boolean (rq.distance);
-  j.key ("closed_a").boolean (o.closed_a);
-  j.key ("closed_b").boolean (o.closed_b);
-  j.key ("orientation_a").string (pcl_probcollision::orientationName (o.orientation_a));
-  j.key ("orientation_b").string (pcl_probcollision::orientationName (o.orientation_b));
-  const pcl_probcollision::BVHParams hierarchy = modelParamsFor (o, true).hierarchy;
-  j.key ("nmax").integer (hierarchy.n_max);
-  j.key ("nmin").integer (hierarchy.n_min);
-  j.key ("sigma_max").number (hierarchy.sigma_max);
-  j.key ("epsilon").number (hierarchy.epsilon);
-  j.key ("split").string (o.split);
-  j.endObject ();
+  j.members (run_members ? *run_members : runMembersJson (o, a, b));
   if (o.output)
   {
     j.key ("output").beginObject ();

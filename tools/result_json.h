@@ -58,8 +58,14 @@ void summarizeModel (const pcl_probcollision::CloudModel* model, InputSummary& s
 /** \brief One JSON line of pcd_collision -json for result r of pose (its index in a -poses file,
   * or -1 for -pose), under options o; write_ms and points_written describe -o's file (output
   * member only with -o). The witness and nearest points are written as r holds them (b's
-  * frame); r.build_ms is the first pose's only. No trailing newline. */
+  * frame); r.build_ms is the first pose's only. No trailing newline. run_members, when given,
+  * is runMembersJson (o, a, b), formatted once for a run's lines. */
 std::string resultJson (const Options& o, const InputSummary& a, const InputSummary& b,
                         const pcl_probcollision::CollisionResult& r, const Pose& pose, long long pose_index,
-                        const std::optional<double>& write_ms = std::nullopt, std::size_t points_written = 0);
+                        const std::optional<double>& write_ms = std::nullopt, std::size_t points_written = 0,
+                        const std::string* run_members = nullptr);
+
+/** \brief The members of resultJson's line that every pose of a run repeats ("inputs" and
+  * "parameters"), without the braces (JsonWriter::members). */
+std::string runMembersJson (const Options& o, const InputSummary& a, const InputSummary& b);
 } // namespace pcd_collision

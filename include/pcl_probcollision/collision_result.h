@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstddef>
 #include <limits>
@@ -184,4 +185,11 @@ struct CollisionResult
   /** \brief True when the query answered (status Ok). */
   bool ok () const { return status == Status::Ok; }
 };
+
+/** \brief Maps result's points and normal into another frame: witness_point and witness_normal
+  * (with a witness), nearest_point_a and _b (with sample_distance), by T (the normal by its
+  * rotation). collide (a, b, T_a_b) answers in A's frame; T = T_a_b.inverse () gives B's, as
+  * ProbabilisticCollision::compute and pcd_collision report. The one place this is done, so that
+  * every way of asking (C++, Python, Dask) gives the same bits. */
+void mapResultPoints (CollisionResult& result, const Eigen::Isometry3d& T);
 } // namespace pcl_probcollision

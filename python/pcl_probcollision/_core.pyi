@@ -219,7 +219,7 @@ class CollisionResult:
         none reads inside, reads unknown: P 0.5, at least 0.25 pooled); always False without request.surface."""
     @property
     def witness_side(self) -> int:
-        """Which input holds the point attaining P: +1 a (the moved one), -1 b, 0 none."""
+        """Which input holds the point attaining P: +1 a (collide's first model), -1 b, 0 none."""
     @property
     def witness_index(self) -> int:
         """That point's index in its own input (-1 when none)."""
@@ -253,6 +253,10 @@ class CollisionResult:
     def probabilities_b(self) -> npt.NDArray[np.float32]: ...
     @property
     def ok(self) -> bool: ...
+    def in_frame(self, pose: npt.ArrayLike) -> CollisionResult:
+        """A copy with witness_point, witness_normal and (with sample_distance) the nearest points mapped by
+        pose ((4, 4) rigid): collide(a, b, T_a_b) answers in a's frame, in_frame(invert_poses(T_a_b)) in b's,
+        with the bits pcd_collision prints."""
 
 class CloudModel:
     @property

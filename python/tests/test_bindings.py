@@ -365,7 +365,7 @@ def test_result_repr_shows_every_member(table, gripper_patch):
     assert capped.budget_exhausted and told.message
     results = (near, far, capped, told)
     members = {n for n in dir(pc.CollisionResult) if not n.startswith("_")} - {
-        "probabilities_a", "probabilities_b", "ok", "Status"}
+        "probabilities_a", "probabilities_b", "ok", "Status", "in_frame"}  # in_frame: a method
     flags = {"full_resolution", "unobserved"}  # not set by these queries (tested with their layers)
     shown = {m for m in members if any(f"{m}=" in repr(r) for r in results)}
     assert shown == members - flags, sorted(members - flags - shown)
@@ -1489,6 +1489,31 @@ def test_invert_poses_refuses_what_collide_refuses():
     row[0, 3, 0] = 1.0
     with pytest.raises(ValueError, match=r"poses\[0\]: the last row"):
         pc.invert_poses(row)
+
+
+def test_in_frame_maps_the_witness_and_nearest_points_as_pcd_collision_reports_them(gripper_patch, table):
+    # collide() answers in a's frame; in_frame(T_b_a) gives b's, with the library's own arithmetic
+    # (the Dask layer's numpy rotation differed from pcd_collision's in the last bit of a normal).
+    yaw = 0.7
+    T_b_a = pc.poses_from_xyzrpy([[0.01, -0.02, 0.005, 0.1, -0.05, yaw]])
+    T_a_b = pc.invert_poses(T_b_a)[0]
+    r = pc.collide(gripper_patch, table, T_a_b, pc.CollisionRequest(distance=True))
+    assert r.witness_side != 0
+    moved = r.in_frame(T_b_a[0])
+    R, t = T_b_a[0, :3, :3], T_b_a[0, :3, 3]
+    np.testing.assert_allclose(moved.witness_point, R @ r.witness_point + t, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(moved.witness_normal, R @ r.witness_normal, rtol=0, atol=1e-15)
+    assert np.linalg.norm(moved.witness_point - r.witness_point) > 1e-3  # it did move
+    assert moved.probability == r.probability and moved.verdict == r.verdict
+    far = pc.collide(gripper_patch, table, translation(z=-0.5), pc.CollisionRequest(distance=True))
+    assert far.sample_distance
+    far_b = far.in_frame(translation(z=0.5))
+    np.testing.assert_allclose(far_b.nearest_point_a, far.nearest_point_a + (0, 0, 0.5), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(far_b.nearest_point_b, far.nearest_point_b + (0, 0, 0.5), rtol=0, atol=1e-15)
+    scaled = np.eye(4) * 2.0
+    scaled[3, 3] = 1.0
+    with pytest.raises(ValueError, match="not a rotation plus translation"):
+        r.in_frame(scaled)
 
 
 def test_a_viewpoint_that_is_not_finite_is_refused():

@@ -6,8 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
+#include <random>
 
 using pcl_probcollision::io::JsonWriter;
 
@@ -28,14 +31,52 @@ TEST (JsonWriter, CommasAndNesting)
   EXPECT_NO_THROW (mini_json::parse (j.text ()));
 }
 
-TEST (JsonWriter, NumbersHaveTenSignificantDigitsAndNeverNanOrInf)
+// The shortest text that reads back as the same double: a -json line's P and distances compare
+// bit for bit with the library's (they had 10 significant digits).
+TEST (JsonWriter, NumbersReadBackExactlyAndAreNeverNanOrInf)
 {
   JsonWriter j;
-  j.numbers ({0.0, 1.0, -0.5, 0.1, 1.0 / 3.0, 123456789012.0, 1e-7, 0.003670914317123,
+  j.numbers ({0.0, 1.0, -0.5, 0.1, 1.0 / 3.0, 123456789012.0, 1e-7, 0.003670914317123, 0.1 + 0.2,
               std::numeric_limits<double>::quiet_NaN (), std::numeric_limits<double>::infinity (),
               -std::numeric_limits<double>::infinity ()});
-  EXPECT_EQ (j.text (), "[0,1,-0.5,0.1,0.3333333333,1.23456789e+11,1e-07,0.003670914317,null,null,null]");
+  EXPECT_EQ (j.text (), "[0,1,-0.5,0.1,0.3333333333333333,123456789012,1e-07,0.003670914317123,0.30000000000000004,"
+                        "null,null,null]");
   EXPECT_NO_THROW (mini_json::parse (j.text ()));
+
+  std::mt19937_64 draw (7);
+  std::uniform_real_distribution<double> uniform (-1.0, 1.0);
+  for (int i = 0; i < 1000; ++i)
+  {
+    const double value = uniform (draw) * std::pow (10.0, static_cast<int> (draw () % 40) - 20);
+    JsonWriter one;
+    one.number (value);
+    EXPECT_EQ (std::strtod (one.text ().c_str (), nullptr), value) << one.text ();
+  }
+}
+
+// Members formatted once and repeated, as pcd_collision -json writes the inputs and parameters of
+// every line of a run: the same bytes as written in place.
+TEST (JsonWriter, PreformattedMembersAreTheSameBytes)
+{
+  JsonWriter part;
+  part.beginObject ().key ("inputs").beginObject ().key ("a").string ("x.pcd").endObject ();
+  part.key ("k").integer (10).endObject ();
+  const std::string members = part.objectMembers ();
+  EXPECT_EQ (members, "\"inputs\":{\"a\":\"x.pcd\"},\"k\":10");
+
+  JsonWriter in_place, reused;
+  in_place.beginObject ().key ("p").number (0.5);
+  in_place.key ("inputs").beginObject ().key ("a").string ("x.pcd").endObject ().key ("k").integer (10);
+  in_place.key ("version").string ("1").endObject ();
+  reused.beginObject ().key ("p").number (0.5).members (members).key ("version").string ("1").endObject ();
+  EXPECT_EQ (reused.text (), in_place.text ());
+  JsonWriter first;
+  first.beginObject ().members (members).members ("").endObject ();
+  EXPECT_EQ (first.text (), "{" + members + "}");
+  EXPECT_NO_THROW (mini_json::parse (first.text ()));
+  JsonWriter array;
+  array.beginArray ().endArray ();
+  EXPECT_EQ (array.objectMembers (), "");
 }
 
 TEST (JsonWriter, StringsAreEscaped)

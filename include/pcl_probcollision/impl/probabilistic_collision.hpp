@@ -220,16 +220,7 @@ ProbabilisticCollision<PointT>::finishResult (const Eigen::Isometry3d& T_target_
 {
   result.build_ms = request_.enable_timings ? build_ms : std::numeric_limits<double>::quiet_NaN ();
   // collide() answers in its query frame, A's; compute()'s query frame is the target's.
-  if (result.witness_side != 0)
-  {
-    result.witness_point = T_target_input * result.witness_point;
-    result.witness_normal = T_target_input.linear () * result.witness_normal;
-  }
-  if (result.sample_distance)
-  {
-    result.nearest_point_a = T_target_input * result.nearest_point_a;
-    result.nearest_point_b = T_target_input * result.nearest_point_b;
-  }
+  mapResultPoints (result, T_target_input);
 }
 
 template <typename PointT>

@@ -448,17 +448,11 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     for f in _INT_FIELDS:
         out[f] = np.array([getattr(r, f) for r in results], dtype=np.int64)
     # collide() answers in A's frame; pcd_collision reports the witness (and the nearest samples,
-    # NaN without sample_distance) in b's frame: p_b = T_b_a p_a, n_b = R_b_a n_a, summed in
-    # Eigen's order.
-    R = T_b_a[:, :3, :3]
-
-    def rotated(field):
-        v = np.array([getattr(r, field) for r in results], dtype=np.float64).reshape(n, 3)
-        return R[:, :, 0] * v[:, 0:1] + R[:, :, 1] * v[:, 1:2] + R[:, :, 2] * v[:, 2:3]
-
-    for field in ("witness_point", "nearest_point_a", "nearest_point_b"):
-        out[field] = rotated(field) + T_b_a[:, :3, 3]
-    out["witness_normal"] = rotated("witness_normal")
+    # NaN without sample_distance) in b's frame, mapped by the library's own code
+    # (CollisionResult.in_frame): the same bits as pcd_collision's.
+    moved = [r.in_frame(T) for r, T in zip(results, T_b_a)]
+    for field in ("witness_point", "witness_normal", "nearest_point_a", "nearest_point_b"):
+        out[field] = np.array([getattr(r, field) for r in moved], dtype=np.float64).reshape(n, 3)
     out["build_ms"] = np.array([A.build_ms + B.build_ms])
     out["surfaces"] = {"a": surface_summary(A), "b": surface_summary(B)}
     out["merged_samples"] = {"a": A.merged_samples, "b": B.merged_samples}
