@@ -562,12 +562,16 @@ parseCommandLine (const std::vector<std::string>& args)
     }
     else if (a == "-noise_resolution")
     {
+      // "auto", the default the help names: the library's choice (unset: 2 without -surface, 0 with it).
       double radius = 0.0;
-      if (!parseDouble (v, radius))
-        return usage (bad + notANumber (v));
-      if (!(radius >= 0.0) || !std::isfinite (radius))
-        return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging)");
-      o.noise_resolution = radius;
+      if (lower (v) == "auto")
+        o.noise_resolution.reset ();
+      else if (!parseDouble (v, radius))
+        return usage (bad + notANumber (v) + " (or auto)");
+      else if (!(radius >= 0.0) || !std::isfinite (radius))
+        return usage (bad + "must be a finite number >= 0 (noise standard deviations; 0: no merging) or auto");
+      else
+        o.noise_resolution = radius;
     }
     else if (a == "-noise_resolution_gate")
     {
@@ -647,6 +651,9 @@ parseCommandLine (const std::vector<std::string>& args)
   if (o.max_surface_pairs > 0 && !o.surface)
     return usage ("option -max_surface_pairs needs -surface (or -surface_pooled, -surface_ladder): it caps the "
                   "surface layer's work (-max_leaf_fits caps the separators')");
+  if (o.ignore_normals && !o.surface)
+    return usage ("option -ignore_normals needs -surface (or -surface_pooled, -surface_ladder): the normals a file "
+                  "stores orient the surface layer's surfaces only");
   if (o.surface_calibrated && !o.surface)
     return usage ("option -surface_calibrated needs -surface (or -surface_pooled, -surface_ladder): it maps the "
                   "surface layer's probability");

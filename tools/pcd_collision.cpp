@@ -730,7 +730,7 @@ run (int argc, char** argv)
       // A cloud modelled by its merged samples (-noise_resolution) says how many there were.
       char merged[96] = "";
       if (model->mergedSamples () > 0)
-        std::snprintf (merged, sizeof merged, " (%zu samples merged within %g noise sigmas)",
+        std::snprintf (merged, sizeof merged, " (from %zu samples merged within %g noise sigmas)",
                        model->size () + model->mergedSamples (), model->params ().noiseResolution ());
       std::fprintf (log, "Building %s [done, %.1f ms : %zu points%s, %zu hierarchy nodes%s, %.2f MB]\n", in->path.c_str (),
                     model->buildMilliseconds (), model->size (), merged, model->hierarchy ().nodes ().size (),

@@ -72,6 +72,11 @@ TEST (CliOptions, Defaults)
   EXPECT_EQ (parse ({"-surface_ladder", "-max_surface_pairs", "256"}).options.max_surface_pairs, 256u);
   EXPECT_EQ (requestFor (parse ({"-surface", "-max_surface_pairs=256"}).options).max_surface_pairs, 256u);
   EXPECT_EQ (parse ({"-noise_resolution=2.5"}).options.noise_resolution, 2.5);
+  // "auto", the default -h names, can be typed (it was "not a number"), after a radius too.
+  EXPECT_FALSE (parse ({"-noise_resolution", "2.5", "-noise_resolution=AUTO"}).options.noise_resolution.has_value ());
+  EXPECT_EQ (modelParamsFor (parse ({"-noise_resolution", "auto"}).options, true).noiseResolution (), 2.0);
+  EXPECT_EQ (modelParamsFor (parse ({"-surface", "-noise_resolution", "auto"}).options, true).noiseResolution (), 0.0);
+  expectUsageError ({"-noise_resolution", "automatic"}, "option -noise_resolution: 'automatic' is not a number (or auto)");
   EXPECT_EQ (o.noise_resolution_gate, pcl_probcollision::CloudModelParams::ResolutionGate::WholeCloud);
   EXPECT_EQ (parse ({"-noise_resolution", "2", "-noise_resolution_gate", "everywhere"}).options.noise_resolution_gate,
              pcl_probcollision::CloudModelParams::ResolutionGate::Everywhere);
@@ -207,6 +212,10 @@ TEST (CliOptions, OptionsThatWouldChangeNothingAreRefused)
   EXPECT_EQ (parse ({"-surface", "-noise_resolution", "2", "-noise_resolution_gate", "spacing"}).kind, Kind::Run);
   EXPECT_EQ (parse ({"-noise_resolution", "0.5", "-noise_resolution_gate", "cloud"}).kind, Kind::Run);
   EXPECT_EQ (parse ({"-noise_resolution", "0"}).kind, Kind::Run);  // "never merge", said explicitly
+  // The normals a file stores orient the surface layer only, as -orientation does (a probe of
+  // the docs, 2026-12-06: -ignore_normals alone was accepted).
+  expectUsageError ({"-ignore_normals"}, "option -ignore_normals needs -surface");
+  EXPECT_EQ (parse ({"-surface_ladder", "-ignore_normals"}).kind, Kind::Run);
 
   const Options with = parse ({"-mesh_density", "0.01"}).options, without = parse ({}).options;
   const std::string refused = inputKindsUsageError (with, false, false);
