@@ -182,6 +182,25 @@ CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
 }
 
 void
+CloudModel::assessClosed (const std::string& name)
+{
+  // Asked closed, checked not closed: the query then treats the surface as open (two-sided), so
+  // an object wholly inside reads free; say so, as pcd_collision's Orienting line does (a probe
+  // of a C++ pipeline found the refusal silent, 2026-12-06).
+  if (!params_.closed_objects || surface_.empty () || surface_.orientation () != NormalOrientation::Propagate ||
+      surface_.insideKnown ())
+    return;
+  std::ostringstream out;
+  out.precision (2);
+  out << name << ": closed_objects was asked for, but its propagated orientation does not check closed (outside in front "
+      << 100.0 * surface_.closedShare () << " %, inside behind " << 100.0 * surface_.solidShare () << " %; "
+      << 100.0 * SurfaceModel::kMinClosedShare << " and " << 100.0 * SurfaceModel::kMinSolidShare
+      << " % needed): its inside is not used, and an object wholly inside it can read free (give it oriented normals, or "
+         "a viewpoint)";
+  warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+}
+
+void
 CloudModel::assessNormals (const std::string& name)
 {
   const double ratio = surface_.givenNormalSpreadRatio ();

@@ -329,6 +329,12 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
   // and a spacing), for a distance asked beyond it; the separators' weighted traversal can fit a
   // pair of disjoint boxes at any separation, so their no_leaf_tested does not say "far".
   bool surface_ran = false, surface_reached = false;
+  // Whether one of the answers pooled or standing ran in full (no cap reached) and read free:
+  // a cap on the other cannot make a free answer undecided (below, budget_exhausted).
+  bool free_in_full = false;
+  const auto freeInFull = [&request] (const CollisionResult& r, bool capped, bool reached) {
+    return !capped && reached && r.probability < request.free_below;
+  };
   if (surface && request.surface_ladder)
   {
     // The ladder (CollisionRequest::surface_ladder): the separators first; the surface layer
@@ -347,6 +353,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         return false;
       surface_ran = true;
       surface_reached = !result.no_leaf_tested;
+      free_in_full = freeInFull (separators, separators.budget_exhausted, true) ||
+                     freeInFull (result, answer.budget_exhausted, surface_reached);
       pooled = separators.probability < request.free_below;
       if (answer.budget_exhausted && !pooled && !(result.probability > request.collision_above))
       {
@@ -428,6 +436,8 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
         result = separators;
         return false;
       }
+      free_in_full = freeInFull (separators, separators.budget_exhausted, true) ||
+                     (!defer && freeInFull (result, answer.budget_exhausted, surface_reached));
       if (defer)
       {
         separatorsStand (result, std::move (separators), result.budget_exhausted);
@@ -491,6 +501,13 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
   for (const CloudModel* m : {&a, &b})
     if (!m->warning ().empty ())
       result.message += (result.message.empty () ? "" : "; ") + m->warning ();
+  // A query cut short by a cap (max_leaf_fits, max_surface_pairs) did not look everywhere: its P
+  // is a lower bound, and "free" a claim it cannot make (a gripper 2 cm into a table read free
+  // P >= 0 with max_surface_pairs 1). It reads contact, undecided; P stays the bound. Where one
+  // of two answers pooled or standing ran in full and read free (the ladder's separators, when
+  // its capped surface rung found nothing more), free stands, as that answer alone gives it.
+  if (result.budget_exhausted && result.verdict == Verdict::Free && !free_in_full)
+    result.verdict = Verdict::InContact;
   // The surface layer asked for where a model has none: the separators answered (answered_by),
   // and the message says why, as a model's warning does.
   if (request.surface && !surface)

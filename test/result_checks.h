@@ -39,7 +39,15 @@ expectSane (const pcl_probcollision::CollisionResult& r, bool ok,
   ASSERT_TRUE (std::isfinite (r.probability));
   EXPECT_GE (r.probability, 0.0);
   EXPECT_LE (r.probability, 1.0);
-  EXPECT_EQ (r.verdict, pcl_probcollision::verdictFor (r.probability, rq));
+  // A capped query (budget_exhausted) does not read free under free_below but contact, unless one
+  // of two answers pooled or laddered ran in full and read free (collide.cpp).
+  const Verdict by_probability = pcl_probcollision::verdictFor (r.probability, rq);
+  if (r.budget_exhausted && by_probability == Verdict::Free)
+    EXPECT_TRUE (r.verdict == Verdict::InContact ||
+                 ((rq.surface_pooled || rq.surface_ladder) && r.verdict == Verdict::Free))
+        << "P " << r.probability;
+  else
+    EXPECT_EQ (r.verdict, by_probability);
   EXPECT_NE (r.verdict, Verdict::Unknown);
   if (r.witness_side != 0)
   {

@@ -1194,6 +1194,55 @@ TEST (CloudModel, ANonFiniteSensorOriginIsNamedWithTheFunction)
   }
 }
 
+// A prebuilt model with a cloud set beside it of another size: compute() answered with the old
+// model (1,403 points for a cloud of 14,252) where filter() refused (a probe of a PCL pipeline,
+// 2026-12-06). compute() refuses now, naming both sizes and the way to build from the new cloud;
+// the model's own cloud is accepted, and without a cloud the model answers alone.
+TEST (ProbabilisticCollisionRebuild, APrebuiltModelNeedsTheCloudItWasBuiltFrom)
+{
+  for (const std::string which : {"input", "target"})
+  {
+    const Cloud::Ptr a = sheet (0.1, 0.005, 0.0, 1);
+    const Cloud::Ptr b = sheet (0.1, 0.005, 0.0, 2, Eigen::Vector3d (0.0, 0.0, 0.3));
+    const Cloud::Ptr other = sheet (0.2, 0.005, 0.0, 3);
+    const auto model = buildCloudModel (which == "input" ? *a : *b, CloudModelParams ());
+    ProbabilisticCollision<pcl::PointXYZ> pc;
+    (which == "input" ? static_cast<void> (pc.setTargetCloud (b)) : static_cast<void> (pc.setInputCloud (a)));
+    if (which == "input")
+      pc.setInputModel (model);
+    else
+      pc.setTargetModel (model);
+    CollisionResult r;
+    ASSERT_TRUE (pc.compute (r)) << which << ": " << r.message;  // no cloud beside it
+    if (which == "input")
+      pc.setInputCloud (a);
+    else
+      pc.setTargetCloud (b);
+    ASSERT_TRUE (pc.compute (r)) << which << ": " << r.message;  // its own cloud
+    const double answer = r.probability;
+    if (which == "input")
+      pc.setInputCloud (other);
+    else
+      pc.setTargetCloud (other);
+    EXPECT_FALSE (pc.compute (r)) << which;
+    EXPECT_EQ (r.status, CollisionResult::Status::InvalidInput);
+    EXPECT_NE (r.message.find ("model was built from a cloud of " + std::to_string (model->sourceSize ()) + " points, the " +
+                               which + " cloud has " + std::to_string (other->size ())),
+               std::string::npos)
+        << r.message;
+    EXPECT_NE (r.message.find (which == "input" ? "setInputModel (nullptr)" : "setTargetModel (nullptr)"), std::string::npos)
+        << r.message;
+    // Let go of the model: the new cloud's is built.
+    if (which == "input")
+      pc.setInputModel (nullptr);
+    else
+      pc.setTargetModel (nullptr);
+    ASSERT_TRUE (pc.compute (r)) << which << ": " << r.message;
+    EXPECT_EQ (which == "input" ? r.points_a : r.points_b, other->size ());
+    EXPECT_FALSE (std::isnan (answer));
+  }
+}
+
 // A cloud resized in place without being set again: compute() answered with the old model (its
 // per-point values index-aligned with 400 points for a cloud of 5) where filter() refused; both
 // refuse now, by one rule and with one message (a probe, 2026-12-04). A change that keeps the size

@@ -1103,6 +1103,14 @@ TEST (SurfaceModel, ClosedObjectsCheckTheirPropagatedOrientation)
   ASSERT_EQ (table->surface ().orientation (), NormalOrientation::Propagate);
   EXPECT_LT (table->surface ().closedShare (), 0.1);  // 0.04
   EXPECT_FALSE (table->surface ().insideKnown ());
+  // Refused, it says so in the model's warning (and so in every result's message), as
+  // pcd_collision's Orienting line does; checked closed or undeclared, nothing is said.
+  EXPECT_NE (table->warning ().find ("closed_objects was asked for, but its propagated orientation does not check closed"),
+             std::string::npos)
+      << table->warning ();
+  EXPECT_EQ (ball->warning ().find ("closed_objects"), std::string::npos) << ball->warning ();
+  EXPECT_EQ (box->warning ().find ("closed_objects"), std::string::npos) << box->warning ();
+  EXPECT_EQ (undeclared->warning ().find ("closed_objects"), std::string::npos) << undeclared->warning ();
   CloudModelParams propagated = closedObjects (noisy (0.0005));
   propagated.orientation = NormalOrientation::Propagate;  // PCL's default origin would be its viewpoint
   const auto plate = buildCloudModel (boxSurface (Eigen::Vector3d (1, 2, 3), Eigen::Vector3d (0.1, 0.1, 0.001), 0.004, 0.0005, 8),

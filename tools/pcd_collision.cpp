@@ -257,14 +257,18 @@ humanLine (const pcl_probcollision::CollisionResult& r, long long pose_index, bo
   // A query that stopped early (lower_bound) reports the first point that decided the collision,
   // not the deepest: say so, as "P >=" says it of P. An asked distance (-distance) is never that
   // bound, even where P is (the ladder's sure collisions: the separators stopped, the surface
-  // layer then visited every pair for the distance).
+  // layer then visited every pair for the distance). A capped one (budget_exhausted) is the
+  // leaves' it tested: a gripper 2 cm into a table read d = +0.0166 there.
   char distance[128] = "";
   if (std::isfinite (r.signed_distance))
   {
     // Under the printed precision the sign is noise: "+0.0000", never "-0.0000" (JSON keeps the value).
     const double d = std::abs (r.signed_distance) < 5e-5 ? 0.0 : r.signed_distance;
     std::snprintf (distance, sizeof (distance), "   d = %+.4f +- %.4f%s", d, r.signed_distance_std,
-                   r.lower_bound && !distance_asked ? " (first deciding point)" : r.sample_distance ? " (nearest samples)" : "");
+                   r.budget_exhausted ? " (leaves tested before the cap)"
+                   : r.lower_bound && !distance_asked ? " (first deciding point)"
+                   : r.sample_distance                ? " (nearest samples)"
+                                                      : "");
   }
   // The surface layer's answer rests on surface the samples do not show (CollisionResult::unobserved).
   const char* unobserved = r.unobserved ? "  (unobserved: across a hole or behind a sheet)" : "";

@@ -183,6 +183,9 @@ private:
   /** \brief Adds to warning() where the given normals lie off their points' planes
     * (SurfaceModel::givenNormalSpreadRatio above kMaxNormalSpreadRatio). */
   void assessNormals (const std::string& name);
+  /** \brief Adds to warning() where closed_objects was asked for and the propagated orientation
+    * did not check closed (SurfaceModel::insideKnown() false): its inside is then not used. */
+  void assessClosed (const std::string& name);
 
   /** \brief Builds the surface model from the local points alone (the constructor from an
     * UncertainCloud): normals and neighbours estimated here; there is no viewpoint and

@@ -70,7 +70,8 @@ struct CollisionRequest
   /** \brief A cap on the separators' work: at most this many leaf pairs tested per query
     * (CollisionResult::leaf_pairs_tested); 0 (default) = no cap. Leaf pairs are visited nearest
     * first (detail/bvh_traversal.h), so the pairs left over are the farther ones; a query that reaches the cap stops with P the
-    * largest so far (CollisionResult::budget_exhausted, a lower bound). It bounds the worst
+    * largest so far (CollisionResult::budget_exhausted, a lower bound; never Free, contact
+    * under free_below). It bounds the worst
     * case at high noise, where inflated boxes overlap everywhere and thousands of pairs are
     * fitted (docs/PERFORMANCE.md, issue #17). Not used by the surface layer
     * (max_surface_pairs is its cap). */
@@ -79,8 +80,8 @@ struct CollisionRequest
     * stops before its next query leaf once this many leaf pairs have been tested (each query
     * leaf's pairs on each side count; a leaf's pairs are tested together, so the count may pass
     * the cap by one leaf's); 0 (default) = no cap. A capped answer is flagged
-    * (CollisionResult::budget_exhausted): P is the largest so far, a lower bound, and the
-    * winding-number test of parts beyond reach is skipped. In the ladder the separators' answer
+    * (CollisionResult::budget_exhausted): P is the largest so far, a lower bound (the verdict
+    * never Free: contact under free_below), and the winding-number test of parts beyond reach is skipped. In the ladder the separators' answer
     * then stands where they read contact (a collision the capped rung found stands instead), and
     * the pool takes the lower bound where they read free. It bounds the surface layer's worst case, whose contact answers visit every leaf
     * pair within reach (docs/SURFACE.md, "A cap on the surface layer's work"). */

@@ -100,7 +100,9 @@ struct CollisionResult
   /** \brief True when the query stopped at CollisionRequest::max_leaf_fits with leaf pairs
     * left unfitted, or the surface layer at CollisionRequest::max_surface_pairs with leaf pairs
     * left untested: P (and lower_bound) is the largest over the pairs tested (the separators'
-    * nearest first); the pairs left could only raise it. */
+    * nearest first); the pairs left could only raise it. Such an answer never reads Free: under
+    * free_below its verdict is InContact (undecided), its P still the bound; signed_distance is
+    * then the tested leaves'. */
   bool budget_exhausted = false;
   /** \brief True when no leaf pair was tested (P = 0): every pair of boxes the traversal met was
     * disjoint, and its reach weight (METHOD.md 6.3) fell under CollisionRequest::rho_min (in

@@ -39,7 +39,9 @@ namespace pcl_probcollision
   * T)) is NOT noticed until it is set again or markForRebuild() is called: until then the old
   * model answers. One resized in place is refused: compute() and filter() fail naming both
   * sizes (their per-point results would not be index-aligned with it). Prebuilt models
-  * (setInputModel, setTargetModel) are used as they are.
+  * (setInputModel, setTargetModel) are used as they are; a cloud set beside one must have the
+  * size of the cloud it was built from (compute() fails otherwise: set the model to nullptr to
+  * build from a new cloud).
   *
   * As a filter (pcl::FilterIndices), it keeps the points of A whose collision probability
   * reaches setProbabilityThreshold() (default 0.5); setNegative() keeps the others and
@@ -48,7 +50,8 @@ namespace pcl_probcollision
   * near count as probability 0.
   *
   * \note Non-finite points are skipped (and counted in the result). The two clouds must be in
-  * the same units: covariances, thresholds of the hierarchy and noise sigmas are in those units.
+  * the same units: covariances, noise sigmas and distances are in those units (the hierarchy's
+  * thresholds, BVHParams::sigma_max and epsilon, are ratios: the same for metres and millimetres).
   * \note Not thread-safe (a PCL filter object). computeBatch() spreads many poses over
   * threads; for concurrent queries from the caller's own threads build the models once
   * (buildCloudModel, or getInputModel() after a compute) and call collide() from each thread.

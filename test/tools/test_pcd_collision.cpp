@@ -924,6 +924,21 @@ TEST_F (PcdCollisionTool, LeafFitCapAndNoiseResolution)
   EXPECT_TRUE (found[0]["budget_exhausted"].boolean);
   EXPECT_EQ (found[0]["verdict"].text, "collision");
   EXPECT_EQ (found[0]["answered_by"].text, "surface");
+  // A capped query did not look everywhere, so it never reads free (a probe, 2026-12-06): the
+  // surface layer alone, capped at one pair, read the penetrating pose "free P >= 0" and its
+  // leaves' distance +0.0166 as the first deciding point's.
+  const std::vector<std::string> alone_capped = {kGripper.string (), kScene.string (), "-pose=-0.15,0.05,-0.02,0,0,0",
+                                                 "-surface", "-max_surface_pairs", "1"};
+  const auto bound = runJson (alone_capped);
+  ASSERT_EQ (bound.size (), 1u);
+  EXPECT_TRUE (bound[0]["budget_exhausted"].boolean);
+  EXPECT_LT (bound[0]["probability"].number, 0.1) << "the bound this case is for: under free's threshold";
+  EXPECT_EQ (bound[0]["verdict"].text, "contact");
+  const ToolRun bound_line = run (alone_capped);
+  ASSERT_EQ (bound_line.status, 0) << bound_line.err;
+  EXPECT_EQ (bound_line.out.rfind ("contact   P >= ", 0), 0u) << bound_line.out;
+  EXPECT_NE (bound_line.out.find ("(leaves tested before the cap)"), std::string::npos) << bound_line.out;
+  EXPECT_EQ (bound_line.out.find ("first deciding point"), std::string::npos) << bound_line.out;
 
   const auto merged = runJson ({kGripper.string (), kScene.string (), "-pose", "0.1,0,0.25,0,0,0", "-noise_resolution", "3",
                                 "-noise_resolution_gate", "everywhere"});

@@ -433,6 +433,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   model->neighbour_spacing_ = neighbour_spacing;
   model->assessPrecision (max_abs, name);
   model->assessNormals (name);
+  model->assessClosed (name);
   model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   if (!model->warning_.empty ())
     PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", model->warning_.c_str ());

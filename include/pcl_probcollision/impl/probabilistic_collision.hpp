@@ -186,12 +186,19 @@ ProbabilisticCollision<PointT>::prepare (CollisionResult& result)
   };
   // PCLBase replaces missing indices by "all points": pass only what the user set.
   const pcl::IndicesConstPtr input_indices = this->use_indices_ ? pcl::IndicesConstPtr (this->indices_) : nullptr;
-  const bool ok = (input_prebuilt_ ||
-                   build (this->input_, input_indices, input_covariances_, input_params_, "input", input_model_,
-                          input_dirty_)) &&
-                  (target_prebuilt_ ||
-                   build (target_, target_indices_, target_covariances_, target_params_, "target", target_model_,
-                          target_dirty_));
+  // A prebuilt model needs no cloud, but one set beside it must be the cloud it was built from
+  // (filter() and the per-point values index it): a cloud of another size set after the model
+  // was answered for by the old model (a probe, 2026-12-06).
+  const auto prebuilt = [&] (const PointCloudConstPtr& cloud, const CloudModel::ConstPtr& model, const char* which) {
+    result.message = cloud && model ? staleModelError (*model, *cloud, which) : std::string ();
+    return result.message.empty ();
+  };
+  const bool ok = (input_prebuilt_ ? prebuilt (this->input_, input_model_, "input")
+                                   : build (this->input_, input_indices, input_covariances_, input_params_, "input",
+                                            input_model_, input_dirty_)) &&
+                  (target_prebuilt_ ? prebuilt (target_, target_model_, "target")
+                                    : build (target_, target_indices_, target_covariances_, target_params_, "target",
+                                             target_model_, target_dirty_));
   if (!ok)
   {
     result.status = CollisionResult::Status::InvalidInput;
@@ -210,7 +217,8 @@ ProbabilisticCollision<PointT>::staleModelError (const CloudModel& model, const 
   return std::string ("the ") + which + " model was built from a cloud of " + std::to_string (model.sourceSize ()) +
          " points, the " + which + " cloud has " + std::to_string (cloud.size ()) +
          " (a cloud changed in place needs to be set again, or markForRebuild(); a model given by set" +
-         (which == std::string ("input") ? "InputModel" : "TargetModel") + "() needs the cloud it was built from)";
+         (which == std::string ("input") ? "InputModel" : "TargetModel") + "() needs the cloud it was built from, or set" +
+         (which == std::string ("input") ? "InputModel" : "TargetModel") + " (nullptr) to build one from the cloud)";
 }
 
 template <typename PointT>
@@ -341,8 +349,8 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
     return;  // compute() printed the error; the output stays empty
 
   const std::vector<float>& p = result.probabilities_a;
-  // A model set by setInputModel() is not checked by compute() (it needs no cloud); here it must
-  // be the input cloud's.
+  // compute() checked a model set by setInputModel() against the input cloud already; a model
+  // built here is the input cloud's.
   if (const std::string stale = staleModelError (*input_model_, *this->input_, "input"); !stale.empty ())
   {
     PCL_ERROR ("[pcl_probcollision::%s::applyFilter] %s\n", this->getClassName ().c_str (), stale.c_str ());
