@@ -185,7 +185,7 @@ floatArray (const py::object& obj, const char* arg, int ndim, const char* expect
 
 template <typename T>
 void
-fillPoints (const py::array& arr, pcl::PointCloud<pcl::PointXYZ>& cloud)
+fillPoints (const py::array& arr, pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Vector3d& offset = Eigen::Vector3d::Zero ())
 {
   const auto a = arr.unchecked<T, 2> ();
   cloud.resize (static_cast<std::size_t> (a.shape (0)));
@@ -195,9 +195,9 @@ fillPoints (const py::array& arr, pcl::PointCloud<pcl::PointXYZ>& cloud)
   for (py::ssize_t i = 0; i < a.shape (0); ++i)
   {
     pcl::PointXYZ& p = cloud[static_cast<std::size_t> (i)];
-    p.x = static_cast<float> (a (i, 0));
-    p.y = static_cast<float> (a (i, 1));
-    p.z = static_cast<float> (a (i, 2));
+    p.x = static_cast<float> (static_cast<double> (a (i, 0)) - offset.x ());
+    p.y = static_cast<float> (static_cast<double> (a (i, 1)) - offset.y ());
+    p.z = static_cast<float> (static_cast<double> (a (i, 2)) - offset.z ());
     // float64 finite in double but beyond float: it would silently become Inf and be skipped.
     if (!std::is_same<T, float>::value)
       for (int d = 0; d < 3; ++d)
@@ -255,24 +255,64 @@ fillNormals (const py::array& arr, pcl::PointCloud<pcl::PointNormal>& cloud, boo
   }
 }
 
+/** Where float64 points lie so far from the origin, against their own extent, that float32 would
+  * round them (beyond 16 extents, float's step there exceeds 1e-6 of the extent): the centre of
+  * their box, which build_model subtracts in double before the points become float32
+  * (offsetModel); zero otherwise, so that a cloud near the origin gives the bits it always gave. */
+Eigen::Vector3d
+farOffset (const py::array& arr)
+{
+  const auto a = arr.unchecked<double, 2> ();
+  Eigen::Vector3d low = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ()), high = -low;
+  for (py::ssize_t i = 0; i < a.shape (0); ++i)
+  {
+    const Eigen::Vector3d p (a (i, 0), a (i, 1), a (i, 2));
+    if (!p.allFinite ())
+      continue;
+    low = low.cwiseMin (p);
+    high = high.cwiseMax (p);
+  }
+  if (!(low.array () <= high.array ()).all ())
+    return Eigen::Vector3d::Zero ();  // no finite point
+  const double extent = (high - low).maxCoeff ();
+  const double far = std::max (low.cwiseAbs ().maxCoeff (), high.cwiseAbs ().maxCoeff ());
+  return far > 16.0 * extent && far > 1.0 ? Eigen::Vector3d (0.5 * (low + high)) : Eigen::Vector3d::Zero ();
+}
+
 /** An (N, 3) float32 / float64 array as pcl::PointXYZ (fillPoints), arg naming it in errors; with
-  * image, an (H, W, 3) image of points as an organized cloud, W x H (its rows in order). */
+  * image, an (H, W, 3) image of points as an organized cloud, W x H (its rows in order). With
+  * offset, float64 points far from the origin are given about farOffset() (else offset is zero). */
 pcl::PointCloud<pcl::PointXYZ>
-cloudOf (const py::object& points, const char* arg, bool image = false)
+cloudOf (const py::object& points, const char* arg, bool image = false, Eigen::Vector3d* offset = nullptr)
 {
   const py::array given = image ? floatArray (points, arg, 3, "(H, W, 3)", 2) : floatArray (points, arg, 2, "(N, 3)");
   const py::array pts = image ? py::array (given.attr ("reshape") (py::make_tuple (-1, 3))) : given;
   pcl::PointCloud<pcl::PointXYZ> cloud;
+  if (offset)
+    offset->setZero ();
   if (py::isinstance<py::array_t<float>> (pts))
     fillPoints<float> (pts, cloud);
   else
-    fillPoints<double> (pts, cloud);
+  {
+    if (offset)
+      *offset = farOffset (pts);
+    fillPoints<double> (pts, cloud, offset ? *offset : Eigen::Vector3d::Zero ());
+  }
   if (image)
   {
     cloud.width = static_cast<std::uint32_t> (given.shape (1));
     cloud.height = static_cast<std::uint32_t> (given.shape (0));
   }
   return cloud;
+}
+
+/** model, just built from points given about offset, with its origin moved there (offsetModel). */
+std::shared_ptr<const CloudModel>
+offsetBuilt (std::shared_ptr<const CloudModel> model, const Eigen::Vector3d& offset)
+{
+  if (!offset.isZero ())
+    offsetModel (const_cast<CloudModel&> (*model), offset);
+  return model;
 }
 
 std::shared_ptr<const CloudModel>
@@ -285,7 +325,10 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
   // sensor was (organizedSensorPose), as a file's WIDTH and HEIGHT do for load_model. Its
   // covariances and normals come per pixel, (H, W, 3, 3) and (H, W, 3), or flattened.
   const bool image = py::isinstance<py::array> (points) && py::reinterpret_borrow<py::array> (points).ndim () == 3;
-  pcl::PointCloud<pcl::PointXYZ> cloud = cloudOf (points, "points", image);
+  // float64 points far from the origin are taken about an offset, in double (offsetModel): as
+  // float32 they lost what the model keeps (a cube 1 cm into a table in a UTM frame read free).
+  Eigen::Vector3d offset;
+  pcl::PointCloud<pcl::PointXYZ> cloud = cloudOf (points, "points", image, &offset);
   const auto flattened = [&] (const py::object& obj, int image_ndim) {
     if (!image || !py::isinstance<py::array> (obj) || py::reinterpret_borrow<py::array> (obj).ndim () != image_ndim)
       return obj;
@@ -326,10 +369,14 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
     for (int i = 0; i < 7; ++i)
       if (!std::isfinite (d[i]))
         throw py::value_error ("viewpoint: value " + std::to_string (i + 1) + " is not finite (tx ty tz qw qx qy qz)");
-    cloud.sensor_origin_ = Eigen::Vector4f (static_cast<float> (d[0]), static_cast<float> (d[1]), static_cast<float> (d[2]), 0.f);
+    cloud.sensor_origin_ = Eigen::Vector4f (static_cast<float> (d[0] - offset.x ()), static_cast<float> (d[1] - offset.y ()),
+                                            static_cast<float> (d[2] - offset.z ()), 0.f);
     cloud.sensor_orientation_ = Eigen::Quaternionf (static_cast<float> (d[3]), static_cast<float> (d[4]),
                                                     static_cast<float> (d[5]), static_cast<float> (d[6]));
   }
+  else if (!offset.isZero ())  // PCL's default viewpoint stays where it was: the frame's origin
+    cloud.sensor_origin_ = Eigen::Vector4f (static_cast<float> (-offset.x ()), static_cast<float> (-offset.y ()),
+                                            static_cast<float> (-offset.z ()), 0.f);
 
   if (!normals.is_none ())
   {
@@ -352,10 +399,11 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
     else
       fillNormals<double> (nrm, oriented, any_length_normals);
     py::gil_scoped_release release;
-    return buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, have_covs ? &covs : nullptr, name);
+    return offsetBuilt (buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, have_covs ? &covs : nullptr, name),
+                        offset);
   }
   py::gil_scoped_release release;
-  return buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name);
+  return offsetBuilt (buildCloudModel<pcl::PointXYZ> (cloud, params, nullptr, have_covs ? &covs : nullptr, name), offset);
 }
 
 /** FileNotFoundError for a missing path, IsADirectoryError for a directory, ValueError for
@@ -1810,7 +1858,9 @@ PYBIND11_MODULE (_core, m)
          py::arg ("name") = "cloud", py::arg ("viewpoint") = py::none (), py::arg ("normals") = py::none (),
          py::kw_only (), py::arg ("any_length_normals") = false, py::arg ("warn") = true,
          "Builds the CloudModel of a cloud given as a numpy array.\n\n"
-         "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides). Rows with a NaN or Inf\n"
+         "points: (N, 3) float32 or float64 (stored as float32, as pcl::PointXYZ; any strides; float64 points farther\n"
+         "    from the origin than 16 times their extent about their box's centre, in double, so that a map frame loses\n"
+         "    nothing: CloudModel.origin keeps it). Rows with a NaN or Inf\n"
          "    are skipped and counted (CloudModel.skipped_points); ValueError if none is finite or N == 0. An (H, W, 3)\n"
          "    image of points (a depth camera's, NaN where a pixel has none) is an organized cloud: where its\n"
          "    VIEWPOINT is not the sensor its rows and columns meet at (organized_sensor_pose), the model takes that\n"

@@ -182,6 +182,15 @@ CloudModel::assessPrecision (double max_abs_coordinate, const std::string& name)
 }
 
 void
+offsetModel (CloudModel& model, const Eigen::Vector3d& offset)
+{
+  model.origin_ += offset;
+  // The unmerged model a merged one keeps was built from the same cloud in the same build.
+  if (model.full_resolution_)
+    offsetModel (const_cast<CloudModel&> (*model.full_resolution_), offset);
+}
+
+void
 CloudModel::assessClosed (const std::string& name)
 {
   // Asked closed, checked not closed: the query then treats the surface as open (two-sided), so

@@ -665,6 +665,37 @@ TEST (NoiseResolution, DeterministicAndInvariantUnderRigidMotion)
   EXPECT_LE (differ, a->size () / 100);
 }
 
+// offsetModel: a cloud given about an offset (double coordinates a float cannot hold) answers as
+// the same cloud given whole near the origin; a merged model's unmerged one moves with it.
+TEST (NoiseResolution, AnOffsetModelMovesWithItsFullResolutionModel)
+{
+  const Cloud::Ptr a = sheet (0.08, 0.005, 0.008, 21);
+  const Cloud::Ptr b = sheet (0.08, 0.005, 0.008, 22);
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.008);
+  const CloudModel::ConstPtr whole = buildCloudModel (*a, params);
+  const CloudModel::ConstPtr mb = buildCloudModel (*b, params);
+  auto moved = std::const_pointer_cast<CloudModel> (buildCloudModel (*a, params));
+  ASSERT_GT (moved->mergedSamples (), 0u);
+  ASSERT_NE (moved->fullResolution (), nullptr);
+  const Eigen::Vector3d offset (5e5, 4.2e6, 100.0);
+  offsetModel (*moved, offset);
+  EXPECT_EQ (moved->origin (), whole->origin () + offset);
+  EXPECT_EQ (moved->fullResolution ()->origin (), whole->fullResolution ()->origin () + offset);
+  // B moved by the offset too: the same answers, the full-resolution rung's included.
+  for (const double z : {0.05, 0.0, -0.02})
+  {
+    const Eigen::Isometry3d near (Eigen::Translation3d (0.0, 0.0, z) * Eigen::AngleAxisd (0.5 * M_PI, Eigen::Vector3d::UnitX ()));
+    const Eigen::Isometry3d far = Eigen::Translation3d (offset) * near;
+    CollisionResult r_near, r_far;
+    ASSERT_TRUE (collide (*whole, *mb, near, CollisionRequest (), r_near)) << r_near.message;
+    ASSERT_TRUE (collide (*moved, *mb, far, CollisionRequest (), r_far)) << r_far.message;
+    EXPECT_EQ (r_far.verdict, r_near.verdict) << z;
+    EXPECT_NEAR (r_far.probability, r_near.probability, 1e-6) << z;
+    EXPECT_EQ (r_far.full_resolution, r_near.full_resolution) << z;
+  }
+}
+
 TEST (NoiseResolution, AContactLeaningToCollisionIsAskedAgainAtFullResolution)
 {
   // A noisy wall pushed through a noisy sheet, both 80 mm wide, sampled 5 mm apart with 8 mm

@@ -162,6 +162,7 @@ public:
   static constexpr double kStaleAxisCosine = 0.99939;  ///< cos 2 degrees
 
 private:
+  friend void offsetModel (CloudModel& model, const Eigen::Vector3d& offset);
   CloudModel () = default;
   /** \brief Centres the points on their centroid (origin()) and builds the hierarchy there, on
     * the covariances `packed` holds, or where it is empty on points.covariances. */
@@ -207,6 +208,13 @@ private:
   std::string warning_;
 };
 
+/** \brief Declares the cloud a model was built from to be given about offset: its point p stands
+  * for offset + p, in double. Moves origin() (and fullResolution()'s) by offset; nothing else
+  * changes. For coordinates a float cannot hold (a map frame far from the origin, in double):
+  * subtract a point near the cloud in double, build from the differences (and a viewpoint moved
+  * alike), then offset the model; Python's build_model does so for float64 points far from the
+  * origin. Call it on a model nothing else uses yet. */
+void offsetModel (CloudModel& model, const Eigen::Vector3d& offset);
 } // namespace pcl_probcollision
 
 #ifdef PCL_NO_PRECOMPILE

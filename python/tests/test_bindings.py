@@ -1076,9 +1076,14 @@ def test_wrong_argument_types_and_values_are_typeerror_and_valueerror():
 def test_a_model_that_lost_precision_far_from_the_origin_warns():
     # 100 km out a float keeps 7.8 mm, far above a tenth of the 1 mm noise: CloudModel.warning,
     # which Python users see as a RuntimeWarning (the library's PCL console message goes unseen).
+    # float32 points there were rounded by the caller; float64 ones lose nothing (they are taken
+    # about an offset: test_float64_points_far_from_the_origin_lose_no_precision).
     params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.001))
     points = sheet().astype(np.float64)
-    far = points + np.array([1e5, 0.0, 0.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert pc.build_model(points + np.array([1e5, 0.0, 0.0]), params=params).warning == ""
+    far = (points + np.array([1e5, 0.0, 0.0])).astype(np.float32)
     with pytest.warns(RuntimeWarning, match="float spacing") as caught:
         model = pc.build_model(far, params=params, name="far_sheet")
     assert model.warning and "far_sheet" in model.warning
@@ -1129,7 +1134,7 @@ def test_load_model_warns_of_a_double_file_rounded_far_from_the_origin(tmp_path)
     # build_model(warn=False) leaves the model's warning to the caller.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        quiet = pc.build_model(points + np.array([1e5, 0.0, 0.0]), params=params, warn=False)
+        quiet = pc.build_model((points + np.array([1e5, 0.0, 0.0])).astype(np.float32), params=params, warn=False)
     assert "float spacing" in quiet.warning
 
 
@@ -1514,6 +1519,41 @@ def test_in_frame_maps_the_witness_and_nearest_points_as_pcd_collision_reports_t
     scaled[3, 3] = 1.0
     with pytest.raises(ValueError, match="not a rotation plus translation"):
         r.in_frame(scaled)
+
+
+def test_float64_points_far_from_the_origin_lose_no_precision():
+    # float64 points in a UTM-like frame were rounded to float32 (0.25-0.5 m steps) before the
+    # model centred them: a 2 cm cube 1 cm into a table read free (a probe, 2026-12-06). They are
+    # now taken about an offset in double (offsetModel), and answer as the same scene at the origin.
+    rng = np.random.default_rng(0)
+    g = np.linspace(-0.2, 0.2, 60)
+    table = np.stack(np.meshgrid(g, g) + [np.zeros((60, 60))], -1).reshape(-1, 3) + rng.normal(0, 0.002, (3600, 3))
+    face = rng.integers(0, 6, 2000)
+    cube = rng.uniform(-0.01, 0.01, (2000, 3))
+    cube[np.arange(2000), face // 2] = np.where(face % 2, 0.01, -0.01)
+    cube[:, 2] += 0.01
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.002), surface=True)
+    far = np.array([500000.0, 4200000.0, 100.0])
+    view = (0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no precision warning: nothing was lost
+        a_far = pc.build_model(table + far, params=params, viewpoint=(far[0], far[1], far[2] + 1.0, 1.0, 0.0, 0.0, 0.0))
+        b_far = pc.build_model(cube + far, params=params)
+    a = pc.build_model(table, params=params, viewpoint=view)
+    b = pc.build_model(cube, params=params)
+    np.testing.assert_allclose(a_far.origin - far, a.origin, atol=1e-6)
+    for request in (pc.CollisionRequest(), pc.CollisionRequest(surface=True, distance=True)):
+        for x, z in ((0.0, -0.01), (0.05, -0.01), (0.0, 0.03), (0.0, 0.3), (0.3, 0.0)):
+            near, mapped = (pc.collide(m_a, m_b, translation(x=x, z=z), request) for m_a, m_b in ((a, b), (a_far, b_far)))
+            assert mapped.verdict == near.verdict, (x, z, request.surface)
+            assert mapped.probability == pytest.approx(near.probability, abs=0.02), (x, z)
+            if request.surface:
+                assert mapped.signed_distance == pytest.approx(near.signed_distance, abs=2e-4), (x, z)
+        deep = pc.collide(a_far, b_far, translation(z=-0.01), request)  # the cube 1 cm into the table
+        assert deep.verdict == pc.Verdict.InCollision
+    # float32 points there are still what the caller rounded, and still warned of.
+    with pytest.warns(RuntimeWarning, match="lost precision"):
+        pc.build_model((table + far).astype(np.float32), params=params)
 
 
 def test_a_viewpoint_that_is_not_finite_is_refused():
