@@ -212,6 +212,14 @@ CloudModel::assessClosed (const std::string& name)
 void
 CloudModel::assessNormals (const std::string& name)
 {
+  if (surface_.givenNormalsFaceAwayFromViewpoint () && surface_.orientation () == NormalOrientation::PointNormals)
+  {
+    const std::string away =
+        name + ": its normals face away from its viewpoint, which a sensor cannot see (it sees a surface's front): they "
+               "look turned the wrong way and are taken as given, so what lies in front of the surface reads inside it "
+               "(negate them, or leave them out to orient the surface from the viewpoint)";
+    warning_ = warning_.empty () ? away : warning_ + "; " + away;
+  }
   const double ratio = surface_.givenNormalSpreadRatio ();
   if (!(ratio > SurfaceModel::kMaxNormalSpreadRatio))
     return;

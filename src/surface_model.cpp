@@ -1012,6 +1012,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // closed object face a viewpoint outside it on one side and away on the other. Read by Auto
   // (normals_turned_to_view_) and, for a viewpoint outside, by seen_from_view_.
   bool given_face_view = false, most_face_view = false;
+  given_face_away_ = false;
   if (any_given && in.viewpoint && in.viewpoint->allFinite () &&
       (mode == NormalOrientation::Auto || (mode == NormalOrientation::PointNormals && view_outside)))
   {
@@ -1032,6 +1033,12 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // Setting normals aside asks more: most of them facing it, not a few seen edge-on (a sheet
     // with PCL's default origin in its own plane).
     most_face_view = given_face_view && 2 * (toward + away) >= given;
+    // The mirror image from outside: a sensor sees a surface's front, so normals facing away from
+    // it nearly all were turned the wrong way (a probe: a table's normals given pointing down,
+    // its sensor above, read a plate 12 mm over it as collision). Said (CloudModel::warning), not
+    // changed: from inside an object (PCL's default origin in a mug) outward normals face away.
+    given_face_away_ = view_outside && facing >= kMinViewSeeds * static_cast<double> (n) &&
+                       static_cast<double> (toward) <= kMaxViewDisagreement * facing && 2 * away >= given;
     if (given_face_view && (view_outside || (mode == NormalOrientation::Auto && most_face_view)))
       hidden_from_view_ = hiddenShare ();
   }

@@ -194,6 +194,10 @@ public:
     * convex object nothing is hidden: its normals, turned inward, are kept (a room scanned from
     * within looks the same). */
   bool normalsTurnedToViewpoint () const { return normals_turned_to_view_; }
+  /** \brief Whether nearly all the caller's normals face away from a viewpoint outside the
+    * cloud (the mirror of a scan's, whose normals face its sensor): most likely turned the wrong
+    * way. They are still taken as given; CloudModel::warning() says so. */
+  bool givenNormalsFaceAwayFromViewpoint () const { return given_face_away_; }
   /** \brief Above this givenNormalSpreadRatio(), orientation Auto sets the given normals aside
     * (normalsOffSurface()). Normals that belong read under 1 however noisy the points (the
     * spread along them is the noise's, across them the noise's and the surface's): 0.001-0.03 on
@@ -356,6 +360,7 @@ private:
   /** \brief Where seen_from_view_: its viewpoint's bins (behindView). */
   ViewBins view_bins_;
   bool normals_turned_to_view_ = false;
+  bool given_face_away_ = false;
   double normal_spread_ratio_ = std::numeric_limits<double>::quiet_NaN ();
   bool normals_off_surface_ = false;
   double closed_share_ = std::numeric_limits<double>::quiet_NaN ();

@@ -1556,6 +1556,29 @@ def test_float64_points_far_from_the_origin_lose_no_precision():
         pc.build_model((table + far).astype(np.float32), params=params)
 
 
+def test_normals_facing_away_from_a_viewpoint_outside_are_warned_of():
+    # A sensor sees a surface's front: a table's normals given pointing down, its sensor above,
+    # read a plate 12 mm over it as collision without a word (a probe, 2026-12-06). They are still
+    # taken as given, and the model says so; the right way up, seen edge-on from a viewpoint in the
+    # table's plane, or a sphere's outward normals (half face any viewpoint outside it), say nothing.
+    rng = np.random.default_rng(0)
+    g = np.linspace(-0.2, 0.2, 60)
+    table = np.stack(np.meshgrid(g, g) + [np.zeros((60, 60))], -1).reshape(-1, 3) + rng.normal(0, 0.002, (3600, 3))
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(0.002), surface=True)
+    above = (0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+    down, up = (np.tile([0.0, 0.0, z], (len(table), 1)) for z in (-1.0, 1.0))
+    with pytest.warns(RuntimeWarning, match="its normals face away from its viewpoint"):
+        flipped = pc.build_model(table, params=params, normals=down, viewpoint=above)
+    assert flipped.surface_orientation == pc.NormalOrientation.PointNormals  # taken as given
+    ball = rng.normal(size=(2000, 3))
+    ball /= np.linalg.norm(ball, axis=1, keepdims=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for points, normals, view in ((table, up, above), (table, down, (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)),
+                                      (0.1 * ball, ball, (0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0))):
+            assert "face away" not in pc.build_model(points, params=params, normals=normals, viewpoint=view).warning
+
+
 def test_a_viewpoint_that_is_not_finite_is_refused():
     # build_model(viewpoint=[inf, ...]) went on to a misleading message (a probe, 2026-12-03).
     with pytest.raises(ValueError, match="viewpoint: value 1 is not finite"):
