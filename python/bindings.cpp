@@ -1867,6 +1867,7 @@ PYBIND11_MODULE (_core, m)
          "    sensor's pose, with a RuntimeWarning. Its covariances and normals are then (H, W, 3, 3) and (H, W, 3),\n"
          "    or flattened in row order.\n"
          "covariances: optional (N, 3, 3) float32/float64, symmetric; estimated from the k nearest neighbours when None.\n"
+         "    Given, they are the whole spread: params.noise is not added. A row with a NaN drops its point.\n"
          "params: CloudModelParams (None = CloudModelParams()).\n"
          "name: what error messages call the cloud.\n"
          "viewpoint: optional sensor pose tx ty tz qw qx qy qz (a PCD's VIEWPOINT; None = the origin, looking along +z).\n"

@@ -416,6 +416,38 @@ TEST (ProbabilisticCollision, FilterKeepsThePointsNearTheTarget)
   EXPECT_EQ (organized.width, a->width);
 }
 
+// A NaN point is kept by neither side of the filter, as PCL's own filters do: setNegative
+// returned every NaN pixel of a stereo scan (a probe of a PCL pipeline, 2026-12-06). Removed
+// indices list them.
+TEST (ProbabilisticCollision, FilterNeverKeepsANaNPoint)
+{
+  const auto a = organizedPatch (0.2, 0.01, 0.0, 0.0, 15);
+  const auto b = organizedPatch (0.04, 0.01, 0.0005, 0.0, 16);
+  const std::vector<int> holes = {0, 7, 200, static_cast<int> (a->size ()) - 1};
+  for (const int i : holes)
+    (*a)[static_cast<std::size_t> (i)].z = std::numeric_limits<float>::quiet_NaN ();
+  a->is_dense = false;
+  ProbabilisticCollision<pcl::PointXYZ> pc (true);  // extract_removed_indices
+  pc.setInputCloud (a);
+  pc.setTargetCloud (b);
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setProbabilityThreshold (0.3);
+  for (const bool negative : {false, true})
+  {
+    pc.setNegative (negative);
+    pcl::Indices kept;
+    pc.filter (kept);
+    ASSERT_FALSE (kept.empty ()) << negative;
+    for (const int i : kept)
+      EXPECT_TRUE (pcl::isXYZFinite ((*a)[static_cast<std::size_t> (i)])) << negative << " kept " << i;
+    const pcl::IndicesConstPtr removed = pc.getRemovedIndices ();
+    for (const int i : holes)
+      EXPECT_NE (std::find (removed->begin (), removed->end (), i), removed->end ()) << negative << " " << i;
+    EXPECT_EQ (kept.size () + removed->size (), a->size ()) << negative;
+  }
+}
+
 TEST (ProbabilisticCollision, NaNPointsAreSkippedAndCountedLikeRemovingThem)
 {
   auto a = organizedPatch (0.1, 0.01, 0.0, 0.0, 17);

@@ -31,7 +31,8 @@ class CloudModel;
   * \param[in] params per-cloud settings (validated)
   * \param[in] indices the points to use (all when null)
   * \param[in] covariances covariances index-aligned with the whole cloud (estimated when null);
-  *            a non-finite one drops its point
+  *            a non-finite one drops its point. Given, they are the whole spread: params.noise
+  *            and the discretisation term are not added
   * \param[in] name what error messages call the cloud ("input", "target", a file name)
   * \return the model
   * \throws pcl::BadArgumentException, its description starting with name (what() puts

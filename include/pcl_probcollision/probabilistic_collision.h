@@ -72,8 +72,10 @@ public:
   using CovarianceCloudConstPtr = pcl::PointCloud<Covariance>::ConstPtr;
 
   /** \brief No clouds yet; both models' parameters and the request are their defaults
-    * (CloudModelParams, CollisionRequest). Each getter below returns what its setter set. */
-  ProbabilisticCollision ();
+    * (CloudModelParams, CollisionRequest). Each getter below returns what its setter set.
+    * extract_removed_indices: filter() lists the points it did not keep (getRemovedIndices()),
+    * as PCL's filters take it. */
+  explicit ProbabilisticCollision (bool extract_removed_indices = false);
 
   /** \brief Object A; marks its model for rebuild (even for the same pointer). */
   void setInputCloud (const PointCloudConstPtr& cloud) override;

@@ -7,6 +7,7 @@
 #include <pcl_probcollision/probabilistic_collision.h>
 #include <pcl_probcollision/detail/input_checks.h>
 
+#include <pcl/common/point_tests.h>
 #include <pcl/exceptions.h>
 // The base class's one out-of-line member (FilterIndices::applyFilter(PointCloud &)) is
 // instantiated with ours, so no binary needs libpcl_filters and libpcl_sample_consensus at run
@@ -23,8 +24,8 @@
 namespace pcl_probcollision
 {
 template <typename PointT>
-ProbabilisticCollision<PointT>::ProbabilisticCollision ()
-  : classifier_ (request_.classifier)
+ProbabilisticCollision<PointT>::ProbabilisticCollision (bool extract_removed_indices)
+  : pcl::FilterIndices<PointT> (extract_removed_indices), classifier_ (request_.classifier)
 {
   this->filter_name_ = "ProbabilisticCollision";
 }
@@ -358,8 +359,17 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
   }
   const pcl::Indices& candidates = *this->indices_;
   indices.reserve (candidates.size ());
+  const PointCloud& cloud = *this->input_;
   for (const int i : candidates)
   {
+    // A non-finite point is never kept, negative or not, as PCL's own filters do (setNegative
+    // returned the 97,920 NaN pixels of a stereo scan: a probe, 2026-12-06).
+    if (!pcl::isXYZFinite (cloud[static_cast<std::size_t> (i)]))
+    {
+      if (this->extract_removed_indices_)
+        this->removed_indices_->push_back (i);
+      continue;
+    }
     // Never reached by the traversal (NaN) means far from B: probability 0.
     const bool hit = !std::isnan (p[i]) && p[i] >= probability_threshold_;
     if (hit != this->negative_)
