@@ -149,9 +149,15 @@ CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size,
     out << name << ": noise_resolution " << params.noiseResolution () << " merged its " << mapped << " samples into "
         << bvh_.size () << " point" << (bvh_.size () == 1 ? "" : "s") << ", no more than the covariance estimation's k = "
         << params.k << ": the model no longer resolves the object's shape (lower noise_resolution; 2 is the evaluated choice)";
-    warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+    addWarning (out.str ());
     PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", out.str ().c_str ());
   }
+}
+
+void
+CloudModel::addWarning (const std::string& text)
+{
+  warning_ = warning_.empty () ? text : warning_ + "; " + text;
 }
 
 void
@@ -206,7 +212,7 @@ CloudModel::assessClosed (const std::string& name)
       << 100.0 * SurfaceModel::kMinClosedShare << " and " << 100.0 * SurfaceModel::kMinSolidShare
       << " % needed): its inside is not used, and an object wholly inside it can read free (give it oriented normals, or "
          "a viewpoint)";
-  warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+  addWarning (out.str ());
 }
 
 void
@@ -218,7 +224,7 @@ CloudModel::assessNormals (const std::string& name)
         name + ": its normals face away from its viewpoint, which a sensor cannot see (it sees a surface's front): they "
                "look turned the wrong way and are taken as given, so what lies in front of the surface reads inside it "
                "(negate them, or leave them out to orient the surface from the viewpoint)";
-    warning_ = warning_.empty () ? away : warning_ + "; " + away;
+    addWarning (away);
   }
   const double ratio = surface_.givenNormalSpreadRatio ();
   if (!(ratio > SurfaceModel::kMaxNormalSpreadRatio))
@@ -235,7 +241,7 @@ CloudModel::assessNormals (const std::string& name)
   if (surface_.normalsOffSurface () && surface_.orientation () == NormalOrientation::Viewpoint)
     out << "; its VIEWPOINT orients the surface instead, and pcl::transformPointCloud leaves that behind as well: if the "
            "sensor did not move with the points, set sensor_origin_ where it was or orient by propagation";
-  warning_ = warning_.empty () ? out.str () : warning_ + "; " + out.str ();
+  addWarning (out.str ());
 }
 } // namespace pcl_probcollision
 

@@ -180,6 +180,8 @@ private:
     * Sets warning() where the merge left no more points than the covariance estimation's k. */
   void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
                    const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name);
+  /** \brief Appends text to warning(), after "; " where it says something already. */
+  void addWarning (const std::string& text);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
   void assessPrecision (double max_abs_coordinate, const std::string& name);
   /** \brief Adds to warning() where the given normals lie off their points' planes

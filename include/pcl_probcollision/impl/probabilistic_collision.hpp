@@ -215,11 +215,11 @@ ProbabilisticCollision<PointT>::staleModelError (const CloudModel& model, const 
 {
   if (model.sourceSize () == cloud.size ())
     return std::string ();
+  const std::string setter = which == std::string ("input") ? "setInputModel" : "setTargetModel";
   return std::string ("the ") + which + " model was built from a cloud of " + std::to_string (model.sourceSize ()) +
          " points, the " + which + " cloud has " + std::to_string (cloud.size ()) +
-         " (a cloud changed in place needs to be set again, or markForRebuild(); a model given by set" +
-         (which == std::string ("input") ? "InputModel" : "TargetModel") + "() needs the cloud it was built from, or set" +
-         (which == std::string ("input") ? "InputModel" : "TargetModel") + " (nullptr) to build one from the cloud)";
+         " (a cloud changed in place needs to be set again, or markForRebuild(); a model given by " + setter +
+         "() needs the cloud it was built from, or " + setter + " (nullptr) to build one from the cloud)";
 }
 
 template <typename PointT>
