@@ -1836,6 +1836,16 @@ PYBIND11_MODULE (_core, m)
                               "Whether orientation Auto set the given normals aside: surface_given_normal_spread_ratio above\n"
                               "1.2, most of them lie along the surface, so they were not moved with their points; each point\n"
                               "took its neighbours' plane instead (SurfaceModel::normalsOffSurface). None without a surface.")
+      .def_property_readonly ("surface_given_normal_side_disagreement", surfaceNumber (&SurfaceModel::givenNormalSideDisagreement),
+                              "Where given normals disagreed with a viewpoint that sees the cloud as one scan, the share of them\n"
+                              "whose side disagrees with their part's majority once one side is carried between neighbours:\n"
+                              "about 0 for an orientation, 0.5 for random signs (SurfaceModel::givenNormalSideDisagreement);\n"
+                              "NaN otherwise.")
+      .def_property_readonly ("surface_given_normals_misoriented", surfaceFlag (&SurfaceModel::givenNormalsMisoriented),
+                              "Whether more than a tenth of the given normals face away from a viewpoint outside the cloud\n"
+                              "that sees it as one scan: their sides were not turned toward the sensor (as Open3D's\n"
+                              "estimate_normals leaves them). Orientation Auto then keeps their directions and turns them\n"
+                              "toward the viewpoint (SurfaceModel::givenNormalsMisoriented). None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +

@@ -218,13 +218,27 @@ CloudModel::assessClosed (const std::string& name)
 void
 CloudModel::assessNormals (const std::string& name)
 {
-  if (surface_.givenNormalsFaceAwayFromViewpoint () && surface_.orientation () == NormalOrientation::PointNormals)
+  if (surface_.givenNormalsFaceAwayFromViewpoint () && surface_.orientation () == NormalOrientation::PointNormals &&
+      !surface_.givenNormalsMisoriented ())
   {
     const std::string away =
         name + ": its normals face away from its viewpoint, which a sensor cannot see (it sees a surface's front): they "
                "look turned the wrong way and are taken as given, so what lies in front of the surface reads inside it "
                "(negate them, or leave them out to orient the surface from the viewpoint)";
     addWarning (away);
+  }
+  if (surface_.givenNormalsMisoriented ())
+  {
+    std::ostringstream out;
+    out.precision (2);
+    out << name << ": " << 100.0 * surface_.givenNormalsAwayShare ()
+        << " % of its normals face away from its viewpoint, which sees it as one scan (a sensor sees only fronts): "
+           "their sides were not turned toward the sensor (Open3D's estimate_normals leaves them so), and they are "
+        << (surface_.orientation () == NormalOrientation::PointNormals
+                ? "taken as given, as orientation point_normals asks, so parts of the surface face inward (turn them "
+                  "toward the sensor first, or leave orientation auto)"
+                : "taken as directions, turned toward the viewpoint");
+    addWarning (out.str ());
   }
   const double ratio = surface_.givenNormalSpreadRatio ();
   if (!(ratio > SurfaceModel::kMaxNormalSpreadRatio))

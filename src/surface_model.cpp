@@ -57,6 +57,10 @@ constexpr double kMaxViewDisagreement = 0.1;
   * mug (stereo_mug_object0_full.pcd) disagreed on 8.7 % of its points, with 0.9 on 0.3 %; an
   * edge-on sheet's patches are tilted by its noise, well within it (27-50 % either way). */
 constexpr float kCarryCosine = 0.9f;
+/** \brief viewDisagreement with points: opposed neighbours offset along the normal by more
+  * than this share of their distance (30 degrees off the tangent plane) lie across the surface,
+  * not beside each other on it. */
+constexpr double kAcrossShare = 0.5;
 /** \brief Viewpoint orientation: below this share of the points facing the viewpoint (|cos| at
   * least kMinViewCosine), it sees the surface edge-on too: a sheet in the viewpoint's plane
   * with 0.5 mm noise at 5 mm spacing has 1 of 1,600, tilted toward it or away at random; at 8
@@ -192,9 +196,14 @@ private:
   * share their neighbours), so neighbour pairs rarely disagree but the patches do. Breadth
   * first, over edges whose normals are within kCarryCosine (not Propagation's most-parallel-first
   * queue: on a 209,280-point stereo scan that added 12 % to the surface model's build, this 1-4 %,
-  * measured with a 60-degree limit). */
+  * measured with a 60-degree limit).
+  * With points (the given normals' sides, SurfaceModel::givenNormalsMisoriented), opposed
+  * neighbours that lie across each other's normal rather than beside it (offset more than
+  * kAcrossShare of their distance along it) are not carried: a thin plate's two faces, or two
+  * parts facing each other over a gap, are oriented apart and agree. */
 double
-viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normals, const std::vector<int>& component)
+viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normals, const std::vector<int>& component,
+                  const std::vector<Eigen::Vector3d>* points = nullptr)
 {
   const std::size_t n = normals.size ();
   std::vector<int> part (n, -1);
@@ -222,6 +231,12 @@ viewDisagreement (const Graph& graph, const std::vector<Eigen::Vector3f>& normal
         const float cosine = normals[i].dot (normals[t]);
         if (part[t] >= 0 || std::abs (cosine) < kCarryCosine)
           continue;
+        if (points && cosine < 0.0f)
+        {
+          const Eigen::Vector3d offset = (*points)[t] - (*points)[i];
+          if (std::abs (offset.dot (normals[i].cast<double> ())) > kAcrossShare * offset.norm ())
+            continue;
+        }
         part[t] = id;
         side[t] = static_cast<signed char> (cosine < 0.0f ? -side[i] : side[i]);
         queue.push_back (static_cast<int> (t));
@@ -946,6 +961,8 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   else
     spacingStatistics ();
 
+  const Graph graph = symmetricGraph (in.neighbours, in.k, n);
+
   // Resolve Auto: the caller's normals, else a viewpoint outside the cloud that sees it as one
   // scan does (binView's hidden share), else propagation.
   bool any_given = false;
@@ -1013,6 +1030,8 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // (normals_turned_to_view_) and, for a viewpoint outside, by seen_from_view_.
   bool given_face_view = false, most_face_view = false;
   given_face_away_ = false;
+  given_misoriented_ = false;
+  given_away_share_ = given_side_disagreement_ = std::numeric_limits<double>::quiet_NaN ();
   if (any_given && in.viewpoint && in.viewpoint->allFinite () &&
       (mode == NormalOrientation::Auto || (mode == NormalOrientation::PointNormals && view_outside)))
   {
@@ -1039,8 +1058,30 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // changed: from inside an object (PCL's default origin in a mug) outward normals face away.
     given_face_away_ = view_outside && facing >= kMinViewSeeds * static_cast<double> (n) &&
                        static_cast<double> (toward) <= kMaxViewDisagreement * facing && 2 * away >= given;
-    if (given_face_view && (view_outside || (mode == NormalOrientation::Auto && most_face_view)))
+    // Normals and a viewpoint outside the cloud that disagree: more than a tenth of those facing
+    // it or away face away. Either may be wrong: a scan's normals estimated without an
+    // orientation (Open3D's estimate_normals leaves each sign to its eigen solver: on the scenes'
+    // objects 8-81 % face away), or a VIEWPOINT left behind by pcl::transformPointCloud (a
+    // table's normals up, its stale origin on the floor below). Their sides between neighbours
+    // tell: an orientation's agree, unoriented ones disagree (the scenes' mug, 17 %). Where they
+    // disagree and the viewpoint sees the cloud as one scan, Auto turns their directions toward
+    // it. (That check alone cannot judge a cloud without a usable viewpoint: a thin part's two
+    // faces, blurred into one sheet by the noise, alternate just as much; W1's room and piano,
+    // with their meshes' normals, disagreed on 23-49 % of their points.)
+    given_away_share_ = facing > 0.0 ? static_cast<double> (away) / facing : std::numeric_limits<double>::quiet_NaN ();
+    const bool against_view = view_outside && view_far && facing >= kMinViewSeeds * static_cast<double> (n) &&
+                              static_cast<double> (away) > kMaxViewDisagreement * facing;
+    if ((given_face_view && (view_outside || (mode == NormalOrientation::Auto && most_face_view))) || against_view)
       hidden_from_view_ = hiddenShare ();
+    if (against_view && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare)
+    {
+      std::vector<int> seeds (n, -1);
+      for (std::size_t i = 0; i < n; ++i)
+        if (in.given[i] && !normals_[i].isZero ())
+          seeds[i] = 0;
+      given_side_disagreement_ = viewDisagreement (graph, normals_, seeds, &points);
+    }
+    given_misoriented_ = given_side_disagreement_ > kMaxViewDisagreement;
   }
   // Such normals on a cloud that viewpoint cannot see as one scan (a sphere sampled all round,
   // its normals turned toward PCL's default origin beside it: two thirds point in; a mug's,
@@ -1050,14 +1091,13 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   normals_turned_to_view_ = mode == NormalOrientation::Auto && most_face_view &&
                             hidden_from_view_ > SurfaceModel::kMaxHiddenShare;
   if (mode == NormalOrientation::Auto)
-    mode = any_given && !normals_turned_to_view_ ? NormalOrientation::PointNormals
+    mode = any_given && !normals_turned_to_view_ && !given_misoriented_ ? NormalOrientation::PointNormals
            : view_outside && view_far && hidden_from_view_ <= SurfaceModel::kMaxHiddenShare ? NormalOrientation::Viewpoint
                                                                               : NormalOrientation::Propagate;
   if (mode == NormalOrientation::Viewpoint && !(in.viewpoint && in.viewpoint->allFinite ()))
     mode = NormalOrientation::Propagate;
   orientation_ = mode;
 
-  const Graph graph = symmetricGraph (in.neighbours, in.k, n);
   std::vector<int> component (n, -1);
   Propagation propagation (graph, normals_, component);
   std::size_t seeded = 0;

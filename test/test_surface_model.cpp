@@ -785,6 +785,62 @@ TEST (SurfaceLayer, BehindAScanSavedWithItsNormalsIsUnobserved)
   EXPECT_FALSE (behind_turned.unobserved);
 }
 
+// Normals estimated without an orientation (Open3D's estimate_normals leaves each sign to its eigen
+// solver; a probe of 2026-12-06 fed them to the surface model as outward) face a viewpoint that sees
+// the cloud as one scan and away about as often, and disagree between neighbours: Auto keeps their
+// directions and turns them toward the viewpoint, as for a scan without normals. Normals that agree
+// between neighbours but face away from the viewpoint are an orientation under a stale VIEWPOINT
+// (pcl::transformPointCloud leaves it behind): kept, with a warning.
+TEST (SurfaceLayer, AScansNormalsWithUnorientedSidesAreTurnedTowardItsViewpoint)
+{
+  const Eigen::Vector3f up (0, 0, 1);
+  std::mt19937 draw (3);
+  auto withNormals = [] (const pcl::PointCloud<pcl::PointXYZ>& in, auto&& normal) {
+    pcl::PointCloud<pcl::PointNormal> out;
+    for (const auto& p : in)
+      out.push_back (pointNormal (p.x, p.y, p.z, normal ()));
+    out.sensor_origin_ = in.sensor_origin_;
+    return out;
+  };
+  const auto random_sides = withNormals (sheet (0.4, 0.01, 0.0, up), [&] { return draw () % 2 ? up : Eigen::Vector3f (-up); });
+  const auto unoriented = buildCloudModel (random_sides, noisy (0.001));
+  EXPECT_TRUE (unoriented->surface ().givenNormalsMisoriented ());
+  EXPECT_GT (unoriented->surface ().givenNormalSideDisagreement (), 0.3);
+  EXPECT_EQ (unoriented->surface ().orientation (), NormalOrientation::Viewpoint);
+  EXPECT_NE (unoriented->warning ().find ("taken as directions, turned toward the viewpoint"), std::string::npos)
+      << unoriented->warning ();
+  CloudModelParams as_given = noisy (0.001);
+  as_given.orientation = NormalOrientation::PointNormals;
+  const auto taken = buildCloudModel (random_sides, as_given);
+  EXPECT_EQ (taken->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_NE (taken->warning ().find ("taken as given, as orientation point_normals asks"), std::string::npos)
+      << taken->warning ();
+
+  // Agreeing normals under a viewpoint below them: kept as given, and warned of.
+  const auto stale = buildCloudModel (withNormals (sheet (0.4, 0.01, 0.0, -up), [&] { return up; }), noisy (0.001));
+  EXPECT_FALSE (stale->surface ().givenNormalsMisoriented ());
+  EXPECT_LT (stale->surface ().givenNormalSideDisagreement (), 0.01);
+  EXPECT_EQ (stale->surface ().orientation (), NormalOrientation::PointNormals);
+  EXPECT_NE (stale->warning ().find ("face away from its viewpoint"), std::string::npos) << stale->warning ();
+
+  // The unoriented scan answers as the same scan without normals: a plate 1 cm under it is in
+  // the unobserved space behind it, one 1 cm over it is clear. (Taken as given, the plate under it
+  // read free, P = 0.0017.)
+  CloudModelParams two_sided = noisy (0.001);
+  two_sided.orientation = NormalOrientation::Propagate;
+  const auto plate = buildCloudModel (sheet (0.1, 0.01, 0.0, up), two_sided);
+  const auto bare = buildCloudModel (sheet (0.4, 0.01, 0.0, up), noisy (0.001));
+  for (const double z : {-0.01, 0.01})
+  {
+    CollisionResult with_normals, without;
+    ASSERT_TRUE (collide (*unoriented, *plate, shift (0, 0, z), surfaceRequest (), with_normals));
+    ASSERT_TRUE (collide (*bare, *plate, shift (0, 0, z), surfaceRequest (), without));
+    EXPECT_EQ (with_normals.verdict, without.verdict) << z;
+    EXPECT_EQ (with_normals.verdict, z < 0.0 ? Verdict::InCollision : Verdict::Free) << z;
+    EXPECT_EQ (with_normals.unobserved, z < 0.0) << z;
+  }
+}
+
 // Sparse table (spacing 10 sigma): a point between four samples, 3 sigma under the surface, is
 // inside; the surface is continuous between samples.
 TEST (SurfaceLayer, SparseSurfaceIsContinuousBetweenSamples)

@@ -378,6 +378,10 @@ reportOrientation (const Input& in, const pcl_probcollision::CloudModel& model, 
   if (model.surface ().normalsOffSurface ())
     why = "; not the file's normals: they lie along its surface, not across it, so they were not moved with its points "
           "(-orientation point_normals to take them)";
+  else if (model.surface ().givenNormalsMisoriented () && orientation == pcl_probcollision::NormalOrientation::Viewpoint)
+    why = "; the file's normals' directions only: " + percent (model.surface ().givenNormalsAwayShare ()) +
+          " % of them face away from its VIEWPOINT, which sees the cloud as one scan, so their sides were not turned "
+          "toward the sensor (-orientation point_normals to take them)";
   else if (model.surface ().normalsTurnedToViewpoint ())
     why = "; not the file's normals: they all face its VIEWPOINT, as PCL's normal estimation turns them, and " +
           percent (hidden) + " % of the points lie behind others from there (one scan hides none), so they are not outward "

@@ -26,7 +26,10 @@ enum class NormalOrientation
   /** \brief Default: the point type's normals when it has finite ones (meshes: the faces'),
     * unless they all face the viewpoint while it does not see the cloud as one scan (PCL's normal
     * estimation turned them toward it: SurfaceModel::normalsTurnedToViewpoint) or lie along the
-    * surface (not moved with their points: SurfaceModel::normalsOffSurface), else the
+    * surface (not moved with their points: SurfaceModel::normalsOffSurface) or face away from a
+    * viewpoint that sees the cloud as one scan with sides that disagree between neighbours (never
+    * oriented: SurfaceModel::givenNormalsMisoriented, whose directions are then turned toward
+    * it), else the
     * viewpoint when the cloud's sensor_origin_ lies outside its bounding box, more than 10
     * median spacings from its nearest sample (SurfaceModel::kMinViewSpacings), and sees it as
     * one scan does (at most 10 % of the points hidden behind others from there:

@@ -198,6 +198,28 @@ public:
     * cloud (the mirror of a scan's, whose normals face its sensor): most likely turned the wrong
     * way. They are still taken as given; CloudModel::warning() says so. */
   bool givenNormalsFaceAwayFromViewpoint () const { return given_face_away_; }
+  /** \brief Whether the caller's normals were not oriented: more than a tenth of those facing a
+    * viewpoint outside the cloud (or away from it) face away, the viewpoint sees the cloud as one
+    * scan (at most kMaxHiddenShare hidden), and their sides disagree between neighbours
+    * (givenNormalSideDisagreement() above a tenth), as those of normals estimated without an
+    * orientation do (Open3D's estimate_normals leaves each sign to its eigen solver). Auto then
+    * keeps their directions and turns them toward the viewpoint (orientation() Viewpoint);
+    * PointNormals takes them; CloudModel::warning() says so either way. Normals that agree
+    * between neighbours are an orientation, and a viewpoint they face away from may be stale
+    * (pcl::transformPointCloud leaves it behind): they are kept, with a warning
+    * (givenNormalsFaceAwayFromViewpoint). Without a usable viewpoint, sides are not checked: a
+    * thin part's two faces, blurred into one sheet by the noise, alternate between neighbours as
+    * unoriented normals do. */
+  bool givenNormalsMisoriented () const { return given_misoriented_; }
+  /** \brief Where given normals were weighed against a viewpoint, the share of those facing it
+    * or away that face away; NaN otherwise. */
+  double givenNormalsAwayShare () const { return given_away_share_; }
+  /** \brief Where given normals disagreed with a viewpoint that sees the cloud as one scan: the
+    * share of them whose side disagrees with their part's majority once one side is carried
+    * between neighbours within 26 degrees of each other (opposed neighbours lying across each
+    * other's normal, a thin plate's two faces, are not carried). About 0 for an orientation, a
+    * half for random signs. NaN where not checked. */
+  double givenNormalSideDisagreement () const { return given_side_disagreement_; }
   /** \brief Above this givenNormalSpreadRatio(), orientation Auto sets the given normals aside
     * (normalsOffSurface()). Normals that belong read under 1 however noisy the points (the
     * spread along them is the noise's, across them the noise's and the surface's): 0.001-0.03 on
@@ -361,6 +383,9 @@ private:
   ViewBins view_bins_;
   bool normals_turned_to_view_ = false;
   bool given_face_away_ = false;
+  bool given_misoriented_ = false;
+  double given_away_share_ = std::numeric_limits<double>::quiet_NaN ();
+  double given_side_disagreement_ = std::numeric_limits<double>::quiet_NaN ();
   double normal_spread_ratio_ = std::numeric_limits<double>::quiet_NaN ();
   bool normals_off_surface_ = false;
   double closed_share_ = std::numeric_limits<double>::quiet_NaN ();
