@@ -591,6 +591,63 @@ TEST (NoiseResolution, AMergedPointIsItsMembersCentroid)
   }
 }
 
+/** The surface of an axis-aligned box [-sx/2, sx/2] x [-sy/2, sy/2] x [z0, z0 + sz], every face
+  * sampled on a grid of spacing h, with Gaussian noise sigma on every coordinate (seeded). */
+Cloud::Ptr
+boxSurface (double sx, double sy, double sz, double z0, double h, double sigma, unsigned seed)
+{
+  std::mt19937 rng (seed);
+  std::normal_distribution<double> noise (0.0, sigma);
+  Cloud::Ptr c (new Cloud);
+  const int nx = static_cast<int> (std::round (sx / h)), ny = static_cast<int> (std::round (sy / h)),
+            nz = static_cast<int> (std::round (sz / h));
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j)
+      for (int k = 0; k <= nz; ++k)
+        if (i == 0 || i == nx || j == 0 || j == ny || k == 0 || k == nz)
+          c->push_back (pcl::PointXYZ (static_cast<float> (-sx / 2 + i * sx / nx + noise (rng)),
+                                       static_cast<float> (-sy / 2 + j * sy / ny + noise (rng)),
+                                       static_cast<float> (z0 + k * sz / nz + noise (rng))));
+  return c;
+}
+
+// Declared noise far above the points' own scatter (found by a probe, 2026-12-06; diagnosed on
+// 2026-12-07): a 2 cm cube sampled every 4 mm with 1 mm of real noise, declared at 5 mm, is
+// sampled finer than its declared noise and merged by default into 16 points, whose projection
+// took the cube's shape for noise: a 9 x 7 x 7 mm blob 7 mm above its bottom face, which read
+// free 2, 4 and 8 mm over a table (P = 0.04, 0.02, and 0 with no leaf pair tested). A merge that
+// shrinks the object's box diagonal below CloudModel::kMinMergedDiagonal is not taken by default.
+TEST (NoiseResolution, AMergeThatShrinksTheObjectIsNotTakenByDefault)
+{
+  const double sigma = 0.005;
+  const Cloud::Ptr finger = boxSurface (0.02, 0.02, 0.02, 0.0, 0.004, 0.001, 41);
+  const Cloud::Ptr table = sheet (0.2, 0.005, 0.001, 42);  // spacing 5 mm: never merged at 5 mm
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (sigma);
+  const CloudModel::ConstPtr a = buildCloudModel (*finger, params);
+  const CloudModel::ConstPtr b = buildCloudModel (*table, params);
+  EXPECT_EQ (a->mergedSamples (), 0u);
+  EXPECT_EQ (a->size (), finger->size ());
+  EXPECT_EQ (b->mergedSamples (), 0u);
+  CollisionRequest request;
+  for (const double clearance : {0.002, 0.004, 0.008})
+  {
+    CollisionResult result;
+    ASSERT_TRUE (collide (*a, *b, Eigen::Isometry3d (Eigen::Translation3d (0.0, 0.0, -clearance)), request, result));
+    EXPECT_NE (result.verdict, Verdict::Free) << "clearance " << clearance << ": P = " << result.probability;
+    EXPECT_FALSE (result.no_leaf_tested) << "clearance " << clearance;
+  }
+  CollisionResult far;
+  ASSERT_TRUE (collide (*a, *b, Eigen::Isometry3d (Eigen::Translation3d (0.0, 0.0, -0.04)), request, far));
+  EXPECT_EQ (far.verdict, Verdict::Free) << "P = " << far.probability;
+  // A radius given merges it all the same.
+  CloudModelParams asked = params;
+  asked.noise_resolution = 2.0;
+  EXPECT_GT (buildCloudModel (*finger, asked)->mergedSamples (), 0u);
+  // A sheet sampled every 2 mm, as noisy as it declares, still merges.
+  EXPECT_GT (buildCloudModel (*sheet (0.1, 0.002, sigma, 43), params)->mergedSamples (), 0u);
+}
+
 TEST (NoiseResolution, PerPointValuesCoverEverySampleAndTheWitnessIsOne)
 {
   // Two noisy sheets 4 mm apart with 10 mm noise: in contact; a non-finite sample and a sample

@@ -161,6 +161,13 @@ public:
     * micrometres on the real Kinect and stereo scans of ../shared/data). */
   static constexpr double kStaleViewpointShare = 0.01;
   static constexpr double kStaleAxisCosine = 0.99939;  ///< cos 2 degrees
+  /** \brief With noise_resolution unset, a merge whose points' bounding-box diagonal is under
+    * this share of the samples' is not taken (the cloud stays unmerged): the object is only a
+    * few noise deviations across, and the merge averages its shape away (a 2 cm cube sampled
+    * every 4 mm with 1 mm of scatter, declared at 5 mm: 60 % of its diagonal lost; it read free
+    * 2-8 mm over a table). CloudModelParams::noise_resolution's other such rule: a merge into no
+    * more than k points. */
+  static constexpr double kMinMergedDiagonal = 0.75;
 
 private:
   friend void offsetModel (CloudModel& model, const Eigen::Vector3d& offset);

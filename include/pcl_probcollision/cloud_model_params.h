@@ -113,8 +113,10 @@ struct CloudModelParams
     * then estimated at the merged spacing; every merged sample reports its merged point's
     * per-point values. In noise standard deviations, >= 0; 0 merges nothing. Unset (the
     * default): noiseResolution() decides, kDefaultNoiseResolution (2) without the surface model
-    * and 0 with it; a cloud the default would merge into no more than k points (an object
-    * smaller than its noise) stays unmerged, where a radius given merges it with a warning.
+    * and 0 with it; a cloud the default would merge into no more than k points, or whose merged
+    * points' box diagonal would shrink below CloudModel::kMinMergedDiagonal of its own (an object
+    * a few noise deviations across), stays unmerged, where a radius given merges it (the first
+    * with a warning).
     * With the default noise_resolution_gate only a cloud sampled finer than its noise merges,
     * and keep_full_resolution asks the unmerged models again where a merged answer leans to
     * collision. On the evaluation's reported run (seed 1, 2026-12-05) the separators then answer
