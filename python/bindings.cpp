@@ -1842,10 +1842,11 @@ PYBIND11_MODULE (_core, m)
                               "about 0 for an orientation, 0.5 for random signs (SurfaceModel::givenNormalSideDisagreement);\n"
                               "NaN otherwise.")
       .def_property_readonly ("surface_given_normals_misoriented", surfaceFlag (&SurfaceModel::givenNormalsMisoriented),
-                              "Whether more than a tenth of the given normals face away from a viewpoint outside the cloud\n"
-                              "that sees it as one scan: their sides were not turned toward the sensor (as Open3D's\n"
-                              "estimate_normals leaves them). Orientation Auto then keeps their directions and turns them\n"
-                              "toward the viewpoint (SurfaceModel::givenNormalsMisoriented). None without a surface.")
+                              "Whether the given normals were never oriented: more than a tenth of them face away from a\n"
+                              "viewpoint outside the cloud that sees it as one scan, and their sides disagree between\n"
+                              "neighbours (surface_given_normal_side_disagreement above 0.1), as Open3D's estimate_normals\n"
+                              "leaves them. Orientation Auto then keeps their directions and turns them toward the viewpoint\n"
+                              "(SurfaceModel::givenNormalsMisoriented). None without a surface.")
       .def ("__len__", &CloudModel::size)
       .def ("__repr__", [] (const CloudModel& c) {
         return "CloudModel(size=" + std::to_string (c.size ()) + ", skipped_points=" + std::to_string (c.skippedPoints ()) +
