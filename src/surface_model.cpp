@@ -1061,11 +1061,11 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     // Normals and a viewpoint outside the cloud that disagree: more than a tenth of those facing
     // it or away face away. Either may be wrong: a scan's normals estimated without an
     // orientation (Open3D's estimate_normals leaves each sign to its eigen solver: on the scenes'
-    // objects 8-81 % face away), or a VIEWPOINT left behind by pcl::transformPointCloud (a
-    // table's normals up, its stale origin on the floor below). Their sides between neighbours
-    // tell: an orientation's agree, unoriented ones disagree (the scenes' mug, 17 %). Where they
-    // disagree and the viewpoint sees the cloud as one scan, Auto turns their directions toward
-    // it. (That check alone cannot judge a cloud without a usable viewpoint: a thin part's two
+    // objects 68-81 % face away, on their tables 7-8 %), or a VIEWPOINT left behind by
+    // pcl::transformPointCloud (a table's normals up, its stale origin on the floor below). Their
+    // sides between neighbours tell: an orientation's agree, unoriented ones disagree (the scenes'
+    // objects, 19-32 %). Where they disagree and the viewpoint sees the cloud as one scan, Auto
+    // turns their directions toward it. (That check alone cannot judge a cloud without a usable viewpoint: a thin part's two
     // faces, blurred into one sheet by the noise, alternate just as much; W1's room and piano,
     // with their meshes' normals, disagreed on 23-49 % of their points.)
     given_away_share_ = facing > 0.0 ? static_cast<double> (away) / facing : std::numeric_limits<double>::quiet_NaN ();
