@@ -1331,6 +1331,60 @@ TEST (ProbabilisticCollisionRebuild, APrebuiltModelNeedsTheCloudItWasBuiltFrom)
   }
 }
 
+// filter() names the input cloud's points by index, so a model of other points with the same
+// count answered for the wrong points: a prebuilt model with its cloud moved 1 m kept 53 points
+// a metre from anything (a probe, 2026-12-06). filter() now compares the points' fingerprint and
+// keeps nothing on either side; the cloud the model came from, or a model built anew, filter.
+TEST (ProbabilisticCollisionRebuild, FilterNeedsThePointsItsInputModelWasBuiltFrom)
+{
+  const Cloud::Ptr a = sheet (0.1, 0.005, 0.0, 1);
+  const Cloud::Ptr b = sheet (0.04, 0.005, 0.0, 2, Eigen::Vector3d (0.0, 0.0, 0.001));
+  Cloud::Ptr moved (new Cloud);
+  pcl::transformPointCloud (*a, *moved, Eigen::Affine3f (Eigen::Translation3f (1.0f, 0.0f, 0.0f)));
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.002);
+  const auto model = buildCloudModel (*a, params);
+  EXPECT_EQ (model->sourceFingerprint (), cloudFingerprint (*a));
+  EXPECT_NE (cloudFingerprint (*a), cloudFingerprint (*moved));
+  Cloud nudged = *a;
+  nudged[7].z = std::nextafter (nudged[7].z, 1.0f);
+  EXPECT_NE (cloudFingerprint (*a), cloudFingerprint (nudged));
+  // Built from points directly: nothing to compare.
+  UncertainCloud points;
+  points.means = {Eigen::Vector3d::Zero (), Eigen::Vector3d::UnitX ()};
+  points.covariances.assign (2, Eigen::Matrix3d::Identity () * 1e-6);
+  EXPECT_EQ (CloudModel (points).sourceFingerprint (), 0u);
+
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setTargetCloud (b);
+  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));  // for the models built below
+  pc.setProbabilityThreshold (0.3);
+  pc.setInputModel (model);
+  const auto kept = [&] (bool negative) {
+    pc.setNegative (negative);
+    pcl::Indices indices;
+    pc.filter (indices);
+    return indices.size ();
+  };
+  pc.setInputCloud (a);
+  const std::size_t near = kept (false);
+  ASSERT_GT (near, 0u);
+  EXPECT_EQ (near + kept (true), a->size ());
+  pc.setInputCloud (moved);
+  EXPECT_EQ (kept (false), 0u);  // 53 before
+  EXPECT_EQ (kept (true), 0u);   // refused: neither side
+  pc.setInputModel (nullptr);    // the moved cloud's own model: a metre from b
+  EXPECT_EQ (kept (false), 0u);
+  EXPECT_EQ (kept (true), moved->size ());
+  // A model this object built, its cloud then changed in place: refused until markForRebuild().
+  *moved = *a;
+  EXPECT_EQ (kept (false), 0u);
+  EXPECT_EQ (kept (true), 0u);
+  pc.markForRebuild ();
+  EXPECT_EQ (kept (false), near);
+}
+
 // A cloud resized in place without being set again: compute() answered with the old model (its
 // per-point values index-aligned with 400 points for a cloud of 5) where filter() refused; both
 // refuse now, by one rule and with one message (a probe, 2026-12-04). A change that keeps the size

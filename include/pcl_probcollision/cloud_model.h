@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
@@ -46,6 +48,34 @@ std::shared_ptr<const CloudModel>
 buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params = CloudModelParams (),
                  const pcl::Indices* indices = nullptr, const pcl::PointCloud<Covariance>* covariances = nullptr,
                  const std::string& name = "cloud");
+
+/** \brief A 64-bit hash of the x, y, z of every point of the cloud (their bits, non-finite points
+  * included, in order): what CloudModel::sourceFingerprint() holds, so that a cloud can be
+  * checked against the model built from it (ProbabilisticCollision::filter() does). It detects
+  * changes, it is no cryptographic hash. About 2 ns a point (8 ms for 5,000,000 points). */
+template <typename PointT>
+std::uint64_t
+cloudFingerprint (const pcl::PointCloud<PointT>& cloud)
+{
+  // FNV-1a over 32-bit words, one lane per coordinate (three independent multiply chains run 4
+  // times as fast as one: 1.6 against 7.3 ns a point). Each step is invertible, so a change of
+  // any one coordinate always changes the hash.
+  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
+  const auto bits = [] (float v) {
+    std::uint32_t b;
+    std::memcpy (&b, &v, sizeof b);
+    return b;
+  };
+  std::uint64_t hx = 0xcbf29ce484222325ULL, hy = hx, hz = hx;
+  for (const PointT& p : cloud)
+  {
+    hx = (hx ^ bits (p.x)) * kPrime;
+    hy = (hy ^ bits (p.y)) * kPrime;
+    hz = (hz ^ bits (p.z)) * kPrime;
+  }
+  return ((((hx * kPrime) ^ hy) * kPrime ^ hz) * kPrime) ^ static_cast<std::uint64_t> (cloud.size ());
+}
+
 /** \brief The model of one object known from a point cloud: its uncertain points (one
   * Gaussian each) and their epsilon-overlap hierarchy, built once and then immutable.
   *
@@ -92,6 +122,9 @@ public:
   std::size_t size () const { return bvh_.size (); }
   /** \brief Size of the caller's cloud: per-point results are index-aligned with it. */
   std::size_t sourceSize () const { return source_size_; }
+  /** \brief cloudFingerprint() of the cloud buildCloudModel() built the model from (all its
+    * points, whatever the indices); 0 for a model built from points directly. */
+  std::uint64_t sourceFingerprint () const { return source_fingerprint_; }
   /** \brief Points of the cloud (within its indices) left out as non-finite. */
   std::size_t skippedPoints () const { return skipped_; }
   /** \brief The settings the model was built with (defaults but for the hierarchy when built
@@ -177,6 +210,12 @@ private:
   void buildLocal (UncertainCloud&& points, std::vector<PackedCovariance>&& packed, const BVHParams& hierarchy,
                    std::size_t source_size, int threads = 1);
 
+  /** \brief buildCloudModel() but for sourceFingerprint(), which buildCloudModel() sets on what
+    * this returns (one place for its several returns, merged or not). */
+  template <typename PointT>
+  static std::shared_ptr<const CloudModel>
+  buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
+                  const pcl::PointCloud<Covariance>* covariances, const std::string& name);
   template <typename PointT>
   friend std::shared_ptr<const CloudModel>
   buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
@@ -206,6 +245,7 @@ private:
   SurfaceModel surface_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero ();
   std::size_t source_size_ = 0;
+  std::uint64_t source_fingerprint_ = 0;
   std::size_t skipped_ = 0;
   std::size_t merged_samples_ = 0;
   std::vector<int> point_of_source_;

@@ -36,12 +36,14 @@ namespace pcl_probcollision
   * (setInputCloud, setIndices, setTargetCloud, setTargetIndices, the covariances, noise models,
   * k, surface projection and hierarchy parameters) marks that model for rebuild, even when it
   * is given the same pointer again. A cloud changed in place (pcl::transformPointCloud (*a, *a,
-  * T)) is NOT noticed until it is set again or markForRebuild() is called: until then the old
-  * model answers. One resized in place is refused: compute() and filter() fail naming both
-  * sizes (their per-point results would not be index-aligned with it). Prebuilt models
-  * (setInputModel, setTargetModel) are used as they are; a cloud set beside one must have the
-  * size of the cloud it was built from (compute() fails otherwise: set the model to nullptr to
-  * build from a new cloud).
+  * T)) is NOT noticed by compute() until it is set again or markForRebuild() is called: until
+  * then the old model answers. One resized in place is refused: compute() and filter() fail
+  * naming both sizes (their per-point results would not be index-aligned with it). Prebuilt
+  * models (setInputModel, setTargetModel) are used as they are; a cloud set beside one must have
+  * the size of the cloud it was built from (compute() fails otherwise: set the model to nullptr
+  * to build from a new cloud). filter(), whose output names the input cloud's points, also
+  * checks that the input model was built from those very points (CloudModel::sourceFingerprint(),
+  * an O(n) hash) and fails otherwise.
   *
   * As a filter (pcl::FilterIndices), it keeps the points of A whose collision probability
   * reaches setProbabilityThreshold() (default 0.5); setNegative() keeps the others and
@@ -144,7 +146,8 @@ public:
   const CloudModelParams& getTargetModelParams () const { return target_params_; }
 
   /** \brief Uses a prebuilt model of A instead of building one from the input cloud (null:
-    * build from the input cloud again). filter() still needs the input cloud it came from. */
+    * build from the input cloud again). filter() still needs the input cloud it came from (its
+    * points are checked: changedCloudError()). */
   void setInputModel (const CloudModel::ConstPtr& model) { input_model_ = model; input_prebuilt_ = static_cast<bool> (model); input_dirty_ = !model; }
   /** \brief Uses a prebuilt model of B instead of building one from the target cloud. */
   void setTargetModel (const CloudModel::ConstPtr& model) { target_model_ = model; target_prebuilt_ = static_cast<bool> (model); target_dirty_ = !model; }
@@ -215,7 +218,8 @@ public:
 protected:
   /** \brief Runs an exhaustive per-point query and keeps the indices of A whose P_i reaches
     * the probability threshold (the others with setNegative()); empty, with a PCL_ERROR, when
-    * the query fails or the input model is not the input cloud's. */
+    * the query fails or the input model is not the input cloud's (its size or its points:
+    * changedCloudError()). */
   void applyFilter (pcl::Indices& indices) override;
   using pcl::FilterIndices<PointT>::applyFilter;
 
@@ -229,6 +233,10 @@ private:
     * (for any input model): empty when the model's per-point results are index-aligned with the
     * cloud (model.sourceSize() == cloud.size()), otherwise why not, naming `which` cloud. */
   static std::string staleModelError (const CloudModel& model, const PointCloud& cloud, const char* which);
+  /** \brief filter()'s rule: staleModelError(), and then that the model's
+    * CloudModel::sourceFingerprint() is the cloud's (cloudFingerprint()), so the indices filter()
+    * keeps name the points the model answered for; empty when they do. */
+  std::string changedCloudError (const CloudModel& model, const PointCloud& cloud) const;
   /** \brief Turns collide()'s answer (A's frame) into compute()'s: the witness in the
     * target's frame and, with timings, build_ms. */
   void finishResult (const Eigen::Isometry3d& T_target_input, double build_ms, CollisionResult& result) const;

@@ -33,6 +33,19 @@ std::shared_ptr<const CloudModel>
 buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params, const pcl::Indices* indices,
                  const pcl::PointCloud<Covariance>* covariances, const std::string& name)
 {
+  // The merged model's inner build fingerprints the merged cloud first; this outer call, the
+  // caller's cloud, sets it last.
+  const auto model = std::const_pointer_cast<CloudModel> (CloudModel::buildFromCloud (cloud, params, indices, covariances, name));
+  model->source_fingerprint_ = cloudFingerprint (cloud);
+  return model;
+}
+
+template <typename PointT>
+std::shared_ptr<const CloudModel>
+CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& params,
+                            const pcl::Indices* indices, const pcl::PointCloud<Covariance>* covariances,
+                            const std::string& name)
+{
   const auto start = std::chrono::steady_clock::now ();
   // what()'s function (PCLException's), without the source path PCL_THROW_EXCEPTION would add;
   // the descriptions start with name (errorMessage() keeps them alone).

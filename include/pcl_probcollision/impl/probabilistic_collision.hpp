@@ -223,6 +223,23 @@ ProbabilisticCollision<PointT>::staleModelError (const CloudModel& model, const 
 }
 
 template <typename PointT>
+std::string
+ProbabilisticCollision<PointT>::changedCloudError (const CloudModel& model, const PointCloud& cloud) const
+{
+  if (const std::string stale = staleModelError (model, cloud, "input"); !stale.empty ())
+    return stale;
+  // A model built from points directly has no fingerprint to compare.
+  if (model.sourceFingerprint () == 0 || model.sourceFingerprint () == cloudFingerprint (cloud))
+    return std::string ();
+  return std::string ("the input model was built from a cloud of ") + std::to_string (model.sourceSize ()) +
+         " points other than the input cloud's (" +
+         (input_prebuilt_ ? "a model given by setInputModel() needs the cloud it was built from, or setInputModel (nullptr) "
+                            "to build one from the cloud"
+                          : "a cloud changed in place needs to be set again, or markForRebuild()") +
+         ")";
+}
+
+template <typename PointT>
 void
 ProbabilisticCollision<PointT>::finishResult (const Eigen::Isometry3d& T_target_input, double build_ms,
                                               CollisionResult& result) const
@@ -350,9 +367,10 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
     return;  // compute() printed the error; the output stays empty
 
   const std::vector<float>& p = result.probabilities_a;
-  // compute() checked a model set by setInputModel() against the input cloud already; a model
-  // built here is the input cloud's.
-  if (const std::string stale = staleModelError (*input_model_, *this->input_, "input"); !stale.empty ())
+  // compute() checked the model's size against the input cloud; the indices kept below name the
+  // cloud's points, so here the points themselves must be the model's (a prebuilt model's cloud
+  // moved 1 m kept 53 points a metre from anything: a probe, 2026-12-06).
+  if (const std::string stale = changedCloudError (*input_model_, *this->input_); !stale.empty ())
   {
     PCL_ERROR ("[pcl_probcollision::%s::applyFilter] %s\n", this->getClassName ().c_str (), stale.c_str ());
     return;
