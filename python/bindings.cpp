@@ -641,7 +641,8 @@ setLeakage (CloudModelParams& p, const std::string& v)
 }
 
 /** The k-th pose of an (M, 4, 4) array: ValueError naming it when it is not finite or its last row
-  * is not 0 0 0 1, and with `rigid` when collide()'s rigid check (detail::poseError) fails. */
+  * is not 0 0 0 1, and with `rigid` when collide()'s rigid check (detail::poseError) fails; with
+  * `rigid`, the pose collide() uses (detail::rigidPose: a rounded rotation's nearest). */
 Eigen::Isometry3d
 poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool rigid)
 {
@@ -661,6 +662,7 @@ poseAt (const py::detail::unchecked_reference<double, 3>& p, py::ssize_t k, bool
     const std::string error = pcl_probcollision::detail::poseError (T, name);
     if (!error.empty ())
       throw py::value_error (error);
+    return pcl_probcollision::detail::rigidPose (T);  // what collide() uses for it
   }
   return T;
 }
@@ -1953,7 +1955,9 @@ PYBIND11_MODULE (_core, m)
   m.def ("collide", &collideOne, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("pose"),
          py::arg ("request") = py::none (),
          "Probability that the objects of models a and b collide, b placed in a's frame by pose = T_a_b\n"
-         "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide().\n\n"
+         "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide(). A rotation rounded to a few\n"
+         "digits (R^T R within 1e-2 of the identity: a quaternion printed with 3 decimals) is taken to its\n"
+         "nearest rotation.\n\n"
          "request: CollisionRequest (None = CollisionRequest()). Returns a CollisionResult.\n"
          "ValueError (with the C++ message) for a non-rigid or non-finite pose or an invalid request.");
   m.def ("collide_batch", &collideMany, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("poses"),
@@ -2218,6 +2222,7 @@ PYBIND11_MODULE (_core, m)
          "ValueError naming the first of (M, 4, 4) poses that collide() would refuse (not finite, not rigid within\n"
          "its tolerance, beyond MAX_COORDINATE) or whose last row is not 0 0 0 1; None when all are good.");
   m.def ("invert_poses", &invertPoses, py::arg ("poses"),
-         "(M, 4, 4) rigid transforms -> their inverses (Eigen's). ValueError naming the first that is not rigid\n"
-         "(the rotation's tolerance is collide()'s) or whose last row is not 0 0 0 1.");
+         "(M, 4, 4) rigid transforms -> their inverses (Eigen's), of the nearest rotation where one was rounded,\n"
+         "as collide() takes it. ValueError naming the first that is not rigid (the rotation's tolerance is\n"
+         "collide()'s) or whose last row is not 0 0 0 1.");
 }

@@ -289,8 +289,8 @@ namespace
 /** \brief collide() on the two models as they are, without the full-resolution rung and the
   * timing. */
 bool
-collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b, const CollisionRequest& request,
-               CollisionResult& result, const RobustClassifier* classifier)
+collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& T_a_b_given,
+               const CollisionRequest& request, CollisionResult& result, const RobustClassifier* classifier)
 {
   result = CollisionResult ();
   try
@@ -310,12 +310,14 @@ collideModels (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d
           "the classifier given was built with parameters other than request.classifier's");
     return false;
   }
-  const std::string pose_error = detail::poseError (T_a_b, "T_a_b");
+  const std::string pose_error = detail::poseError (T_a_b_given, "T_a_b");
   if (!pose_error.empty ())
   {
     fail (result, CollisionResult::Status::InvalidInput, pose_error);
     return false;
   }
+  // A rotation given with rounded digits, taken to the nearest rotation (or as given when exact).
+  const Eigen::Isometry3d T_a_b = detail::rigidPose (T_a_b_given);
   // The hierarchies live in the models' local frames (x = local + origin): B's local points go
   // to A's local frame by T_local = Translate (-o_a) T_a_b Translate (o_b), composed in double.
   Eigen::Isometry3d T_local = T_a_b;

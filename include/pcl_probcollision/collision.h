@@ -24,7 +24,10 @@ namespace pcl_probcollision
   *
   * \param[in] a model of object A (its frame is the query frame)
   * \param[in] b model of object B
-  * \param[in] T_a_b rigid transform mapping B-frame points into A's frame
+  * \param[in] T_a_b rigid transform mapping B-frame points into A's frame; a rotation whose
+  *            digits were rounded (R^T R within 1e-2 of the identity,
+  *            detail::kRoundedRotationTolerance) is taken to its nearest rotation
+  *            (detail::rigidPose), an exact one (within 1e-6) is used as given
   * \param[in] request what to compute (validated)
   * \param[out] result verdict, probability, witness (in the query frame, here A's: see
   *             CollisionResult::witness_point), counters; per-point probabilities

@@ -1496,6 +1496,47 @@ def test_invert_poses_refuses_what_collide_refuses():
         pc.invert_poses(row)
 
 
+def quaternion_pose(q, t):
+    """The 4x4 pose of quaternion (w, x, y, z) q, NOT normalised (as Eigen's toRotationMatrix and a
+    hand-written conversion take one read from a file), and translation t."""
+    w, x, y, z = q
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = t
+    return T
+
+
+def test_a_rotation_rounded_to_a_few_digits_is_taken_to_the_nearest_rotation(gripper_patch, table):
+    # A quaternion printed with 6 decimals (a YAML pose; tf_echo prints 3) gives a matrix whose
+    # R^T R departs from the identity by up to 6e-6: about half of such poses were refused as
+    # "not a rotation plus translation" (a probe, 2026-12-06). collide(), collide_batch() and
+    # invert_poses() take them as their nearest rotation now.
+    # Tilted 4 degrees from z: 6 decimals depart by 2.8e-6, 3 by 2.5e-3.
+    angle, axis = 1.83, np.array([0.05, 0.05, 1.0]) / np.sqrt(1.005)
+    exact = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+    t = (0.002, -0.001, 0.004)
+    want = pc.collide(gripper_patch, table, quaternion_pose(exact, t))
+    assert want.leaf_pairs_tested > 0  # near contact: the rotation matters
+    for decimals in (6, 3):
+        T = quaternion_pose(np.round(exact, decimals), t)
+        R = T[:3, :3]
+        assert np.abs(R.T @ R - np.eye(3)).max() > 1e-6  # refused before
+        got = pc.collide(gripper_patch, table, T)
+        same_result(got, pc.collide_batch(gripper_patch, table, T[None], threads=1)[0])
+        inverse = pc.invert_poses(T[None])[0]
+        np.testing.assert_allclose(inverse[:3, :3] @ inverse[:3, :3].T, np.eye(3), rtol=0, atol=1e-15)
+        np.testing.assert_allclose(inverse[:3, :3].T, R, rtol=0, atol=2e-3)  # the nearest rotation
+        if decimals == 6:
+            assert got.verdict == want.verdict
+            assert abs(got.probability - want.probability) < 1e-3
+    scaled = np.eye(4)
+    scaled[:3, :3] *= 1.01
+    with pytest.raises(ValueError, match=r"departs from the identity by 0\.0201, more than the tolerance 0\.01"):
+        pc.collide(gripper_patch, table, scaled)
+
+
 def test_in_frame_maps_the_witness_and_nearest_points_as_pcd_collision_reports_them(gripper_patch, table):
     # collide() answers in a's frame; in_frame(T_b_a) gives b's, with the library's own arithmetic
     # (the Dask layer's numpy rotation differed from pcd_collision's in the last bit of a normal).

@@ -170,7 +170,8 @@ struct TraversalResult
   *            ExpandedBV mode).
   * \return the maximum contribution and counters; an empty hierarchy gives probability 0 with
   *         no_leaf_tested set.
-  * \throws pcl::BadArgumentException when params are invalid or T_a_b is not rigid.
+  * \throws pcl::BadArgumentException when params are invalid or T_a_b is not rigid within
+  *         kRotationTolerance (rigidPose() makes a rounded rotation one).
   * \note Thread safety: reentrant; any number of calls may share the two hierarchies (each call
   *       owns its stack and generator). The leaf test must be safe for its own use.
   */
@@ -184,6 +185,11 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
   const std::string pose_error = poseError (T_a_b, "T_a_b");
   if (!pose_error.empty ())
     PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::detail::traverseHierarchies] " << pose_error);
+  // The leaf test maps points by the same pose: a rounded rotation must be made one by the
+  // caller (collide() does), not here alone.
+  if (!(rotationDeparture (T_a_b) <= kRotationTolerance))
+    PCL_THROW_EXCEPTION (pcl::BadArgumentException, "[pcl_probcollision::detail::traverseHierarchies] pose T_a_b departs from a rotation by "
+                                                         << rotationDeparture (T_a_b) << ": pass detail::rigidPose (T_a_b)");
   TraversalResult result;
   if (bvh_a.empty () || bvh_b.empty ())
     return result;

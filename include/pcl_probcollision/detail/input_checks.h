@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -17,9 +18,41 @@ namespace detail
   * boxes become inf - inf = NaN, which never prune (both found by fuzz/fuzz_collide). */
 constexpr double kMaxCoordinate = 1e15;
 
-/** \brief How far R^T R of a pose's rotation may depart from the identity, entry by entry: a
-  * rotation written with 7 significant digits passes, a scale of 1 + 1e-6 does not. */
+/** \brief How far R^T R of a pose's rotation may depart from the identity, entry by entry, to be
+  * used as given (rigidPose()): a rotation written with 7 significant digits passes. */
 constexpr double kRotationTolerance = 1e-6;
+
+/** \brief How far R^T R may depart from the identity, entry by entry, for a pose to be accepted
+  * at all (poseError()); beyond kRotationTolerance it is taken to the nearest rotation
+  * (rigidPose()). Rotations whose digits were rounded depart by up to 6e-6 when their quaternion
+  * is printed with 6 decimals (52 % of random rotations depart by more than 1e-6, and were refused
+  * before), 6e-4 with 4 and 6e-3 with 3 (as tf_echo prints them); a scale of 1.01 (2e-2) is
+  * refused. */
+constexpr double kRoundedRotationTolerance = 1e-2;
+
+/** \brief R^T R - I's largest entry in magnitude: how far a pose's linear part is from a rotation. */
+inline double
+rotationDeparture (const Eigen::Isometry3d& T)
+{
+  const Eigen::Matrix3d R = T.linear ();
+  return (R.transpose () * R - Eigen::Matrix3d::Identity ()).cwiseAbs ().maxCoeff ();
+}
+
+/** \brief The pose a query uses for T, which poseError() accepted: T itself when its rotation
+  * departs by at most kRotationTolerance (bit for bit what was given), otherwise the nearest
+  * rotation to its linear part (U V^T of its SVD, in the Frobenius norm) with T's translation.
+  * Every inverse and covariance mapping of a query assumes R^T = R^-1; a rounded rotation would
+  * scale them. */
+inline Eigen::Isometry3d
+rigidPose (const Eigen::Isometry3d& T)
+{
+  if (rotationDeparture (T) <= kRotationTolerance)
+    return T;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd (T.linear (), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Isometry3d rigid = T;
+  rigid.linear () = svd.matrixU () * svd.matrixV ().transpose ();
+  return rigid;
+}
 
 /** \brief The one check of a pose's last row: empty when it is (0, 0, 0, 1) exactly, otherwise
   * "the last row must be (0, 0, 0, 1), got (...)". Eigen's Isometry3d and Affine3d keep the row
@@ -37,7 +70,7 @@ lastRowError (const Eigen::Matrix4d& m)
 }
 
 /** \brief The one rigid-pose check of the library: empty when T is finite, a rotation
-  * (orthonormal within kRotationTolerance, determinant +1) plus a translation within
+  * (orthonormal within kRoundedRotationTolerance, determinant +1; queries use rigidPose (T)) plus a translation within
   * +-kMaxCoordinate, its last row (0, 0, 0, 1) (lastRowError()); otherwise why not (by how much,
   * for a rotation), naming the pose `name`. */
 inline std::string
@@ -48,8 +81,8 @@ poseError (const Eigen::Isometry3d& T, const std::string& name)
   if (const std::string row = lastRowError (T.matrix ()); !row.empty ())
     return "pose " + name + ": " + row;
   const Eigen::Matrix3d R = T.linear ();
-  const double departure = (R.transpose () * R - Eigen::Matrix3d::Identity ()).cwiseAbs ().maxCoeff ();
-  if (!(departure <= kRotationTolerance) || R.determinant () < 0.0)
+  const double departure = rotationDeparture (T);
+  if (!(departure <= kRoundedRotationTolerance) || R.determinant () < 0.0)
   {
     // Say by how much: a rotation rounded to a few digits in a poses file fails the same way as
     // a scale, and the reader needs to know which.
@@ -58,7 +91,7 @@ poseError (const Eigen::Isometry3d& T, const std::string& name)
       std::snprintf (why, sizeof why, " (a reflection: det R = %.6g)", R.determinant ());
     else
       std::snprintf (why, sizeof why, " (R^T R departs from the identity by %.3g, more than the tolerance %g)", departure,
-                     kRotationTolerance);
+                     kRoundedRotationTolerance);
     return "pose " + name + " is not a rotation plus translation" + why;
   }
   if (!(T.translation ().cwiseAbs ().maxCoeff () <= kMaxCoordinate))

@@ -258,10 +258,12 @@ ProbabilisticCollision<PointT>::compute (const Eigen::Isometry3d& T_target_input
   if (result.message.empty () && prepare (result))
   {
     const double build_ms = result.build_ms;
-    // collide() works in A's frame: B is mapped there by the inverse pose.
-    if (collide (*input_model_, *target_model_, T_target_input.inverse (), request_, result, &classifier_))
+    // collide() works in A's frame: B is mapped there by the inverse pose, of a rotation (a
+    // rounded one is taken to the nearest: its transpose would not invert it).
+    const Eigen::Isometry3d T = detail::rigidPose (T_target_input);
+    if (collide (*input_model_, *target_model_, T.inverse (), request_, result, &classifier_))
     {
-      finishResult (T_target_input, build_ms, result);
+      finishResult (T, build_ms, result);
       return true;
     }
   }
@@ -313,7 +315,7 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
     if (results[i].message.empty ())
     {
       posed.push_back (i);
-      T_input_target.push_back (T_target_input[i].inverse ());
+      T_input_target.push_back (detail::rigidPose (T_target_input[i]).inverse ());
     }
   }
   // Every pose is finished and handed over in pose order: those up to `end` once results hold them.
@@ -322,7 +324,7 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
   auto handOverUpTo = [&] (std::size_t end) {
     for (; handed < end; ++handed)
     {
-      finishBatchResult (handed, T_target_input[handed], prepared.build_ms, results[handed], failed);
+      finishBatchResult (handed, detail::rigidPose (T_target_input[handed]), prepared.build_ms, results[handed], failed);
       if (ready)
         ready (handed);
     }
