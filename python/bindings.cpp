@@ -398,6 +398,15 @@ buildModel (const py::object& points, const py::object& covariances, const py::o
       fillNormals<float> (nrm, oriented, any_length_normals);
     else
       fillNormals<double> (nrm, oriented, any_length_normals);
+    // Only the surface model reads them: without it they changed nothing, without a word (a probe,
+    // 2026-12-06).
+    if (!params.surface &&
+        PyErr_WarnEx (PyExc_RuntimeWarning,
+                      (name + ": normals given without params.surface: only the surface model reads them, so they are "
+                              "not used (CloudModelParams(surface=True) builds it)")
+                          .c_str (),
+                      1) < 0)
+      throw py::error_already_set ();
     py::gil_scoped_release release;
     return offsetBuilt (buildCloudModel<pcl::PointNormal> (oriented, params, nullptr, have_covs ? &covs : nullptr, name),
                         offset);

@@ -713,6 +713,10 @@ def test_surface_normals_and_orientation_options(sheets):
                                 orientation=pc.NormalOrientation.PointNormals)
     none = pc.build_model(a, params=asked)
     assert none.surface_orientation == pc.NormalOrientation.Propagate and none.surface_inside_known is False
+    # Normals without the surface model, which alone reads them, changed nothing without a word.
+    with pytest.warns(RuntimeWarning, match=r"^cloud: normals given without params.surface: only the surface model"):
+        unused = pc.build_model(a, normals=np.tile([0.0, 0.0, 1.0], (len(a), 1)))
+    assert unused.size == pc.build_model(a).size
     with pytest.raises(ValueError, match="normals"):
         pc.build_model(a, normals=np.zeros((len(a) - 1, 3)))
     with pytest.raises(ValueError, match="normals"):
