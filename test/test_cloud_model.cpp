@@ -1377,6 +1377,28 @@ TEST (ProbabilisticCollisionRebuild, FilterNeedsThePointsItsInputModelWasBuiltFr
   pc.setInputModel (nullptr);    // the moved cloud's own model: a metre from b
   EXPECT_EQ (kept (false), 0u);
   EXPECT_EQ (kept (true), moved->size ());
+  // A model of the left half (indices) over the whole cloud: the points outside it read P = 0 and
+  // were kept by setNegative without a word (a probe, 2026-12-07). Refused; with the same indices
+  // set, it filters as a model the object builds from them.
+  pcl::Indices left;
+  for (std::size_t i = 0; i < a->size (); ++i)
+    if ((*a)[i].x < 0.0f)
+      left.push_back (static_cast<int> (i));
+  const auto half = buildCloudModel (*a, params, &left);
+  EXPECT_NE (half->sourceFingerprint (), model->sourceFingerprint ());
+  pc.setInputCloud (a);
+  pc.setInputModel (half);
+  EXPECT_EQ (kept (false), 0u);
+  EXPECT_EQ (kept (true), 0u);
+  pc.setIndices (pcl::IndicesPtr (new pcl::Indices (left)));
+  const std::size_t left_near = kept (false);
+  EXPECT_GT (left_near, 0u);
+  EXPECT_EQ (left_near + kept (true), left.size ());
+  pc.setInputModel (nullptr);
+  EXPECT_EQ (kept (false), left_near);
+  pc.setIndices (pcl::IndicesPtr ());
+  pc.setInputCloud (moved);
+  EXPECT_EQ (kept (false), 0u);  // its model built, a metre from b
   // A model this object built, its cloud then changed in place: refused until markForRebuild().
   *moved = *a;
   EXPECT_EQ (kept (false), 0u);

@@ -449,6 +449,133 @@ TEST (ProbabilisticCollision, FilterNeverKeepsANaNPoint)
   }
 }
 
+/** A closed box of half side `half` about the origin, its faces sampled every h with outward
+  * normals: a robot part with the normals its mesh gives. */
+pcl::PointCloud<pcl::PointNormal>
+outwardBox (double half, double h)
+{
+  pcl::PointCloud<pcl::PointNormal> box;
+  const int n = static_cast<int> (std::round (2.0 * half / h));
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double side : {-1.0, 1.0})
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j)
+        {
+          Eigen::Vector3d p;
+          p[axis] = side * half;
+          p[(axis + 1) % 3] = -half + i * h;
+          p[(axis + 2) % 3] = -half + j * h;
+          pcl::PointNormal q;
+          q.getVector3fMap () = p.cast<float> ();
+          q.getNormalVector3fMap () = Eigen::Vector3f::Zero ();
+          q.getNormalVector3fMap ()[axis] = static_cast<float> (side);
+          box.push_back (q);
+        }
+  return box;
+}
+
+// filter() answers each point, whatever the request asks of a pose: a request capped for a
+// planner (max_leaf_fits = 8) kept no point of a scan inside a gripper, and the ladder gave every
+// point the separators' values, which fall inside an object, wherever they read the pair as a
+// collision (a probe of robot self-filtering, 2026-12-07). A scan's sheet through a 4 cm box
+// with outward normals: the surface layer keeps the points inside, and so do the capped requests
+// and the ladder now, point for point. Points never reached count as P = 0, so a threshold of 0
+// keeps every finite point.
+TEST (ProbabilisticCollision, FilterAnswersEveryPointWhateverTheRequestAsks)
+{
+  const auto a = organizedPatch (0.2, 0.004, 0.0, 0.0, 31);
+  CloudModelParams box_params;
+  box_params.noise = SensorNoiseModel::isotropic (0.001);
+  box_params.surface = true;
+  const auto box = buildCloudModel (outwardBox (0.02, 0.004), box_params);
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputCloud (a);
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.001));
+  pc.setTargetModel (box);
+  const auto kept = [&] (const CollisionRequest& request) {
+    pc.setRequest (request);
+    pcl::Indices indices;
+    pc.filter (indices);
+    return indices;
+  };
+  CollisionRequest surface;
+  surface.surface = true;
+  const pcl::Indices want = kept (surface);
+  std::size_t deep = 0, deep_kept = 0;  // more than 3 mm inside the box's walls
+  for (std::size_t i = 0; i < a->size (); ++i)
+    if (std::max (std::abs ((*a)[i].x), std::abs ((*a)[i].y)) < 0.017f)
+    {
+      ++deep;
+      deep_kept += std::count (want.begin (), want.end (), static_cast<int> (i));
+    }
+  ASSERT_GT (deep, 50u);
+  EXPECT_GE (deep_kept, deep * 9 / 10);
+  EXPECT_LT (want.size (), a->size () / 4);  // the rest of the sheet, outside, is not kept
+
+  CollisionRequest capped = surface;
+  capped.max_leaf_fits = 8;
+  capped.max_surface_pairs = 4;
+  EXPECT_EQ (kept (capped), want);
+  CollisionRequest ladder = surface;
+  ladder.surface_ladder = true;
+  EXPECT_EQ (kept (ladder), want);
+  // The separators alone, capped, against their own uncapped answer.
+  CollisionRequest separators_capped;
+  separators_capped.max_leaf_fits = 8;
+  EXPECT_EQ (kept (separators_capped), kept (CollisionRequest ()));
+
+  pc.setRequest (surface);
+  pc.setProbabilityThreshold (0.0);
+  pcl::Indices all;
+  pc.filter (all);
+  EXPECT_EQ (all.size (), a->size ());
+}
+
+// filter (*input) in place: PCL's filters take it, and ours cleared the output, so the input,
+// before the query (a 307,200-point scan became empty, "no finite point"). A failed call leaves
+// the output empty, with setKeepOrganized() too, where PCL's base class returned the whole input
+// (the same probe).
+TEST (ProbabilisticCollision, FilterInPlaceAndFailuresLeaveNoStalePoints)
+{
+  const auto a = organizedPatch (0.2, 0.01, 0.0, 0.0, 15);
+  const auto b = organizedPatch (0.04, 0.01, 0.0005, 0.0, 16);
+  ProbabilisticCollision<pcl::PointXYZ> pc;
+  pc.setInputNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setTargetNoise (SensorNoiseModel::isotropic (0.002));
+  pc.setProbabilityThreshold (0.3);
+  pc.setInputCloud (a);
+  pc.setTargetCloud (b);
+  Cloud apart;
+  pc.filter (apart);
+  ASSERT_GT (apart.size (), 0u);
+  ASSERT_LT (apart.size (), a->size ());
+  const Cloud::Ptr same (new Cloud (*a));
+  pc.setInputCloud (same);
+  pc.filter (*same);
+  ASSERT_EQ (same->size (), apart.size ());
+  for (std::size_t i = 0; i < apart.size (); ++i)
+    EXPECT_EQ ((*same)[i].getVector3fMap (), apart[i].getVector3fMap ()) << i;
+  // Filtered in place, the input changed: its model is built anew, so filtering again keeps what
+  // the first call kept (the filtered points are the ones near b).
+  Cloud again;
+  pc.filter (again);
+  EXPECT_EQ (again.size (), same->size ());
+
+  for (const bool organized : {false, true})
+  {
+    ProbabilisticCollision<pcl::PointXYZ> failing;
+    failing.setInputCloud (a);  // no target cloud: the query fails
+    failing.setKeepOrganized (organized);
+    Cloud out;
+    out.push_back (pcl::PointXYZ (1.0f, 2.0f, 3.0f));
+    failing.filter (out);
+    EXPECT_TRUE (out.empty ()) << "organized " << organized << ": " << out.size () << " points";
+    pcl::Indices indices = {1, 2};
+    failing.filter (indices);
+    EXPECT_TRUE (indices.empty ()) << organized;
+  }
+}
+
 TEST (ProbabilisticCollision, NaNPointsAreSkippedAndCountedLikeRemovingThem)
 {
   auto a = organizedPatch (0.1, 0.01, 0.0, 0.0, 17);

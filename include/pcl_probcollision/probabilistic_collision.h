@@ -48,8 +48,16 @@ namespace pcl_probcollision
   * As a filter (pcl::FilterIndices), it keeps the points of A whose collision probability
   * reaches setProbabilityThreshold() (default 0.5); setNegative() keeps the others and
   * setKeepOrganized() keeps an organized layout, as in pcl::CropBox. Filtering runs an
-  * exhaustive query so that every point near B is evaluated; points the traversal never came
-  * near count as probability 0.
+  * exhaustive query so that every point near B is evaluated, without the request's caps
+  * (max_leaf_fits, max_surface_pairs) and, for surface_ladder, with the surface layer answering
+  * every point (the ladder picks one rung for the whole pair); points the traversal never came
+  * near count as probability 0. It answers at the identity pose: move B's cloud first.
+  * For robot self-filtering (B a robot part, A a scan; setNegative() removes the part's points):
+  * the separators' per-point P falls inside B, deepest lowest (points 3-5 mm inside a 1 cm
+  * finger read under 0.5: METHOD.md 10.1), so build B with its outward normals (a mesh's
+  * samples as pcl::PointNormal, CloudModelParams::surface) and set request.surface; and a point
+  * on B's surface reads P near 0.5 by design (half its spread lies inside), so a scan of the
+  * part itself needs a lower threshold (0.2) or B padded by the scan's noise.
   *
   * \note Non-finite points are skipped (and counted in the result). The two clouds must be in
   * the same units: covariances, noise sigmas and distances are in those units (the hierarchy's
@@ -209,11 +217,35 @@ public:
   bool computeBatch (const std::vector<Eigen::Isometry3d>& T_target_input, std::vector<CollisionResult>& results,
                      int threads, const std::function<void (std::size_t)>& ready);
 
-  /** \brief Like pcl::Filter::filter, but the output is cleared first, so a failed call never
-    * leaves stale points behind. */
-  void filter (PointCloud& output) { output.clear (); pcl::FilterIndices<PointT>::filter (output); }
-  /** \brief Like pcl::Filter::filter for indices, with indices cleared first. */
-  void filter (pcl::Indices& indices) { indices.clear (); pcl::FilterIndices<PointT>::filter (indices); }
+  /** \brief Like pcl::Filter::filter, in place too (output the input cloud), but a failed call
+    * leaves the output empty, so it never holds stale points: not even with setKeepOrganized(),
+    * where PCL's base class would return the whole input cloud (a probe, 2026-12-07). */
+  void
+  filter (PointCloud& output)
+  {
+    // In place, PCL filters into a copy and assigns it: clearing the output first emptied the input
+    // before the query (a 307,200-point scan read "no finite point").
+    const bool in_place = &output == this->input_.get ();
+    if (!in_place)
+      output.clear ();
+    filter_failed_ = true;  // until applyFilter() succeeds: PCL skips it without an input cloud
+    pcl::FilterIndices<PointT>::filter (output);
+    if (filter_failed_)
+      output.clear ();
+    if (in_place)
+      markInput ();  // the input cloud changed: its model is rebuilt at the next query
+  }
+  /** \brief Like pcl::Filter::filter for indices, with indices cleared first (empty after a failed
+    * call). */
+  void
+  filter (pcl::Indices& indices)
+  {
+    indices.clear ();
+    filter_failed_ = true;
+    pcl::FilterIndices<PointT>::filter (indices);
+    if (filter_failed_)
+      indices.clear ();
+  }
 
 protected:
   /** \brief Runs an exhaustive per-point query and keeps the indices of A whose P_i reaches
@@ -259,6 +291,8 @@ private:
   bool input_dirty_ = true, target_dirty_ = true;
   bool input_prebuilt_ = false, target_prebuilt_ = false;
   RobustClassifier classifier_;
+  /** \brief Whether the last applyFilter() failed (set before it runs, cleared at its end). */
+  bool filter_failed_ = false;
 };
 } // namespace pcl_probcollision
 

@@ -36,7 +36,7 @@ buildCloudModel (const pcl::PointCloud<PointT>& cloud, const CloudModelParams& p
   // The merged model's inner build fingerprints the merged cloud first; this outer call, the
   // caller's cloud, sets it last.
   const auto model = std::const_pointer_cast<CloudModel> (CloudModel::buildFromCloud (cloud, params, indices, covariances, name));
-  model->source_fingerprint_ = cloudFingerprint (cloud);
+  model->source_fingerprint_ = cloudFingerprint (cloud, indices);
   return model;
 }
 

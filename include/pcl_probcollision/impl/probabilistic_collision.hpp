@@ -228,13 +228,15 @@ ProbabilisticCollision<PointT>::changedCloudError (const CloudModel& model, cons
 {
   if (const std::string stale = staleModelError (model, cloud, "input"); !stale.empty ())
     return stale;
-  // A model built from points directly has no fingerprint to compare.
-  if (model.sourceFingerprint () == 0 || model.sourceFingerprint () == cloudFingerprint (cloud))
+  // A model built from points directly has no fingerprint to compare. PCLBase stands "all
+  // points" in for indices never set: the model was built without them then.
+  const pcl::Indices* indices = this->use_indices_ ? this->indices_.get () : nullptr;
+  if (model.sourceFingerprint () == 0 || model.sourceFingerprint () == cloudFingerprint (cloud, indices))
     return std::string ();
-  return std::string ("the input model was built from a cloud of ") + std::to_string (model.sourceSize ()) +
-         " points other than the input cloud's (" +
-         (input_prebuilt_ ? "a model given by setInputModel() needs the cloud it was built from, or setInputModel (nullptr) "
-                            "to build one from the cloud"
+  return std::string ("the input model was built from other points than the input cloud's ") +
+         (indices ? "within its indices" : "(all of them: no setIndices)") + " (" +
+         (input_prebuilt_ ? "a model given by setInputModel() needs the cloud and indices it was built from, or "
+                            "setInputModel (nullptr) to build one from the cloud"
                           : "a cloud changed in place needs to be set again, or markForRebuild()") +
          ")";
 }
@@ -359,14 +361,22 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
 {
   indices.clear ();
   this->removed_indices_->clear ();
+  filter_failed_ = true;
   const CollisionRequest saved = request_;
   request_.per_point = true;
   request_.exhaustive = true;
+  // Every point's own answer. A cap stops where it stops (a planner's max_leaf_fits = 8 kept no
+  // point, with setNegative every point: a probe, 2026-12-07); the ladder picks one rung for the
+  // whole pair, so wherever the separators read collision every point got their values, which do
+  // not see deep into an object (METHOD.md 10.1): its surface layer answers each point instead.
+  request_.max_leaf_fits = 0;
+  request_.max_surface_pairs = 0;
+  request_.surface_ladder = false;
   CollisionResult result;
   const bool ok = compute (result);
   request_ = saved;
   if (!ok)
-    return;  // compute() printed the error; the output stays empty
+    return;  // compute() printed the error; filter() leaves the output empty
 
   const std::vector<float>& p = result.probabilities_a;
   // compute() checked the model's size against the input cloud; the indices kept below name the
@@ -390,13 +400,16 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
         this->removed_indices_->push_back (i);
       continue;
     }
-    // Never reached by the traversal (NaN) means far from B: probability 0.
-    const bool hit = !std::isnan (p[i]) && p[i] >= probability_threshold_;
+    // Never reached by the traversal (NaN) means far from B: probability 0 (kept at a threshold
+    // of 0, as every other point is).
+    const float pi = std::isnan (p[i]) ? 0.0f : p[i];
+    const bool hit = pi >= probability_threshold_;
     if (hit != this->negative_)
       indices.push_back (i);
     else if (this->extract_removed_indices_)
       this->removed_indices_->push_back (i);
   }
+  filter_failed_ = false;
 }
 } // namespace pcl_probcollision
 
