@@ -1324,6 +1324,14 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
     store (id);
   }
   area_ = sums[static_cast<std::size_t> (ProbabilisticBVH::rootId ())].area;
+  // A viewpoint within the cloud's bounding box (a room or a 360-degree scan seen from within,
+  // oriented by Viewpoint as asked: Auto does not take such a viewpoint): the surfaces wind
+  // around it, and behind them their winding numbers cancel (a room's floor and four walls put a
+  // point 2 cm under the floor at about 0.1, and a cube there read free, d = +2 cm: a probe,
+  // 2026-12-07). Behind is then measured from the viewpoint's own winding number.
+  view_winding_ = 0.0;
+  if (seen_from_view_ && orientation_ == NormalOrientation::Viewpoint && in.viewpoint && !view_outside)
+    view_winding_ = windingNumber (bvh, *in.viewpoint);
 
   // Each bin's plane for behindView, from the normals as they now are (repaired, smoothed),
   // turned toward the view.

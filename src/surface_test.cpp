@@ -1174,7 +1174,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       if (matters && deep)
       {
         const Eigen::Vector3d x_s = T_s_inverse * x;
-        const double winding = s_model.windingNumber (s_bvh, x_s);
+        const double winding = s_model.windingNumber (s_bvh, x_s) - s_model.viewWinding ();
         // Behind one scanned view, the sheets it saw may cancel: a box's top seen from straight
         // above and the table around it put 1-2 cm under the top at a winding number near 0.1,
         // and a 1 cm cube there read free (d = +5 mm).

@@ -160,6 +160,11 @@ public:
     * normals lie within 78 degrees of the line of sight (toward the viewpoint or away), at most a
     * tenth of those away, and at most kMaxHiddenShare of the points hidden behind others. */
   bool seenFromViewpoint () const { return seen_from_view_; }
+  /** \brief The winding number at the viewpoint where the surface is oriented by a viewpoint
+    * within the cloud's bounding box (a room or a 360-degree scan seen from within), 0 otherwise:
+    * the query measures how far a point lies behind the surface by its winding number less this
+    * one (about -1 inside a room, whose walls cancel behind its floor). */
+  double viewWinding () const { return view_winding_; }
   /** \brief Where seenFromViewpoint(): how far x (local frame) lies behind the surface the
     * viewpoint saw along x's line of sight: the least, over the 3 x 3 bins of directions about
     * x's (those of hiddenFromViewpoint(), two median spacings wide at the median depth), of x's
@@ -378,6 +383,7 @@ private:
   std::size_t unoriented_ = 0;
   std::size_t propagated_ = 0;
   double hidden_from_view_ = std::numeric_limits<double>::quiet_NaN ();
+  double view_winding_ = 0.0;
   bool seen_from_view_ = false;
   /** \brief Where seen_from_view_: its viewpoint's bins (behindView). */
   ViewBins view_bins_;

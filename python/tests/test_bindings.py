@@ -686,6 +686,46 @@ def test_normals_not_moved_with_their_points_are_set_aside(capfd):
     assert inside.verdict == pc.Verdict.InCollision, inside
 
 
+def test_a_room_scanned_from_within_holds_a_part_under_its_floor():
+    # A room's floor and four walls scanned from inside, oriented by that viewpoint as asked (Auto
+    # takes no viewpoint within the cloud's box): behind the floor its walls' winding numbers
+    # cancel the floor's, and a 1 cm cube 2 cm under the floor read free, d = +2 cm (8 of 10
+    # positions; a probe, 2026-12-07). Behind is now measured from the viewpoint's own winding
+    # number: the cube reads collision, unobserved; 1.8 cm over the floor it reads free.
+    rng = np.random.default_rng(4)
+    spacing, sigma = 0.03, 0.003
+
+    def face(origin, u, v, lu, lv):
+        a, b = np.meshgrid(np.arange(0, lu, spacing), np.arange(0, lv, spacing))
+        a = a.ravel() + rng.uniform(0, 0.6 * spacing, a.size)
+        b = b.ravel() + rng.uniform(0, 0.6 * spacing, b.size)
+        return np.asarray(origin, float) + np.outer(a, u) + np.outer(b, v)
+
+    room = np.vstack([face([0, 0, 0], [1, 0, 0], [0, 1, 0], 3, 3),
+                      face([0, 0, 0], [0, 1, 0], [0, 0, 1], 3, 2.5), face([0, 0, 0], [1, 0, 0], [0, 0, 1], 3, 2.5),
+                      face([3, 0, 0], [0, 1, 0], [0, 0, 1], 3, 2.5), face([0, 3, 0], [1, 0, 0], [0, 0, 1], 3, 2.5)])
+    room += rng.normal(0, sigma, room.shape)
+    params = pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(sigma), surface=True,
+                                 orientation=pc.NormalOrientation.Viewpoint)
+    scene = pc.build_model(room, params=params, viewpoint=[1.5, 1.5, 1.6, 1, 0, 0, 0])
+    assert scene.surface_orientation == pc.NormalOrientation.Viewpoint
+    corners = np.array([[x, y, z] for x in (-0.005, 0.005) for y in (-0.005, 0.005) for z in (-0.005, 0.005)])
+    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], dtype=np.int32)
+    points, normals = pc.sample_mesh_with_normals(corners, faces, 0.001, 1)
+    centre = points.mean(axis=0)
+    normals *= np.sign(np.sum((points - centre) * normals, axis=1))[:, None]  # outward, whatever the winding
+    cube = pc.build_model(points, np.zeros((len(points), 3, 3)), pc.CloudModelParams(surface=True), name="cube",
+                          normals=normals)
+    request = pc.CollisionRequest(surface=True, distance=True)
+    spots = rng.uniform(0.5, 2.5, (10, 2))
+    under = [pc.collide(scene, cube, translation(x, y, -0.025), request) for x, y in spots]
+    assert [r.verdict for r in under] == [pc.Verdict.InCollision] * 10, [(r.verdict, r.signed_distance) for r in under]
+    assert all(r.unobserved for r in under)
+    above = [pc.collide(scene, cube, translation(x, y, 0.023), request) for x, y in spots]
+    assert [r.verdict for r in above] == [pc.Verdict.Free] * 10, [(r.verdict, r.probability) for r in above]
+
+
 def test_surface_normals_and_orientation_options(sheets):
     a, b, A, B = sheets
     # The normals change the surface only: the points' model (origin, size) is the same.
