@@ -1012,6 +1012,16 @@ behindThreshold (const SurfaceModel& s)
   return s.orientation () == NormalOrientation::Viewpoint || !closedSurface (s) ? kBehindWinding : kInsideWinding;
 }
 
+/** \brief The winding number by which x (in `s`'s local frame) lies behind `s`, for
+  * behindThreshold: windingNumber less SurfaceModel::viewWinding() (not 0 only for a viewpoint
+  * within the cloud's box: a room seen from within, whose walls cancel behind its floor). The one
+  * reading of both behind tests, near the surface (testSide) and beyond its reach (insideOf). */
+double
+behindWinding (const SurfaceModel& s, const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
+{
+  return s.windingNumber (bvh, x) - s.viewWinding ();
+}
+
 /** \brief How far x (in `surface`'s local frame) lies behind what `surface`'s viewpoint saw
   * along its line of sight (SurfaceModel::behindView), where that is more than margin and x lies
   * within the scan's bounding box: space the sensor never observed, which the scan's object may
@@ -1174,7 +1184,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       if (matters && deep)
       {
         const Eigen::Vector3d x_s = T_s_inverse * x;
-        const double winding = s_model.windingNumber (s_bvh, x_s) - s_model.viewWinding ();
+        const double winding = behindWinding (s_model, s_bvh, x_s);
         // Behind one scanned view, the sheets it saw may cancel: a box's top seen from straight
         // above and the table around it put 1-2 cm under the top at a winding number near 0.1,
         // and a 1 cm cube there read free (d = +5 mm).
@@ -1320,7 +1330,7 @@ insideOf (const CloudModel& surface, const Eigen::Vector3d& x)
   const ProbabilisticBVH& bvh = surface.hierarchy ();
   const OrientedBox& bound = bvh.node (ProbabilisticBVH::rootId ()).box;
   return (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () <= 0.0 &&
-         surface.surface ().windingNumber (bvh, x) > behindThreshold (surface.surface ());
+         behindWinding (surface.surface (), bvh, x) > behindThreshold (surface.surface ());
 }
 
 /** \brief The points of `node` (of q_bvh, mapped into `surface`'s frame by T_s_q) that lie in the

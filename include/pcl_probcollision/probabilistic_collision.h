@@ -291,7 +291,8 @@ private:
   bool input_dirty_ = true, target_dirty_ = true;
   bool input_prebuilt_ = false, target_prebuilt_ = false;
   RobustClassifier classifier_;
-  /** \brief Whether the last applyFilter() failed (set before it runs, cleared at its end). */
+  /** \brief Whether the last applyFilter() failed: filter() sets it before, applyFilter() clears
+    * it at its end. */
   bool filter_failed_ = false;
 };
 } // namespace pcl_probcollision

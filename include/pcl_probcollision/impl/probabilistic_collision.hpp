@@ -308,16 +308,19 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
                              << threads << " must be >= 0 (0: one per hardware thread)");
   const std::size_t count = T_target_input.size ();
   results.assign (count, CollisionResult ());
-  // Poses compute() would refuse fail here; the others become queries in A's frame.
+  // Poses compute() would refuse fail here; the others become queries in A's frame, each of a
+  // rotation (rigidPose, once a pose: T_query keeps it for finishing the result; a refused pose
+  // keeps what was given, which its failed result never reads).
   std::vector<std::size_t> posed;
-  std::vector<Eigen::Isometry3d> T_input_target;
+  std::vector<Eigen::Isometry3d> T_query (T_target_input), T_input_target;
   for (std::size_t i = 0; i < count; ++i)
   {
     results[i].message = detail::poseError (T_target_input[i], "T_target_input");
     if (results[i].message.empty ())
     {
       posed.push_back (i);
-      T_input_target.push_back (detail::rigidPose (T_target_input[i]).inverse ());
+      T_query[i] = detail::rigidPose (T_target_input[i]);
+      T_input_target.push_back (T_query[i].inverse ());
     }
   }
   // Every pose is finished and handed over in pose order: those up to `end` once results hold them.
@@ -326,7 +329,7 @@ ProbabilisticCollision<PointT>::computeBatch (const std::vector<Eigen::Isometry3
   auto handOverUpTo = [&] (std::size_t end) {
     for (; handed < end; ++handed)
     {
-      finishBatchResult (handed, detail::rigidPose (T_target_input[handed]), prepared.build_ms, results[handed], failed);
+      finishBatchResult (handed, T_query[handed], prepared.build_ms, results[handed], failed);
       if (ready)
         ready (handed);
     }
@@ -361,7 +364,6 @@ ProbabilisticCollision<PointT>::applyFilter (pcl::Indices& indices)
 {
   indices.clear ();
   this->removed_indices_->clear ();
-  filter_failed_ = true;
   const CollisionRequest saved = request_;
   request_.per_point = true;
   request_.exhaustive = true;
