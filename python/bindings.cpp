@@ -583,9 +583,29 @@ requestOf (const py::object& obj)
   return request;
 }
 
-CollisionResult
-collideOne (const ModelPtr& a, const ModelPtr& b, const py::object& pose, const py::object& request_obj)
+/** \brief pcd_collision's units warning (io::scaleWarning) for two models, as a RuntimeWarning:
+  * a model built from millimetres queried against one in metres answers for the numbers given (a
+  * plate stuck through a table read free). Python shows it once a calling line by default. */
+void
+warnUnits (const CloudModel& a, const CloudModel& b)
 {
+  const auto facts = [] (const char* name, const CloudModel& m) {
+    io::InputFacts in;
+    in.path = name;
+    in.finite = m.size ();
+    in.diagonal = m.diagonal ();
+    return in;
+  };
+  const std::string warning = io::scaleWarning (facts ("a", a), facts ("b", b));
+  if (!warning.empty () && PyErr_WarnEx (PyExc_RuntimeWarning, warning.c_str (), 1) < 0)
+    throw py::error_already_set ();
+}
+
+CollisionResult
+collideOne (const ModelPtr& a, const ModelPtr& b, const py::object& pose, const py::object& request_obj, bool check_units)
+{
+  if (check_units)
+    warnUnits (*a, *b);
   const Eigen::Isometry3d T = toPose (pose, "pose");
   const CollisionRequest request = requestOf (request_obj);
   CollisionResult result;
@@ -756,10 +776,12 @@ runInterruptibly (std::size_t count, Work&& work)
 
 std::vector<CollisionResult>
 collideMany (const ModelPtr& a, const ModelPtr& b, const py::object& poses_obj, const py::object& request_obj,
-             const ThreadsArg& threads_arg)
+             const ThreadsArg& threads_arg, bool check_units)
 {
   const auto poses = poseArray (poses_obj);
   const int threads = checkThreads (threads_arg);
+  if (check_units)
+    warnUnits (*a, *b);
   const CollisionRequest request = requestOf (request_obj);
   const auto p = poses.unchecked<3> ();
   std::vector<Eigen::Isometry3d> T (static_cast<std::size_t> (p.shape (0)));
@@ -1809,6 +1831,8 @@ PYBIND11_MODULE (_core, m)
                               "median_spacing() of the points, read from the build's own neighbour search (the same number);\n"
                               "NaN when the build did not search the whole cloud (covariances given, merged samples) or cannot tell.")
       .def_property_readonly ("precision_ratio", &CloudModel::precisionRatio)
+      .def_property_readonly ("diagonal", &CloudModel::diagonal,
+                              "Bounding-box diagonal of the model's points, data units (collide() judges units by it).")
       .def_property_readonly ("params", [] (const CloudModel& c) { return c.params (); },
                               "A copy of the CloudModelParams it was built with (the model is immutable).")
       .def_property_readonly ("has_surface", [] (const CloudModel& c) { return !c.surface ().empty (); },
@@ -1962,19 +1986,21 @@ PYBIND11_MODULE (_core, m)
   m.attr ("PCD_COLLISION_MESH_SEED") = pcd_collision::Defaults::mesh_sampling_seed;
   // .none (false): None is not a model (pybind11 would pass a null pointer; found in review).
   m.def ("collide", &collideOne, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("pose"),
-         py::arg ("request") = py::none (),
+         py::arg ("request") = py::none (), py::kw_only (), py::arg ("check_units") = true,
          "Probability that the objects of models a and b collide, b placed in a's frame by pose = T_a_b\n"
          "(a 4x4 rigid transform, or a pair (R, t)), exactly as the C++ collide(). A rotation rounded to a few\n"
          "digits (R^T R within 1e-2 of the identity: a quaternion printed with 3 decimals) is taken to its\n"
          "nearest rotation.\n\n"
          "request: CollisionRequest (None = CollisionRequest()). Returns a CollisionResult.\n"
-         "ValueError (with the C++ message) for a non-rigid or non-finite pose or an invalid request.");
+         "ValueError (with the C++ message) for a non-rigid or non-finite pose or an invalid request.\n"
+         "check_units: a RuntimeWarning, pcd_collision's, when the models' sizes (CloudModel.diagonal) differ by over\n"
+         "    100x: most likely one is in millimetres and the other in metres (the answer is for the numbers given).");
   m.def ("collide_batch", &collideMany, py::arg ("a").none (false), py::arg ("b").none (false), py::arg ("poses"),
-         py::arg ("request") = py::none (), py::arg ("threads") = 0,
+         py::arg ("request") = py::none (), py::arg ("threads") = 0, py::kw_only (), py::arg ("check_units") = true,
          "collide() for each pose of an (M, 4, 4) array, on `threads` threads (0 = all cores), GIL released.\n\n"
          "Returns a list of M CollisionResult in pose order, each equal to collide(a, b, poses[i], request)\n"
          "(timings aside). ValueError naming the first invalid pose, or naming threads outside [0, MAX_THREADS]\n"
-         "(as pcd_collision refuses -threads).");
+         "(as pcd_collision refuses -threads). check_units as collide()'s.");
   m.def ("verdict_for", &verdictFor, py::arg ("probability"), py::arg ("request"),
          "The verdict of a probability under a request's thresholds (Unknown for NaN). ValueError naming\n"
          "free_below or collision_above when out of range (free_below in (0, 0.5], collision_above in [0.5, 1)),\n"

@@ -111,9 +111,14 @@ CloudModel::buildLocal (UncertainCloud&& points, std::vector<PackedCovariance>&&
   const Eigen::Vector3d centroid = sum / static_cast<double> (points.size ());
   if (centroid.allFinite ())
   {
+    Eigen::AlignedBox3d box;
     for (Eigen::Vector3d& m : points.means)
+    {
       m -= centroid;
+      box.extend (m);
+    }
     origin_ = centroid;
+    diagonal_ = box.isEmpty () ? 0.0 : box.diagonal ().norm ();
   }
   if (packed.empty ())
     bvh_.build (std::move (points), hierarchy, threads);

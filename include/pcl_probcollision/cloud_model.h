@@ -149,6 +149,10 @@ public:
     * cloud's) or cannot tell (a sampled point with more than k coincident neighbours); the caller
     * then measures it itself. */
   double medianNeighbourSpacing () const { return neighbour_spacing_; }
+  /** \brief Bounding-box diagonal of the model's points (their means, merged ones where samples
+    * were merged), in data units; 0 for a single point. What Python's collide() judges units by
+    * (io::scaleWarning): a millimetre model against a metre one differs by about 1000x. */
+  double diagonal () const { return diagonal_; }
   /** \brief The oriented surface (METHOD.md 10a), in the local frame; empty() when built
     * with CloudModelParams::surface off. */
   const SurfaceModel& surface () const { return surface_; }
@@ -263,6 +267,7 @@ private:
   CloudModelParams params_;
   double build_ms_ = 0.0;
   double neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();
+  double diagonal_ = 0.0;
   double precision_ratio_ = 0.0;
   std::string warning_;
 };

@@ -1182,6 +1182,30 @@ def test_load_model_warns_of_a_double_file_rounded_far_from_the_origin(tmp_path)
     assert "float spacing" in quiet.warning
 
 
+def test_collide_warns_when_the_models_sizes_differ_as_pcd_collision_does(table_points):
+    # A model built from millimetres against one in metres answers for the numbers given (a plate
+    # through a table reads free): collide and collide_batch say so with pcd_collision's words.
+    points = table_points[np.isfinite(table_points).all(axis=1)]
+    metres = pc.build_model(points)
+    millimetres = pc.build_model(points * 1000.0, params=pc.CloudModelParams(noise=pc.SensorNoiseModel.isotropic(5.0)))
+    assert metres.diagonal == pytest.approx(pc._core.finite_diagonal(points), rel=1e-6)
+    expected = pc._core.scale_warning(
+        pc._core.InputFacts(path="a", finite=len(metres), diagonal=metres.diagonal),
+        pc._core.InputFacts(path="b", finite=len(millimetres), diagonal=millimetres.diagonal))
+    assert expected.startswith("the inputs' sizes differ by 999x") and "in 'a'" in expected  # float rounding
+    with pytest.warns(RuntimeWarning) as caught:
+        pc.collide(metres, millimetres, np.eye(4))
+    assert [str(w.message) for w in caught] == [expected]
+    with pytest.warns(RuntimeWarning, match=r"^the inputs' sizes differ by 999x"):
+        pc.collide_batch(millimetres, metres, np.eye(4)[None], threads=1)
+    # The same units, or check_units=False: not a word.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pc.collide(metres, metres, np.eye(4))
+        pc.collide_batch(metres, millimetres, np.eye(4)[None], threads=1, check_units=False)
+        pc.collide(millimetres, metres, np.eye(4), check_units=False)
+
+
 def test_input_warnings_are_pcd_collisions():
     # The rules and words pcd_collision prints (io/input_warnings.h), as the Dask command line uses them.
     core = pc._core

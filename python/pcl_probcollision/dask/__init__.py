@@ -421,7 +421,9 @@ def answer_chunk(a: Dict[str, Any], b: Dict[str, Any], T_b_a: np.ndarray, start:
     the models' build time and surface summaries."""
     A = _model(a, o, "a")
     B = _model(b, o, "b")
-    results = core.collide_batch(A, B, core.invert_poses(T_b_a), request_of(o), threads=int(o["threads"]))
+    # check_units=False: collide_poses said it once, as pcd_collision does, not once a chunk.
+    results = core.collide_batch(A, B, core.invert_poses(T_b_a), request_of(o), threads=int(o["threads"]),
+                                 check_units=False)
     n = len(results)
     out: Dict[str, np.ndarray] = {
         "index": np.arange(start, start + n, dtype=np.int64),
