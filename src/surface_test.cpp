@@ -874,7 +874,12 @@ crossPair (Scratch& scratch, const Scratch::Outside& a, const Scratch::Outside& 
     b_end = &b;
     b_reach = b.distance;
   }
-  if (!surrounded (x, first, kCrossingSpacings, inPool (scratch.pool, x_key), scratch.cache))
+  // Where evaluate found the face ended short of x (past_edge: no sample of it beyond x within
+  // the bridging reach), no sample band around x says the sheet reaches it: samples of a side
+  // face near the edge, within the band of a's face plane tilted by a corner's blended normal,
+  // surrounded x under a gripper's fingertip, and a sparse table passing 2.5-3 mm under it read
+  // as crossing the finger, P = 1 (an approach-sweep probe, 2026-12-07).
+  if (at.past_edge || !surrounded (x, first, kCrossingSpacings, inPool (scratch.pool, x_key), scratch.cache))
   {
     const double h = std::max (first.spacing, 1e-12);
     const double spread = std::hypot (kDiscretisationPerDistance * h, std::max (a.sigma, b.sigma));

@@ -726,6 +726,34 @@ def test_a_room_scanned_from_within_holds_a_part_under_its_floor():
     assert [r.verdict for r in above] == [pc.Verdict.Free] * 10, [(r.verdict, r.probability) for r in above]
 
 
+def test_a_sparse_table_passing_under_a_fingertip_is_no_crossing():
+    # The gripper's exact samples (its corners' vertices carry blended normals) over a table
+    # sampled every 12 mm, 1 mm noise: a pair of table points either side of a finger, passing
+    # 2.5-3 mm under its tip, read as crossing the finger (P = 1) at 3 of these 64 layouts, where
+    # the fingertip's face had ended short of the crossing point (past its edge) but samples of the
+    # side faces, within a corner-tilted plane's band, surrounded it. 3 mm into the table every
+    # layout reads collision.
+    v, f = pc.read_mesh(DATA / "gripper.obj")
+    points, normals = pc.sample_mesh_with_normals(v, f, 0.003, 20111)
+    params = lambda noise: pc.CloudModelParams(noise=noise, surface=True, threads=1)
+    gripper = pc.build_model(np.asarray(points, float), params=params(pc.SensorNoiseModel.none()),
+                             normals=np.asarray(normals, float), warn=False)
+    spacing = 0.012
+    for height, clear in ((-0.0025, True), (-0.003, True), (0.003, False)):
+        answers = []
+        for x0 in np.arange(0.0, spacing, 0.0015):
+            for y0 in np.arange(0.0, spacing, 0.003):
+                X, Y = np.meshgrid(np.arange(-0.09, 0.09, spacing) + x0, np.arange(-0.05, 0.05, spacing) + y0)
+                table = pc.build_model(np.stack([X.ravel(), Y.ravel(), np.full(X.size, height)], 1),
+                                       params=params(pc.SensorNoiseModel.isotropic(0.001)),
+                                       viewpoint=(0, 0, 1, 1, 0, 0, 0), warn=False)
+                answers.append(pc.collide(table, gripper, np.eye(4), pc.CollisionRequest(surface=True)).verdict)
+        if clear:
+            assert pc.Verdict.InCollision not in answers, (height, answers)
+        else:
+            assert answers == [pc.Verdict.InCollision] * len(answers), (height, answers)
+
+
 def test_surface_normals_and_orientation_options(sheets):
     a, b, A, B = sheets
     # The normals change the surface only: the points' model (origin, size) is the same.
