@@ -1822,6 +1822,8 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("merged_samples", &CloudModel::mergedSamples,
                               "Finite rows merged into another by noise_resolution (size is the finite rows minus these);\n"
                               "0 when none merged.")
+      .def_property_readonly ("coincident_samples", &CloudModel::coincidentSamples,
+                              "Samples exactly at an earlier sample's position (and normal), modelled once with it; 0 when none.")
       .def_property_readonly ("origin", [] (const CloudModel& c) { return vec3 (c.origin ()); },
                               "Local frame origin (the centroid), in the cloud's frame.")
       .def_property_readonly ("warning", &CloudModel::warning, "A precision warning about the input, '' when none.")

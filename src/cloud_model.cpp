@@ -160,6 +160,50 @@ CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size,
 }
 
 void
+CloudModel::adoptCoincident (std::size_t source_size, std::size_t candidates, const std::vector<int>& distinct_of,
+                             const std::vector<int>& seeds, double spacing)
+{
+  if (full_resolution_)
+    const_cast<CloudModel&> (*full_resolution_).adoptCoincident (source_size, candidates, distinct_of, seeds, spacing);
+  // A merged model's stays NaN (measured on no cloud of the caller's).
+  if (!std::isnan (neighbour_spacing_))
+    neighbour_spacing_ = spacing;
+  // The model point of each distinct sample: through a merge's map where its samples merged.
+  std::vector<int> point_of_distinct;
+  if (!point_of_source_.empty ())
+    point_of_distinct = std::move (point_of_source_);
+  else
+  {
+    point_of_distinct.assign (seeds.size (), -1);
+    for (std::size_t j = 0; j < bvh_.size (); ++j)
+      point_of_distinct[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
+  }
+  // Hierarchy source indices name distinct samples, or a merge's seeds among them.
+  if (representatives_.empty ())
+    representatives_ = seeds;
+  else
+    for (int& r : representatives_)
+      r = seeds[static_cast<std::size_t> (r)];
+  detail::assignHugePages (point_of_source_, source_size, -1);
+  std::size_t samples = 0, mapped = 0;
+  for (std::size_t i = 0; i < distinct_of.size () && i < source_size; ++i)
+  {
+    const int c = distinct_of[i];
+    if (c < 0)
+      continue;
+    ++samples;
+    if (point_of_distinct[static_cast<std::size_t> (c)] >= 0)
+    {
+      point_of_source_[i] = point_of_distinct[static_cast<std::size_t> (c)];
+      ++mapped;
+    }
+  }
+  coincident_samples_ = samples - seeds.size ();
+  skipped_ = candidates - mapped;
+  source_size_ = source_size;
+}
+
+void
 CloudModel::addWarning (const std::string& text)
 {
   warning_ = warning_.empty () ? text : warning_ + "; " + text;

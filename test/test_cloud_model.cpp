@@ -321,6 +321,77 @@ TEST (CloudModel, BuiltFromPointsKeepsSourceIndicesForPerPointResults)
   EXPECT_FALSE (std::isnan (r.probabilities_a[2]));
 }
 
+// Exactly coincident samples are modelled once (detail::mergeCoincident): every point of a
+// stereo scan duplicated moved 27 of 100 near-contact verdicts toward free (a probe,
+// 2026-12-07). A cloud with every point twice (interleaved) and a copy appended answers
+// bit for bit as the cloud once, and every sample gets its position's per-point value.
+TEST (CloudModel, CoincidentSamplesAreModelledOnce)
+{
+  const Cloud::Ptr once = sheet (0.2, 0.01, 0.002, 41);
+  Cloud twice;
+  for (const auto& p : *once)
+  {
+    twice.push_back (p);
+    twice.push_back (p);
+  }
+  twice += *once;
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.002);
+  params.threads = 1;
+  const auto a = buildCloudModel (*once, params);
+  const auto b = buildCloudModel (twice, params);
+  EXPECT_EQ (a->coincidentSamples (), 0u);
+  EXPECT_EQ (b->coincidentSamples (), 2 * once->size ());
+  EXPECT_EQ (b->size (), a->size ());
+  EXPECT_EQ (b->sourceSize (), twice.size ());
+  EXPECT_EQ (b->skippedPoints (), 0u);
+  const Cloud::Ptr probe = sheet (0.05, 0.005, 0.002, 42);
+  const auto q = buildCloudModel (*probe, params);
+  CollisionRequest request;
+  request.per_point = true;
+  for (const double z : {0.012, 0.004, 0.0, -0.004})
+  {
+    const Eigen::Isometry3d T (Eigen::Translation3d (0.01, -0.02, z));
+    CollisionResult ra, rb;
+    ASSERT_TRUE (collide (*a, *q, T, request, ra)) << ra.message;
+    ASSERT_TRUE (collide (*b, *q, T, request, rb)) << rb.message;
+    EXPECT_EQ (rb.probability, ra.probability) << z;
+    EXPECT_EQ (rb.verdict, ra.verdict) << z;
+    ASSERT_EQ (rb.probabilities_a.size (), twice.size ());
+    for (std::size_t i = 0; i < once->size (); ++i)
+    {
+      const float expected = ra.probabilities_a[i];
+      for (const std::size_t j : {2 * i, 2 * i + 1, 2 * once->size () + i})
+        EXPECT_TRUE (rb.probabilities_a[j] == expected || (std::isnan (expected) && std::isnan (rb.probabilities_a[j])))
+            << "z " << z << " sample " << j;
+    }
+    if (ra.witness_side > 0)
+      EXPECT_EQ (rb.witness_index, 2 * ra.witness_index) << "the first of the coincident samples";
+  }
+  // Indices: only coincident samples within them count.
+  pcl::Indices first_copy (once->size ());
+  for (std::size_t i = 0; i < once->size (); ++i)
+    first_copy[i] = static_cast<int> (2 * i);
+  EXPECT_EQ (buildCloudModel (twice, params, &first_copy)->coincidentSamples (), 0u);
+  pcl::Indices both (first_copy);
+  both.push_back (static_cast<int> (2 * once->size ()));
+  EXPECT_EQ (buildCloudModel (twice, params, &both)->coincidentSamples (), 1u);
+  // A mesh's vertex repeated per face, each copy with its face's normal, stays apart.
+  pcl::PointCloud<pcl::PointNormal> soup;
+  for (const auto& p : *once)
+    for (const float nz : {1.0f, -1.0f})
+    {
+      pcl::PointNormal pn;
+      pn.getVector3fMap () = p.getVector3fMap ();
+      pn.getNormalVector3fMap () = Eigen::Vector3f (0.0f, 0.0f, nz);
+      soup.push_back (pn);
+    }
+  params.surface = true;
+  EXPECT_EQ (buildCloudModel (soup, params)->coincidentSamples (), 0u);
+  soup += soup;
+  EXPECT_EQ (buildCloudModel (soup, params)->coincidentSamples (), 2 * once->size ());
+}
+
 // ---- ProbabilisticCollision: models rebuilt when a cloud is set again (issue #15) ----------
 
 namespace

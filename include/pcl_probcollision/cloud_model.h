@@ -170,13 +170,18 @@ public:
   /** \brief Samples merged into another (CloudModelParams::noise_resolution): the finite
     * samples in the model minus size(); 0 when none merged. */
   std::size_t mergedSamples () const { return merged_samples_; }
-  /** \brief When samples were merged: per index of the caller's cloud, the model point (index
-    * into hierarchy().means()) that stands for it, -1 when none does (non-finite, outside the
-    * indices). Empty when none merged: point j then stands for hierarchy().sourceIndex(j) alone. */
+  /** \brief Samples exactly coincident with an earlier one of the cloud (x y z equal, and the
+    * normal for point types with one), modelled once with it: every point of a scan duplicated
+    * collapsed its neighbourhoods and moved near-contact verdicts toward free. 0 when none. */
+  std::size_t coincidentSamples () const { return coincident_samples_; }
+  /** \brief When samples were merged or coincided: per index of the caller's cloud, the model
+    * point (index into hierarchy().means()) that stands for it, -1 when none does (non-finite,
+    * outside the indices). Empty when none merged nor coincided: point j then stands for
+    * hierarchy().sourceIndex(j) alone. */
   const std::vector<int>& pointOfSource () const { return point_of_source_; }
   /** \brief The caller's index of the sample a model point's hierarchy source index names:
-    * hierarchy().sourceIndex(j) itself when none merged, else the index of the sample its
-    * merge was seeded from. */
+    * hierarchy().sourceIndex(j) itself when none merged nor coincided, else the index of the
+    * sample its merge was seeded from (the first of coincident ones). */
   int sourceIndex (int hierarchy_source) const
   {
     return representatives_.empty () || hierarchy_source < 0 ? hierarchy_source
@@ -239,6 +244,12 @@ private:
     * Sets warning() where the merge left no more points than the covariance estimation's k. */
   void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
                    const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name);
+  /** \brief Takes a model built from a cloud's distinct samples (detail::mergeCoincident:
+    * distinct_of per index of the caller's cloud, seeds per distinct sample) back to the caller's
+    * cloud, as adoptMerge does, and its full-resolution model with it; a model that measured
+    * its spacing takes spacing, the caller's cloud's. */
+  void adoptCoincident (std::size_t source_size, std::size_t candidates, const std::vector<int>& distinct_of,
+                        const std::vector<int>& seeds, double spacing);
   /** \brief Appends text to warning(), after "; " where it says something already. */
   void addWarning (const std::string& text);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
@@ -261,6 +272,7 @@ private:
   std::uint64_t source_fingerprint_ = 0;
   std::size_t skipped_ = 0;
   std::size_t merged_samples_ = 0;
+  std::size_t coincident_samples_ = 0;
   std::vector<int> point_of_source_;
   std::vector<int> representatives_;
   std::shared_ptr<const CloudModel> full_resolution_;

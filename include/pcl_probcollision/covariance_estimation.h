@@ -94,6 +94,10 @@ public:
     * coincident while more points exist). What io::medianSpacing() measures, without a second
     * search (CloudModel::medianNeighbourSpacing). */
   const std::vector<float>& getNearestSquaredDistances () const { return nearest_sqr_; }
+  /** \brief After compute(): true when some finite point of the input has another at exactly
+    * its position (x y z equal) among its neighbours, with the input as its own search surface.
+    * buildCloudModel() then models each position once (CloudModel::coincidentSamples()). */
+  bool hasCoincidentPoints () const { return coincident_; }
 
   /** \brief Locally denoised positions (default on, as CloudModelParams::surface_projection,
     * chosen by the evaluation; needs a sensor noise model: without one nothing moves).
@@ -177,6 +181,7 @@ private:
   std::optional<SensorPose> sensor_pose_;
   std::vector<float> radii_;
   std::vector<float> nearest_sqr_;
+  bool coincident_ = false;
   bool project_ = true;  // CloudModelParams::surface_projection; test_cloud_model checks they agree
   std::vector<Eigen::Vector3d> displacements_;
   bool compute_surface_ = false;

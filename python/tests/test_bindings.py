@@ -726,6 +726,19 @@ def test_a_room_scanned_from_within_holds_a_part_under_its_floor():
     assert [r.verdict for r in above] == [pc.Verdict.Free] * 10, [(r.verdict, r.probability) for r in above]
 
 
+def test_coincident_samples_are_modelled_once(table_points):
+    # Every point twice (np.repeat) answers as the cloud once, bit for bit.
+    points = table_points[np.isfinite(table_points).all(axis=1)][::7]
+    once, twice = pc.build_model(points), pc.build_model(np.repeat(points, 2, axis=0))
+    assert (once.coincident_samples, twice.coincident_samples) == (0, len(points))
+    assert len(twice) == len(once)
+    probe = pc.build_model(points[:200] + np.array([0.0, 0.0, 0.004], dtype=points.dtype))
+    request = pc.CollisionRequest(per_point=True)
+    r1, r2 = pc.collide(once, probe, np.eye(4), request), pc.collide(twice, probe, np.eye(4), request)
+    assert r2.probability == r1.probability
+    np.testing.assert_array_equal(np.asarray(r2.probabilities_a), np.repeat(np.asarray(r1.probabilities_a), 2))
+
+
 def test_a_sparse_table_passing_under_a_fingertip_is_no_crossing():
     # The gripper's exact samples (its corners' vertices carry blended normals) over a table
     # sampled every 12 mm, 1 mm noise: a pair of table points either side of a finger, passing

@@ -122,7 +122,9 @@ TEST (MedianSpacing, AMergedModelKeepsTheCloudsSpacingInItsFullResolutionRung)
     ASSERT_NE (model->fullResolution (), nullptr) << threads << " threads";
     EXPECT_TRUE (std::isnan (model->medianNeighbourSpacing ()));
     EXPECT_EQ (model->fullResolution ()->medianNeighbourSpacing (), io) << threads << " threads";
-    EXPECT_EQ (model->fullResolution ()->size () + model->fullResolution ()->skippedPoints (), cloud.size ());
+    EXPECT_EQ (model->fullResolution ()->size () + model->fullResolution ()->skippedPoints () +
+                   model->fullResolution ()->coincidentSamples (),
+               cloud.size ());
   }
 }
 

@@ -282,6 +282,40 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
       detail::reserveHugePages (to, from.size ());
       to.assign (from.begin (), from.end ());
     };
+    // medianNeighbourSpacing(): io::medianSpacing's rule on the estimation's own search, whose
+    // k-d tree holds the cloud's finite points in cloud order as medianSpacing's does, so that
+    // the squared distances, and the number, are the same.
+    const std::vector<float>& nearest_sqr = estimation.getNearestSquaredDistances ();
+    if (!indices && nearest_sqr.size () == n)
+    {
+      std::size_t finite = 0;
+      for (std::size_t j = 0; j < n; ++j)
+        finite += pcl::isXYZFinite (cloud[j]) ? 1 : 0;
+      std::size_t ordinal = 0, j = 0;  // the ordinal-th finite point is cloud[j]; asked in increasing order
+      neighbour_spacing = detail::medianNearestSpacing (finite, detail::kSpacingQueries, [&] (std::size_t i) {
+        for (; j < n; ++j)
+          if (pcl::isXYZFinite (cloud[j]) && ordinal++ == i)
+            break;
+        const float v = nearest_sqr[j++];
+        return std::isnan (v) ? std::numeric_limits<double>::quiet_NaN () : std::sqrt (static_cast<double> (v));
+      });
+    }
+    // Exactly coincident samples (a cloud concatenated with itself): the model of each position
+    // once (detail::mergeCoincident), mapped back to every sample, with the spacing measured
+    // above (io::medianSpacing's, which skips coincident neighbours). Found by the neighbour
+    // search itself, so a cloud without any pays nothing; one with them is estimated again.
+    if (!covariances && estimation.hasCoincidentPoints ())
+    {
+      pcl::PointCloud<PointT> distinct;
+      std::vector<int> distinct_of, seeds;
+      if (detail::mergeCoincident (cloud, indices, distinct, distinct_of, seeds))
+      {
+        const auto model = std::const_pointer_cast<CloudModel> (buildCloudModel (distinct, params, nullptr, nullptr, name));
+        model->adoptCoincident (cloud.size (), n, distinct_of, seeds, neighbour_spacing);
+        model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
+        return model;
+      }
+    }
     copyOf (estimation.getNeighbourRadii (), radii);
     // Sampled finer than its noise (ResolutionGate::WholeCloud): the merged cloud's model instead,
     // the estimation above spent once. A cloud sampled coarser goes on, modelled as unmerged.
@@ -324,24 +358,6 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
     copyOf (estimation.getSurfaceDisplacements (), displacements);
     copyOf (estimation.getNormals (), normals);
     copyOf (estimation.getNeighbours (), neighbours);
-    // medianNeighbourSpacing(): io::medianSpacing's rule on the estimation's own search, whose
-    // k-d tree holds the cloud's finite points in cloud order as medianSpacing's does, so that
-    // the squared distances, and the number, are the same.
-    const std::vector<float>& nearest_sqr = estimation.getNearestSquaredDistances ();
-    if (!indices && nearest_sqr.size () == n)
-    {
-      std::size_t finite = 0;
-      for (std::size_t j = 0; j < n; ++j)
-        finite += pcl::isXYZFinite (cloud[j]) ? 1 : 0;
-      std::size_t ordinal = 0, j = 0;  // the ordinal-th finite point is cloud[j]; asked in increasing order
-      neighbour_spacing = detail::medianNearestSpacing (finite, detail::kSpacingQueries, [&] (std::size_t i) {
-        for (; j < n; ++j)
-          if (pcl::isXYZFinite (cloud[j]) && ordinal++ == i)
-            break;
-        const float v = nearest_sqr[j++];
-        return std::isnan (v) ? std::numeric_limits<double>::quiet_NaN () : std::sqrt (static_cast<double> (v));
-      });
-    }
   }
 
   // The model's points: the finite ones with a finite covariance, in cloud order. Chunks count

@@ -345,6 +345,7 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
   radii_.clear ();
   nearest_sqr_.clear ();
   displacements_.clear ();
+  coincident_ = false;
   if (this->search_radius_ != 0.0)
   {
     PCL_ERROR ("[pcl_probcollision::%s::initCompute] radius search (%g) is not supported: the "
@@ -554,6 +555,7 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   };
   std::vector<Scratch> scratch (std::min (workers, std::max<std::size_t> (blocks, 1)));
   std::vector<char> block_dense (blocks, 1);
+  std::vector<char> block_coincident (blocks, 0);  // hasCoincidentPoints()
 
   detail::parallelFor (blocks, workers, [&] (std::size_t blk, std::size_t worker) {
     Scratch& s = scratch[worker];
@@ -600,6 +602,9 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
       // its duplicates come back at 0): getNearestSquaredDistances().
       const std::size_t found = static_cast<std::size_t> (std::max (block.found[b], 0));
       const float* positive = std::find_if (row_sqr_dists, row_sqr_dists + found, [] (float v) { return v > 0.f; });
+      // The point itself and another at its very position: both at distance 0.
+      if (same_cloud && positive - row_sqr_dists >= 2)
+        block_coincident[blk] = 1;
       if (positive != row_sqr_dists + found)
         nearest_sqr_[out] = *positive;
       else if (found >= finite_surface)
@@ -673,6 +678,7 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
     }
   });
   output.is_dense = std::all_of (block_dense.begin (), block_dense.end (), [] (char d) { return d != 0; });
+  coincident_ = std::any_of (block_coincident.begin (), block_coincident.end (), [] (char c) { return c != 0; });
 }
 } // namespace pcl_probcollision
 
