@@ -1822,6 +1822,9 @@ PYBIND11_MODULE (_core, m)
       .def_property_readonly ("merged_samples", &CloudModel::mergedSamples,
                               "Finite rows merged into another by noise_resolution (size is the finite rows minus these);\n"
                               "0 when none merged.")
+      .def_property_readonly ("neighbour_scatter_ratio", &CloudModel::neighbourScatterRatio,
+                              "Median ratio of the middle to the largest spread of each point's k nearest neighbours: about 0.6 on a\n"
+                              "surface scan, near 0 where the samples lie along lines (a LiDAR's rings: warning says so).")
       .def_property_readonly ("coincident_samples", &CloudModel::coincidentSamples,
                               "Samples exactly at an earlier sample's position (and normal), modelled once with it; 0 when none.")
       .def_property_readonly ("origin", [] (const CloudModel& c) { return vec3 (c.origin ()); },

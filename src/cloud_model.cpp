@@ -7,6 +7,8 @@
 #include <pcl/point_types.h>
 #include <pcl/impl/instantiate.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <memory>
@@ -201,6 +203,36 @@ CloudModel::adoptCoincident (std::size_t source_size, std::size_t candidates, co
   coincident_samples_ = samples - seeds.size ();
   skipped_ = candidates - mapped;
   source_size_ = source_size;
+}
+
+void
+CloudModel::assessScanLines (const std::string& name)
+{
+  const std::vector<Eigen::Vector3d>& means = bvh_.means ();
+  if (!(neighbour_scatter_ratio_ < kScanLineRatio) || means.size () < 3)
+    return;
+  // The points' own spread (the hierarchy's boxes are grown by the noise), from up to ~10,000.
+  const std::size_t stride = std::max<std::size_t> (1, means.size () / 10000);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero ();
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero ();
+  double count = 0.0;
+  for (std::size_t i = 0; i < means.size (); i += stride)
+  {
+    sum += means[i];
+    second.noalias () += means[i] * means[i].transpose ();
+    count += 1.0;
+  }
+  const Eigen::Vector3d mean = sum / count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  const Eigen::Vector3d l = solver.computeDirect (second / count - mean * mean.transpose (), Eigen::EigenvaluesOnly).eigenvalues ();
+  if (!(l[1] > 0.0 && std::sqrt (l[1] / l[2]) >= kScanLineExtentRatio))
+    return;
+  std::ostringstream out;
+  out.precision (2);
+  out << name << ": its samples lie along lines, as a LiDAR's rings do (each point's nearest neighbours spread "
+      << neighbour_scatter_ratio_ << " as wide as long, a surface scan's about 0.6): the model measures their spacing "
+      << "along the lines, and a part lying between two lines can read free (docs/RELIABILITY.md)";
+  addWarning (out.str ());  // buildCloudModel prints warning() once
 }
 
 void

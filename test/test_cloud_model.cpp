@@ -392,6 +392,52 @@ TEST (CloudModel, CoincidentSamplesAreModelledOnce)
   EXPECT_EQ (buildCloudModel (soup, params)->coincidentSamples (), 2 * once->size ());
 }
 
+// Scan lines spread over an area (a LiDAR's rings on a floor) are warned of: between two rings a
+// part read free (docs/RELIABILITY.md). A surface scan, a rod and a cable over a table are not.
+TEST (CloudModel, ScanLinesOverAnAreaAreWarnedOf)
+{
+  CloudModelParams params;
+  params.noise = SensorNoiseModel::isotropic (0.003);
+  params.threads = 1;
+  std::mt19937 rng (51);
+  std::normal_distribution<double> noise (0.0, 0.003);
+  auto jittered = [&] (const Eigen::Vector3d& p) {
+    return pcl::PointXYZ (static_cast<float> (p.x () + noise (rng)), static_cast<float> (p.y () + noise (rng)),
+                          static_cast<float> (p.z () + noise (rng)));
+  };
+  // Rings on the floor of a 16-beam LiDAR 1.8 m up, one sample every 0.5 degrees.
+  Cloud rings;
+  for (int beam = 0; beam < 8; ++beam)
+  {
+    const double down = (2.0 + 2.0 * beam) * M_PI / 180.0;
+    const double radius = 1.8 / std::tan (down);
+    for (int step = 0; step < 720; ++step)
+    {
+      const double az = step * M_PI / 360.0;
+      rings.push_back (jittered (Eigen::Vector3d (radius * std::cos (az), radius * std::sin (az), 0.0)));
+    }
+  }
+  const auto lidar = buildCloudModel (rings, params);
+  EXPECT_LT (lidar->neighbourScatterRatio (), CloudModel::kScanLineRatio);
+  EXPECT_NE (lidar->warning ().find ("its samples lie along lines"), std::string::npos) << lidar->warning ();
+  // A rod: its samples lie along its one line, rightly.
+  Cloud rod;
+  std::normal_distribution<double> fine (0.0, 0.0003);
+  for (int i = 0; i < 500; ++i)
+    rod.push_back (pcl::PointXYZ (static_cast<float> (fine (rng)), static_cast<float> (fine (rng)), static_cast<float> (0.002 * i)));
+  const auto line = buildCloudModel (rod, params);
+  EXPECT_LT (line->neighbourScatterRatio (), CloudModel::kScanLineRatio);
+  EXPECT_EQ (line->warning (), "");
+  // A sheet, and the same with a cable lying over it.
+  Cloud::Ptr table = sheet (1.0, 0.01, 0.001, 52);
+  const auto surface = buildCloudModel (*table, params);
+  EXPECT_GT (surface->neighbourScatterRatio (), 0.3);
+  EXPECT_EQ (surface->warning (), "");
+  for (int i = 0; i < 300; ++i)
+    table->push_back (pcl::PointXYZ (static_cast<float> (-0.5 + 0.0033 * i), 0.1f, 0.05f));
+  EXPECT_EQ (buildCloudModel (*table, params)->warning (), "");
+}
+
 // ---- ProbabilisticCollision: models rebuilt when a cloud is set again (issue #15) ----------
 
 namespace

@@ -174,6 +174,19 @@ public:
     * normal for point types with one), modelled once with it: every point of a scan duplicated
     * collapsed its neighbourhoods and moved near-contact verdicts toward free. 0 when none. */
   std::size_t coincidentSamples () const { return coincident_samples_; }
+  /** \brief CovarianceEstimation::getNeighbourScatterRatio() of the build: about 0.6 on a
+    * surface scan, near 0 where the samples lie along lines (0.03 on a LiDAR's rings); NaN when
+    * the build estimated no covariance (given without the surface model). */
+  double neighbourScatterRatio () const { return neighbour_scatter_ratio_; }
+  /** \brief Below this neighbourScatterRatio(), with the cloud spread over an area, the samples
+    * are scan lines: the model measures their spacing along the lines, and a part lying between
+    * two lines 0.6-0.9 m apart read free (docs/RELIABILITY.md), so warning() says so. Three times
+    * a LiDAR's 0.03, a sixth of a surface scan's 0.59-0.69. */
+  static constexpr double kScanLineRatio = 0.1;
+  /** \brief The points' middle standard deviation (about their principal axes) at least this
+    * share of their largest: a cloud spread over an area. A rod's, a cable's or a row's samples
+    * lie along one line, rightly. */
+  static constexpr double kScanLineExtentRatio = 0.1;
   /** \brief When samples were merged or coincided: per index of the caller's cloud, the model
     * point (index into hierarchy().means()) that stands for it, -1 when none does (non-finite,
     * outside the indices). Empty when none merged nor coincided: point j then stands for
@@ -250,6 +263,10 @@ private:
     * its spacing takes spacing, the caller's cloud's. */
   void adoptCoincident (std::size_t source_size, std::size_t candidates, const std::vector<int>& distinct_of,
                         const std::vector<int>& seeds, double spacing);
+  /** \brief Adds to warning() where the samples lie along lines spread over an area, as a
+    * LiDAR's rings do (neighbourScatterRatio() under kScanLineRatio, the points spread at least
+    * kScanLineExtentRatio as wide as long). */
+  void assessScanLines (const std::string& name);
   /** \brief Appends text to warning(), after "; " where it says something already. */
   void addWarning (const std::string& text);
   /** \brief Sets precisionRatio() and warning() from the largest input coordinate magnitude. */
@@ -273,6 +290,7 @@ private:
   std::size_t skipped_ = 0;
   std::size_t merged_samples_ = 0;
   std::size_t coincident_samples_ = 0;
+  double neighbour_scatter_ratio_ = std::numeric_limits<double>::quiet_NaN ();
   std::vector<int> point_of_source_;
   std::vector<int> representatives_;
   std::shared_ptr<const CloudModel> full_resolution_;

@@ -249,6 +249,7 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
   std::vector<Eigen::Vector3f> normals;
   std::vector<int> neighbours;
   double neighbour_spacing = std::numeric_limits<double>::quiet_NaN ();
+  double scatter_ratio = std::numeric_limits<double>::quiet_NaN ();
   if (!covariances || params.surface)
   {
     // With covariances given, the estimation runs for the surface model alone (its normals,
@@ -278,6 +279,7 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
     }
     detail::reserveHugePages (estimated.points, n);  // compute() resizes it to n
     estimation.compute (estimated);
+    scatter_ratio = estimation.getNeighbourScatterRatio ();
     const auto copyOf = [] (const auto& from, auto& to) {  // on memory offered to huge pages
       detail::reserveHugePages (to, from.size ());
       to.assign (from.begin (), from.end ());
@@ -487,6 +489,8 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
   model->assessPrecision (max_abs, name);
   model->assessNormals (name);
   model->assessClosed (name);
+  model->neighbour_scatter_ratio_ = scatter_ratio;
+  model->assessScanLines (name);
   model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
   if (!model->warning_.empty ())
     PCL_WARN ("[pcl_probcollision::buildCloudModel] %s\n", model->warning_.c_str ());

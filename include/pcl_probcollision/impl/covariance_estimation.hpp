@@ -346,6 +346,7 @@ CovarianceEstimation<PointInT, PointOutT>::initCompute ()
   nearest_sqr_.clear ();
   displacements_.clear ();
   coincident_ = false;
+  scatter_ratio_ = std::numeric_limits<double>::quiet_NaN ();
   if (this->search_radius_ != 0.0)
   {
     PCL_ERROR ("[pcl_probcollision::%s::initCompute] radius search (%g) is not supported: the "
@@ -556,6 +557,9 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   std::vector<Scratch> scratch (std::min (workers, std::max<std::size_t> (blocks, 1)));
   std::vector<char> block_dense (blocks, 1);
   std::vector<char> block_coincident (blocks, 0);  // hasCoincidentPoints()
+  // getNeighbourScatterRatio(): every ratio_stride-th output point, whatever the threads.
+  const std::size_t ratio_stride = std::max<std::size_t> (1, order.size () / kScatterRatioPoints);
+  std::vector<float> scatter_ratios ((order.size () + ratio_stride - 1) / ratio_stride, std::numeric_limits<float>::quiet_NaN ());
 
   detail::parallelFor (blocks, workers, [&] (std::size_t blk, std::size_t worker) {
     Scratch& s = scratch[worker];
@@ -612,6 +616,25 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
       if (compute_surface_)
         std::copy (nn_indices.begin (), nn_indices.begin () + static_cast<std::ptrdiff_t> (kept),
                    neighbours_.begin () + static_cast<std::ptrdiff_t> (out * static_cast<std::size_t> (this->k_)));
+
+      if (out % ratio_stride == 0 && kept >= 2)
+      {
+        // The point and its neighbours, unweighted, about their mean.
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero ();
+        for (std::size_t j = 0; j < kept; ++j)
+          mean += surface[nn_indices[j]].getVector3fMap ().template cast<double> () - xi;
+        mean /= static_cast<double> (kept + 1);
+        Eigen::Matrix3d scatter = mean * mean.transpose ();
+        for (std::size_t j = 0; j < kept; ++j)
+        {
+          const Eigen::Vector3d d = surface[nn_indices[j]].getVector3fMap ().template cast<double> () - xi - mean;
+          scatter.noalias () += d * d.transpose ();
+        }
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+        const Eigen::Vector3d l = solver.computeDirect (scatter, Eigen::EigenvaluesOnly).eigenvalues ();
+        if (l[2] > 0.0)
+          scatter_ratios[out / ratio_stride] = static_cast<float> (std::max (0.0, l[1]) / l[2]);
+      }
 
       Eigen::Matrix3d psi = Eigen::Matrix3d::Zero ();
       // Weighted mean offset of the neighbours and their effective number (surface projection).
@@ -679,6 +702,14 @@ CovarianceEstimation<PointInT, PointOutT>::computeFeature (PointCloudOut& output
   });
   output.is_dense = std::all_of (block_dense.begin (), block_dense.end (), [] (char d) { return d != 0; });
   coincident_ = std::any_of (block_coincident.begin (), block_coincident.end (), [] (char c) { return c != 0; });
+  scatter_ratios.erase (std::remove_if (scatter_ratios.begin (), scatter_ratios.end (), [] (float v) { return std::isnan (v); }),
+                        scatter_ratios.end ());
+  if (!scatter_ratios.empty ())
+  {
+    std::nth_element (scatter_ratios.begin (), scatter_ratios.begin () + static_cast<std::ptrdiff_t> (scatter_ratios.size () / 2),
+                      scatter_ratios.end ());
+    scatter_ratio_ = scatter_ratios[scatter_ratios.size () / 2];
+  }
 }
 } // namespace pcl_probcollision
 
