@@ -1829,7 +1829,7 @@ PYBIND11_MODULE (_core, m)
                               "Samples exactly at an earlier sample's position (and normal), modelled once with it; 0 when none.")
       .def_property_readonly ("origin", [] (const CloudModel& c) { return vec3 (c.origin ()); },
                               "Local frame origin (the centroid), in the cloud's frame.")
-      .def_property_readonly ("warning", &CloudModel::warning, "A precision warning about the input, '' when none.")
+      .def_property_readonly ("warning", &CloudModel::warning, "The model's warnings about its input (CloudModel::warning: precision, a merge, normals, lines), '' when none.")
       .def_property_readonly ("build_ms", &CloudModel::buildMilliseconds, "Wall time of the build, ms.")
       .def_property_readonly ("bytes", &CloudModel::bytes, "Memory held, bytes.")
       .def_property_readonly ("median_neighbour_spacing", &CloudModel::medianNeighbourSpacing,

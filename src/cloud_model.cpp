@@ -129,14 +129,21 @@ CloudModel::buildLocal (UncertainCloud&& points, std::vector<PackedCovariance>&&
   source_size_ = source_size;
 }
 
+std::vector<int>
+CloudModel::pointOfHierarchySource (std::size_t sources) const
+{
+  std::vector<int> point_of (sources, -1);
+  for (std::size_t j = 0; j < bvh_.size (); ++j)
+    point_of[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
+  return point_of;
+}
+
 void
 CloudModel::adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
                         const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name)
 {
   // The hierarchy's source indices are merged points (the merged cloud's indices).
-  std::vector<int> point_of_merged (seeds.size (), -1);
-  for (std::size_t j = 0; j < bvh_.size (); ++j)
-    point_of_merged[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
+  const std::vector<int> point_of_merged = pointOfHierarchySource (seeds.size ());
   detail::assignHugePages (point_of_source_, source_size, -1);
   std::size_t mapped = 0;
   for (std::size_t i = 0; i < cluster_of.size () && i < source_size; ++i)
@@ -171,15 +178,8 @@ CloudModel::adoptCoincident (std::size_t source_size, std::size_t candidates, co
   if (!std::isnan (neighbour_spacing_))
     neighbour_spacing_ = spacing;
   // The model point of each distinct sample: through a merge's map where its samples merged.
-  std::vector<int> point_of_distinct;
-  if (!point_of_source_.empty ())
-    point_of_distinct = std::move (point_of_source_);
-  else
-  {
-    point_of_distinct.assign (seeds.size (), -1);
-    for (std::size_t j = 0; j < bvh_.size (); ++j)
-      point_of_distinct[static_cast<std::size_t> (bvh_.sourceIndex (static_cast<int> (j)))] = static_cast<int> (j);
-  }
+  const std::vector<int> point_of_distinct =
+      point_of_source_.empty () ? pointOfHierarchySource (seeds.size ()) : std::move (point_of_source_);
   // Hierarchy source indices name distinct samples, or a merge's seeds among them.
   if (representatives_.empty ())
     representatives_ = seeds;

@@ -206,8 +206,10 @@ public:
     * CloudModelParams::noise_resolution that merged the cloud into no more points than the
     * covariance estimation's k (each neighbourhood then spans the whole object, and the model
     * no longer resolves its shape: the stereo mug of ../shared/data merged within 30 noise
-    * deviations into one point read free 5 cm into its table). collide() passes it on in
-    * CollisionResult::message. */
+    * deviations into one point read free 5 cm into its table); given normals off their points'
+    * planes, closed_objects asked of a surface that does not check closed, or samples along lines
+    * over an area (assessScanLines: a LiDAR's rings), each appended after "; ". collide() passes
+    * it on in CollisionResult::message. */
   const std::string& warning () const { return warning_; }
 
   /** \brief Float spacing (one ulp) at the largest coordinate magnitude of the cloud divided by
@@ -257,6 +259,8 @@ private:
     * Sets warning() where the merge left no more points than the covariance estimation's k. */
   void adoptMerge (const CloudModelParams& params, std::size_t source_size, std::size_t candidates,
                    const std::vector<int>& cluster_of, std::vector<int>&& seeds, const std::string& name);
+  /** \brief Per hierarchy source index below sources, the model point that holds it (-1 for none). */
+  std::vector<int> pointOfHierarchySource (std::size_t sources) const;
   /** \brief Takes a model built from a cloud's distinct samples (detail::mergeCoincident:
     * distinct_of per index of the caller's cloud, seeds per distinct sample) back to the caller's
     * cloud, as adoptMerge does, and its full-resolution model with it; a model that measured

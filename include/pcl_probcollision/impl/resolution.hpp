@@ -133,21 +133,20 @@ mergeCoincident (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indic
   distinct.sensor_origin_ = cloud.sensor_origin_;
   distinct.sensor_orientation_ = cloud.sensor_orientation_;
   seeds.clear ();
-  std::vector<int> distinct_of_seed (cloud.size (), -1);
+  assignHugePages (cluster_of, cloud.size (), -1);
+  // In cloud order: a group's seed (its first sample) comes before the rest of it.
   for (std::size_t i = 0; i < cloud.size (); ++i)
     if (seed_of[i] == static_cast<int> (i))
     {
-      distinct_of_seed[i] = static_cast<int> (seeds.size ());
+      cluster_of[i] = static_cast<int> (seeds.size ());
       seeds.push_back (static_cast<int> (i));
       distinct.push_back (cloud[i]);
     }
+    else if (seed_of[i] >= 0)
+      cluster_of[i] = cluster_of[static_cast<std::size_t> (seed_of[i])];
   distinct.width = static_cast<std::uint32_t> (distinct.size ());
   distinct.height = 1;
   distinct.is_dense = true;
-  assignHugePages (cluster_of, cloud.size (), -1);
-  for (std::size_t i = 0; i < cloud.size (); ++i)
-    if (seed_of[i] >= 0)
-      cluster_of[i] = distinct_of_seed[static_cast<std::size_t> (seed_of[i])];
   return true;
 }
 
