@@ -598,7 +598,7 @@ SurfaceModel::ViewBins::depthOf (const Eigen::Vector3d& r, int& a, std::int64_t&
 bool
 SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
 {
-  const Eigen::Vector3d r = x - view;
+  const Eigen::Vector3d r = relative (x);
   int a = 0;
   std::int64_t face = 0;
   const double t = depthOf (r, a, face);
@@ -616,8 +616,8 @@ SurfaceModel::ViewBins::keyOf (const Eigen::Vector3d& x, Key& key) const
 
 SurfaceModel::ViewBins
 SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::vector<float>& spacing,
-                       const std::function<Eigen::Vector3f (std::size_t)>& plane_of, const Eigen::Vector3d& view, const Eigen::Vector3d& lo,
-                       const Eigen::Vector3d& hi, double* hidden)
+                       const std::function<Eigen::Vector3f (std::size_t)>& plane_of, const Eigen::Vector3d& view,
+                       const detail::OrientedBox& box, double* hidden)
 {
   ViewBins bins;
   if (hidden)
@@ -626,19 +626,21 @@ SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::ve
   if (n < 2)
     return bins;
   bins.view = view;
+  bins.frame = box.axes ();
   // The axis along which view lies farthest outside the box: every point is in front of it.
+  const Eigen::Vector3d at = box.boxCoordinates (view), h = box.halfExtents ();
   double best = -1.0;
   for (int d = 0; d < 3; ++d)
   {
-    if (lo[d] - view[d] > best)
+    if (-h[d] - at[d] > best)
     {
-      best = lo[d] - view[d];
+      best = -h[d] - at[d];
       bins.axis = d;
       bins.sign = 1.0;
     }
-    if (view[d] - hi[d] > best)
+    if (at[d] - h[d] > best)
     {
-      best = view[d] - hi[d];
+      best = at[d] - h[d];
       bins.axis = d;
       bins.sign = -1.0;
     }
@@ -648,7 +650,7 @@ SurfaceModel::binView (const std::vector<Eigen::Vector3d>& points, const std::ve
   std::vector<double> depth (n), range (n), scratch;
   for (std::size_t i = 0; i < n; ++i)
   {
-    const Eigen::Vector3d r = points[i] - view;
+    const Eigen::Vector3d r = bins.relative (points[i]);
     int a = 0;
     std::int64_t face = 0;
     depth[i] = bins.depthOf (r, a, face);
@@ -754,7 +756,7 @@ SurfaceModel::mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, d
   double u_lo = std::numeric_limits<double>::infinity (), u_hi = -u_lo, v_lo = u_lo, v_hi = -u_lo, farthest = 0.0;
   for (const Eigen::Vector3d& c : corners)
   {
-    const Eigen::Vector3d r = c - b.view;
+    const Eigen::Vector3d r = b.relative (c);
     const double t = b.sign * r[b.axis];
     if (!(t > 0.0))
       return true;
@@ -783,9 +785,11 @@ SurfaceModel::mayLieBehindView (const std::array<Eigen::Vector3d, 8>& corners, d
 }
 
 double
-SurfaceModel::behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x) const
+SurfaceModel::behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x, double* beyond) const
 {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN ();
+  if (beyond)
+    *beyond = kNaN;
   ViewBins::Key key;
   if (view_bins_.empty () || !view_bins_.keyOf (x, key) || bvh.size () != normals_.size ())
     return kNaN;
@@ -800,22 +804,34 @@ SurfaceModel::behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
     return n.isZero () ? range - double (nearest.range) : n.dot (bvh.means ()[j] - x);
   };
   // x's own bin first: most points a query asks about lie in front of what the scan saw.
-  double least = behind (view_bins_.nearestOf (key));
+  const ViewBins::Nearest own = view_bins_.nearestOf (key);
+  double least = behind (own);
   if (!(least > 0.0) && !std::isnan (least))
+  {
+    if (beyond)
+      *beyond = range - double (own.range);
     return least;
+  }
   // A bin of a slanted scan holds a sample or two, and one may be empty inside a surface; beside
   // a silhouette, or where the scan saw nothing, a row of them is.
   int empty = 0;
   least = std::numeric_limits<double>::infinity ();
+  double along = std::numeric_limits<double>::infinity ();
   for (std::int64_t du = -1; du <= 1; ++du)
     for (std::int64_t dv = -1; dv <= 1; ++dv)
     {
-      const double d = behind (view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv}));
+      const ViewBins::Nearest nearest = view_bins_.nearestOf ({key[0], key[1] + du, key[2] + dv});
+      const double d = behind (nearest);
       if (std::isnan (d) && ++empty > kMaxEmptyBins)
         return kNaN;
       if (!std::isnan (d))
+      {
         least = std::min (least, d);
+        along = std::min (along, range - double (nearest.range));
+      }
     }
+  if (beyond)
+    *beyond = own.index >= 0 ? range - double (own.range) : along;
   return least;
 }
 
@@ -968,17 +984,14 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   bool any_given = false;
   for (std::size_t i = 0; i < in.given.size () && !any_given; ++i)
     any_given = in.given[i] && !normals_[i].isZero ();
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant (std::numeric_limits<double>::infinity ()), hi = -lo;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero ();
   for (const Eigen::Vector3d& p : points)
-  {
-    lo = lo.cwiseMin (p);
-    hi = hi.cwiseMax (p);
     centroid += p;
-  }
   centroid /= std::max<std::size_t> (n, 1);
-  const bool view_outside = in.viewpoint && in.viewpoint->allFinite () &&
-                            ((in.viewpoint->array () < lo.array ()).any () || (in.viewpoint->array () > hi.array ()).any ());
+  // The cloud's bounding box on its principal axes (the hierarchy's root): whether the viewpoint
+  // lies inside it, and the view's bins, turn with the cloud (an axis-aligned box would not).
+  const detail::OrientedBox box = bvh.empty () ? detail::OrientedBox () : bvh.node (ProbabilisticBVH::rootId ()).box;
+  const bool view_outside = in.viewpoint && in.viewpoint->allFinite () && n > 0 && !box.contains (*in.viewpoint);
   // A sensor sees its samples from many spacings away (a depth camera at its 0.5 m minimum range,
   // hundreds); a viewpoint within a few spacings of the nearest sample is none's. PCL's default
   // origin 3 mm under a cylinder sampled all round "hid" 4 % of it, its bins too wide for the
@@ -1019,7 +1032,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   };
   auto hiddenShare = [&] {
     double share = 0.0;
-    bins = binView (points, spacing_, planeOf, *in.viewpoint, lo, hi, &share);
+    bins = binView (points, spacing_, planeOf, *in.viewpoint, box, &share);
     return share;
   };
   if (mode == NormalOrientation::Auto && !any_given && view_outside && view_far)
@@ -1147,7 +1160,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
   // Where the scan looked, and how far it saw, for the query's parts behind it.
   view_bins_ = ViewBins ();
   if (seen_from_view_)
-    view_bins_ = bins ? std::move (*bins) : binView (points, spacing_, planeOf, *in.viewpoint, lo, hi, nullptr);
+    view_bins_ = bins ? std::move (*bins) : binView (points, spacing_, planeOf, *in.viewpoint, box, nullptr);
   for (std::size_t i = 0; i < n; ++i)
     if (component[i] == 0)
       propagation.seed (static_cast<int> (i));
@@ -1222,6 +1235,7 @@ SurfaceModel::build (const ProbabilisticBVH& bvh, Inputs&& in, NormalOrientation
 
   if (statistics.valid ())
     statistics.get ();
+  hidden_shell_ = seen_from_view_ ? kHiddenShellSpacings * median_spacing_ : 0.0;
 
   // Dipoles: each point counts in the first leaf holding it (leaves overlap by epsilon).
   const auto& nodes = bvh.nodes ();

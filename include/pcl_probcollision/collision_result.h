@@ -118,8 +118,9 @@ struct CollisionResult
     * (NormalOrientation::Viewpoint: a scan from one sensor, which never sees behind it). P and
     * the verdict then say what the bridged or occupied surface implies; a planner may treat
     * such a pose as unknown. Also where no point reads inside but a point within the scan's
-    * bounding box, out of its samples' reach or read outside by them, lies behind what the
-    * sensor saw along its line of sight (SurfaceModel::behindView): the surface layer's P is
+    * bounding box or its hidden shell (SurfaceModel::hiddenShell), out of its samples' reach or
+    * read outside by them, lies behind what the sensor saw along its line of sight
+    * (SurfaceModel::behindView): the surface layer's P is
     * then at least 1/2 (at least 1/4
     * pooled with the separators': contact at the default thresholds), the distance 0 with a
     * standard deviation of that depth, and the witness normal points toward the sensor. */
