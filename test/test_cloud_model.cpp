@@ -366,7 +366,9 @@ TEST (CloudModel, CoincidentSamplesAreModelledOnce)
             << "z " << z << " sample " << j;
     }
     if (ra.witness_side > 0)
+    {
       EXPECT_EQ (rb.witness_index, 2 * ra.witness_index) << "the first of the coincident samples";
+    }
   }
   // Indices: only coincident samples within them count.
   pcl::Indices first_copy (once->size ());
