@@ -585,6 +585,27 @@ TEST (ProbabilisticBVH, FarFromTheOriginGivesTheSameTree)
   }
 }
 
+TEST (ProbabilisticBVH, TurningTheCloudGivesTheSameTree)
+{
+  // The children's order follows each node's axes, whose signs the eigen solver picks at random;
+  // each is set by the points' third moment along it, so turning the cloud turns the tree with it:
+  // the same points in the same nodes, in the same order (the order a query visits leaves in).
+  for (const Shape shape : {Shape::Box, Shape::NoisyPlane})
+  {
+    SCOPED_TRACE (shapeName (shape));
+    const UncertainCloud c = shapeCloud (shape, 3000, 93, 0.003);
+    const ProbabilisticBVH base (c);
+    for (int k = 0; k < 8; ++k)
+    {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity ();
+      T.linear () = Eigen::AngleAxisd (0.4 + 0.7 * k, Eigen::Vector3d (1.0, -2.0 + k, 0.5 * k).normalized ()).toRotationMatrix ();
+      const ProbabilisticBVH turned (transformCloud (c, T));
+      ASSERT_EQ (base.nodes ().size (), turned.nodes ().size ()) << "rotation " << k;
+      EXPECT_EQ (base.pointIndices (), turned.pointIndices ()) << "rotation " << k;
+    }
+  }
+}
+
 TEST (ProbabilisticBVH, MoveBuildAndUnionBound)
 {
   UncertainCloud c = shapeCloud (Shape::NoisyPlane, 800, 92, 0.004);

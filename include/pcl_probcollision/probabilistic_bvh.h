@@ -88,7 +88,9 @@ struct BVHParams
   * (e3, e2, e1) of its own points' covariance, inflated by k_sigma point standard deviations,
   * and the area-weighted mean probability that its points lie outside that box (leakage).
   * Siblings overlap by epsilon times the parent's extent, so points near a split are stored in
-  * both children; storedPoints() counts them with this duplication.
+  * both children; storedPoints() counts them with this duplication. e3 and e2 point where the
+  * points' third moment along them is positive, and children come lower side first: a rigid
+  * motion of the cloud gives the same tree, in the same order (the order queries visit it in).
   *
   * Everything is expressed in the cloud's own frame; the traversal
   * (detail/bvh_traversal.h) maps the boxes of one hierarchy into the other's frame on the fly.
