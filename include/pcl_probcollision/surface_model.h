@@ -181,7 +181,7 @@ public:
     * \param[in] x the point, in the local frame
     * \param[out] beyond if not null, how far x lies beyond the nearest sample of its bin along
     *             its line of sight (its range less that sample's; the least over the nine bins
-    *             where its own holds none), NaN where the result is */
+    *             where its own holds none); NaN where the result is NaN */
   double behindView (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x, double* beyond = nullptr) const;
   /** \brief False when no point in the convex hull of `corners` (local frame) can lie more than
     * margin behind what the viewpoint saw (behindView() > margin): its farthest corner is nearer
@@ -333,7 +333,8 @@ private:
     * about the view that each direction crosses (its largest component). The box is the
     * hierarchy's root box, on the cloud's principal axes, and the bins lie on its axes: they turn
     * with the cloud, so a rigid motion of the whole scene bins the same samples together (on the
-    * data frame's axes, turning the stereo mug scene moved 1 of 100 verdicts). */
+    * data frame's axes, a box scan turned by a rotation read another behindView() at thousands
+    * of points). */
   struct ViewBins
   {
     using Key = std::array<std::int64_t, 3>;  ///< cube face (0 for a view outside), u, v
