@@ -1043,9 +1043,7 @@ shadowDepth (const CloudModel& surface, const Eigen::Vector3d& x, double margin)
   if (!(behind > margin))
     return kNaN;
   const OrientedBox& bound = surface.hierarchy ().node (ProbabilisticBVH::rootId ()).box;
-  return beyond <= s.hiddenShell () || (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () <= 0.0
-             ? behind
-             : kNaN;
+  return beyond <= s.hiddenShell () || bound.contains (x) ? behind : kNaN;
 }
 
 /** \brief The points of `query` (mapped by T_q into A's frame) against `surface` (mapped by
@@ -1343,8 +1341,7 @@ insideOf (const CloudModel& surface, const Eigen::Vector3d& x)
 {
   const ProbabilisticBVH& bvh = surface.hierarchy ();
   const OrientedBox& bound = bvh.node (ProbabilisticBVH::rootId ()).box;
-  return (bound.boxCoordinates (x).cwiseAbs () - bound.halfExtents ()).maxCoeff () <= 0.0 &&
-         behindWinding (surface.surface (), bvh, x) > behindThreshold (surface.surface ());
+  return bound.contains (x) && behindWinding (surface.surface (), bvh, x) > behindThreshold (surface.surface ());
 }
 
 /** \brief The points of `node` (of q_bvh, mapped into `surface`'s frame by T_s_q) that lie in the
