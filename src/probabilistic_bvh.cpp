@@ -3,6 +3,7 @@
 #include <pcl_probcollision/detail/huge_pages.h>
 #include <pcl_probcollision/detail/node_kernels.h>
 #include <pcl_probcollision/detail/parallel.h>
+#include <pcl_probcollision/detail/principal_axes.h>
 
 #include <pcl/exceptions.h>
 
@@ -219,18 +220,11 @@ computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, doubl
   // the points' third moment along it is positive, a sign that turns with the cloud. (Visited in
   // the solver's order, a crossing across two leaves, judged against the later one's samples,
   // moved a real stereo scene's answer between 0.998 and 0.778 as the scene was turned.)
-  Eigen::Vector2d third = Eigen::Vector2d::Zero ();
-  for (int j : points)
-  {
-    const Eigen::Vector2d d = g.axes.leftCols<2> ().transpose () * (cloud.means[j] - g.mean);
-    third += d.cwiseProduct (d).cwiseProduct (d);
-  }
-  for (int k = 0; k < 2; ++k)
-    if (third (k) < 0.0)
-      g.axes.col (k) = -g.axes.col (k);
-  // e1 is implied by e3 x e2, as the node's box stores it (OrientedBox), so the extents and the
+  // e1 is then e3 x e2, as the node's box stores it (OrientedBox), so the extents and the
   // leakage below are those of the stored box exactly.
-  g.axes.col (2) = g.axes.col (0).cross (g.axes.col (1));
+  detail::orientByThirdMoment (g.axes, g.mean, m, [&] (std::size_t i) {
+    return cloud.means[static_cast<std::size_t> (points[i])];
+  });
   g.variation = variationOf (lambda);
 
   for (int k = 0; k < 3; ++k)

@@ -53,7 +53,9 @@ struct ClassifierParams
   int rff_features = 256;
   /** \brief D of the last ladder rung (>= rff_features). */
   int rff_features_large = 1024;
-  /** \brief Seed of the random Fourier feature draw (Omega, beta), drawn once per classifier. */
+  /** \brief Seed of the random Fourier feature draw (Omega, beta), drawn once per classifier and
+    * laid, for each leaf pair, along the pair's principal axes, so that a fit turns with the
+    * points. */
   std::uint64_t rff_seed = 12345;
   /** \brief Ladder: a point counts as misclassified when it lies on the wrong side of the
     * surface by more than this many of its own standard deviations along the gradient (> 0). */

@@ -29,8 +29,8 @@ enum class Rung
   * With x' = scale * (x - centroid) + (0.5, 0.5, 0.5) the unit-cube coordinates of an input
   * point x (Uniform scaling, METHOD.md 4: uniformUnitCubeTransform (centroid, scale) of
   * normalization.h), the function is f(x') = w^T x' + b (Linear) or
-  * f(x') = w^T phi(x') + b with phi the random Fourier feature map of D = weights.size ()
-  * features (RFF, RFFLarge). f > 0 on A's side. */
+  * f(x') = w^T phi(frame^T (x' - o)) + b with o = (0.5, 0.5, 0.5) and phi the random Fourier
+  * feature map of D = weights.size () features (RFF, RFFLarge). f > 0 on A's side. */
 struct SeparatorModel
 {
   /** \brief Which model f is (None: nothing fitted, the model is empty). */
@@ -39,6 +39,9 @@ struct SeparatorModel
     * sets). */
   Eigen::Vector3d centroid = Eigen::Vector3d::Constant (std::numeric_limits<double>::quiet_NaN ());
   double scale = std::numeric_limits<double>::quiet_NaN ();  ///< 1 / (2 r_c), 1 when r_c = 0
+  /** \brief The axes (columns, a rotation) the random features are drawn along (RFF, RFFLarge):
+    * the principal axes of both point sets, so that the fit turns with the points. */
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity ();
   Eigen::VectorXd weights;  ///< w: 3 entries (Linear) or D entries (RFF)
   double bias = std::numeric_limits<double>::quiet_NaN ();  ///< b
 };
@@ -102,7 +105,8 @@ struct ClassifierResult
   *
   * Points of A carry label +1, points of B label -1; f > 0 on A's side. The problem is
   * normalised into the unit cube with Uniform scaling first, so results are invariant under a
-  * common rigid motion and change of units (exactly for Linear, in distribution for RFF).
+  * common rigid motion and change of units (the random features are drawn in the points'
+  * principal frame, so RFF too, up to rounding and to sets whose principal axes are not unique).
   *
   * Training (METHOD.md 5.2-5.5): the Standard problem is solved first (damped Newton on (w, b)
   * for the plane, L-BFGS with memory 10 on the D + 1 unknowns for RFF); for Robust training

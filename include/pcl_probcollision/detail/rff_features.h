@@ -64,6 +64,21 @@ drawRandomFourierFeatures (std::uint64_t seed, int features, double rbf_gamma,
   }
 }
 
+/** \brief The first D rows of a draw turned into a frame: omega_out = Omega_D R^T and
+  * beta_out = beta_D - omega_out o with o = (1/2, 1/2, 1/2), so that
+  * omega_out x' + beta_out = Omega_D R^T (x' - o) + beta_D: the features of a unit-cube point x'
+  * taken in the frame R (columns: its axes) centred on the cube's centre. Omega's law,
+  * N(0, 2 gamma I_3), is the same in every frame; fixing the draw in a frame that turns with the
+  * points makes the features, and a fit on them, turn with the points too.
+  * \param[in] omega, beta the draw of drawRandomFourierFeatures(), at least D rows */
+inline void
+rffDrawInFrame (const Eigen::MatrixXd& omega, const Eigen::VectorXd& beta, int features,
+                const Eigen::Matrix3d& frame, Eigen::MatrixXd& omega_out, Eigen::VectorXd& beta_out)
+{
+  omega_out.noalias () = omega.topRows (features) * frame.transpose ();
+  beta_out.noalias () = beta.head (features) - omega_out * Eigen::Vector3d::Constant (0.5);
+}
+
 /** \brief phi(x) = sqrt(2/D) cos(Omega_D x + beta_D) with the first D rows of omega and beta,
   * and optionally the Jacobian J(x) = -sqrt(2/D) diag(sin(Omega_D x + beta_D)) Omega_D (D x 3).
   * \param[in] omega, beta the draw of drawRandomFourierFeatures(), at least D rows */
