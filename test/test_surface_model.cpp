@@ -1862,6 +1862,44 @@ TEST (SurfaceLayer, DeepPointsOutOfReachAreFound)
   EXPECT_LT (r.signed_distance, -0.5) << r.signed_distance << " witness side " << r.witness_side;
 }
 
+// Out of reach of the other's surface, a node's points lie on one side of it, and with a
+// distance asked for, the deepest of them sets it: the largest distance from a point of the ball
+// to the big sphere's nearest sample (brute force here), whatever the ball's point order. (It was
+// the depth of each inside node's first point in input order: four orders of the same ball read
+// -0.688 to -0.707, against the deepest point's -0.725.)
+TEST (SurfaceLayer, TheDeepestPointOutOfReachSetsTheDistanceWhateverTheOrder)
+{
+  const auto big_cloud = sphere (2000, 1.0, Eigen::Vector3d::Zero ());
+  const auto big = buildCloudModel (big_cloud, withSurface ());
+  const auto ball_cloud = sphere (300, 0.1, Eigen::Vector3d::Zero ());
+  const Eigen::Isometry3d pose = shift (0.3, 0.1, -0.2);
+  double deepest = 0.0;
+  for (const auto& p : ball_cloud)
+  {
+    const Eigen::Vector3d x = pose * p.getVector3fMap ().cast<double> ();
+    double nearest = std::numeric_limits<double>::infinity ();
+    for (const auto& q : big_cloud)
+      nearest = std::min (nearest, (x - q.getVector3fMap ().cast<double> ()).norm ());
+    deepest = std::max (deepest, nearest);
+  }
+  ASSERT_GT (deepest, 0.5);
+  CollisionRequest request = surfaceRequest ();
+  request.exhaustive = false;
+  request.distance = true;
+  std::mt19937 rng (11);
+  for (int order = 0; order < 4; ++order)
+  {
+    auto permuted = ball_cloud;
+    if (order > 0)
+      std::shuffle (permuted.begin (), permuted.end (), rng);
+    const auto ball = buildCloudModel (permuted, withSurface ());
+    CollisionResult r;
+    ASSERT_TRUE (collide (*big, *ball, pose, request, r));
+    EXPECT_EQ (r.verdict, Verdict::InCollision);
+    EXPECT_NEAR (r.signed_distance, -deepest, 1e-6) << "order " << order;
+  }
+}
+
 // Pooled with the separators, P is the mean of the surface layer's and the separators' on the
 // same pair, per point too; the signed distance stays the surface layer's. (Raw: the
 // calibration map, tested below, acts on the pool's mean.)
