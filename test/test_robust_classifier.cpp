@@ -1017,8 +1017,10 @@ TEST (RobustClassifier, AKernelSolveStalledAtRoundingStops)
   EXPECT_FALSE (r.converged);
   EXPECT_LT (r.iterations, 300) << "the stalled solves must stop, not run to the cap";
   std::cout << "[ stalled ] " << r.iterations << " iterations, P " << r.probability << "\n";
-  // The P of the solve run to its cap (the stop changes theta only in its last bits).
-  EXPECT_NEAR (r.probability, 2.2105655072109e-06, 1e-14);
+  // The P of the solve run to its cap (the stop changes theta only in its last bits), to 1e-5 of
+  // itself: builds round differently where the solve stalls (the sanitizer build's stop: 1.4e-6
+  // of P away).
+  EXPECT_NEAR (r.probability, 2.2105655072109e-06, 1e-5 * 2.2105655072109e-06);
 }
 
 // classify() keeps one leaf problem per thread between calls (its buffer reused when a problem
