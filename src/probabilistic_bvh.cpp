@@ -167,35 +167,6 @@ struct BuildPoints
   const std::vector<double>& area_weights;
 };
 
-/** \brief The mean of points' means and the eigen-decomposition of their scatter (ascending
-  * eigenvalues; zero eigenvalues and identity axes when the solver fails). */
-void
-meanAndScatter (const std::vector<Eigen::Vector3d>& means, const std::vector<int>& points, Eigen::Vector3d& mean,
-                Eigen::Vector3d& lambda, Eigen::Matrix3d& V)
-{
-  const std::size_t m = points.size ();
-  mean.setZero ();
-  for (int j : points)
-    mean += means[j];
-  mean /= static_cast<double> (m);
-  Eigen::Matrix3d C = Eigen::Matrix3d::Zero ();
-  for (int j : points)
-  {
-    const Eigen::Vector3d d = means[j] - mean;
-    C.noalias () += d * d.transpose ();
-  }
-  C /= static_cast<double> (m);
-
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es (C);
-  lambda = es.eigenvalues ();
-  V = es.eigenvectors ();
-  if (es.info () != Eigen::Success || !V.allFinite ())
-  {
-    lambda.setZero ();
-    V.setIdentity ();
-  }
-}
-
 /** \brief sigma_n = lambda_1 / (lambda_1 + lambda_2 + lambda_3) of ascending eigenvalues (0 when
   * they sum to 0). */
 double
@@ -211,20 +182,14 @@ computeGeometry (const BuildPoints& cloud, const std::vector<int>& points, doubl
 {
   const std::size_t m = points.size ();
   Eigen::Vector3d lambda;
-  Eigen::Matrix3d V;
-  meanAndScatter (cloud.means, points, g.mean, lambda, V);
-  g.axes.col (0) = V.col (2);
-  g.axes.col (1) = V.col (1);
   // The solver's sign of each axis is arbitrary, and it orders the children (the lower side
-  // first), so the order a query visits leaves in: each of the first two axes points to where
-  // the points' third moment along it is positive, a sign that turns with the cloud. (Visited in
-  // the solver's order, a crossing across two leaves, judged against the later one's samples,
-  // moved a real stereo scene's answer between 0.998 and 0.778 as the scene was turned.)
-  // e1 is then e3 x e2, as the node's box stores it (OrientedBox), so the extents and the
-  // leakage below are those of the stored box exactly.
-  detail::orientByThirdMoment (g.axes, g.mean, m, [&] (std::size_t i) {
-    return cloud.means[static_cast<std::size_t> (points[i])];
-  });
+  // first), so the order a query visits leaves in: principalFrame's signs turn with the cloud.
+  // (Visited in the solver's order, a crossing across two leaves, judged against the later one's
+  // samples, moved a real stereo scene's answer between 0.998 and 0.778 as the scene was turned.)
+  // e1 is e3 x e2, as the node's box stores it (OrientedBox), so the extents and the leakage
+  // below are those of the stored box exactly.
+  detail::principalFrame (m, [&] (std::size_t i) { return cloud.means[static_cast<std::size_t> (points[i])]; },
+                          g.mean, lambda, g.axes);
   g.variation = variationOf (lambda);
 
   for (int k = 0; k < 3; ++k)
@@ -895,7 +860,8 @@ ProbabilisticBVH::variation (const Node& node) const
     return 0.0;
   Eigen::Vector3d mean, lambda;
   Eigen::Matrix3d V;
-  meanAndScatter (means_, points, mean, lambda, V);
+  detail::meanAndScatter (points.size (), [&] (std::size_t i) { return means_[static_cast<std::size_t> (points[i])]; },
+                          mean, lambda, V);
   return variationOf (lambda);
 }
 

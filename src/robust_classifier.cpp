@@ -14,8 +14,6 @@
 
 #include <pcl/exceptions.h>
 
-#include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -147,34 +145,22 @@ makeProblem (const PointSetView& a, const PointSetView& b, const UnitCubeTransfo
 constexpr double kPreciseFraction = 0.03;
 
 /** \brief The frame a problem's random features are drawn in (rffDrawInFrame): its points'
-  * principal axes in the unit cube, the largest spread first, with the signs of
-  * orientByThirdMoment. The frame turns with the points, so a rigid motion of the whole scene
-  * leaves a kernel rung's fit the same. (With the draw fixed in the unit cube's axes, each frame
-  * fitted another draw: the real stereo mug scene's pose 95 read P 0.904-0.966 over 9 frames.)
-  * Points of equal spread along two axes leave those axes to the solver, as in the hierarchy. */
+  * principalFrame in the unit cube, which turns with the points, so a rigid motion of the whole
+  * scene leaves a kernel rung's fit the same. (With the draw fixed in the unit cube's axes, each
+  * frame fitted another draw: the real stereo mug scene's pose 95 read P 0.904-0.966 over 9
+  * frames.) */
 Eigen::Matrix3d
 featureFrame (const detail::SeparatorProblem& p)
 {
-  const double n = static_cast<double> (p.n);
-  const Eigen::Vector3d mean (p.x.sum () / n, p.y.sum () / n, p.z.sum () / n);
-  const auto point = [&p] (std::size_t i) {
-    const auto k = static_cast<Eigen::Index> (i);
-    return Eigen::Vector3d (p.x (k), p.y (k), p.z (k));
-  };
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero ();
-  for (std::size_t i = 0; i < static_cast<std::size_t> (p.n); ++i)
-  {
-    const Eigen::Vector3d d = point (i) - mean;
-    scatter.noalias () += d * d.transpose ();
-  }
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity ();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es (scatter);
-  if (es.info () == Eigen::Success && es.eigenvectors ().allFinite ())
-  {
-    axes.col (0) = es.eigenvectors ().col (2);
-    axes.col (1) = es.eigenvectors ().col (1);
-  }
-  detail::orientByThirdMoment (axes, mean, static_cast<std::size_t> (p.n), point);
+  Eigen::Vector3d mean, lambda;
+  Eigen::Matrix3d axes;
+  detail::principalFrame (
+      static_cast<std::size_t> (p.n),
+      [&p] (std::size_t i) {
+        const auto k = static_cast<Eigen::Index> (i);
+        return Eigen::Vector3d (p.x (k), p.y (k), p.z (k));
+      },
+      mean, lambda, axes);
   return axes;
 }
 } // namespace
