@@ -2,9 +2,11 @@
 """pcl_probcollision.dask under a fault: one of two worker processes killed in the middle of a batch
 (issue #18). The batch completes, every pose is answered once and the answers are unchanged."""
 import os
+import re
 import signal
 import threading
 import time
+import warnings
 
 import numpy as np
 
@@ -74,3 +76,73 @@ def test_killing_a_worker_mid_batch_changes_no_answer(table_path):
     assert len(r) == POSES and r.chunks == chunks
     for f in FIELDS:
         np.testing.assert_array_equal(getattr(r, f), getattr(reference, f), err_msg=f)
+
+
+def _cancel_clouds_mid_batch(client, cluster_batch, chunks_done=4):
+    """Runs cluster_batch() on a thread and, once both workers are busy and chunks_done chunks are
+    answered, cancels the clouds the batch scattered, as Dask does where it believes a worker took
+    them with it (dask/distributed issue 3149): every chunk not yet fetched is cancelled. Returns
+    what the batch returned or raised, and the chunks answered before the cancel."""
+    out = {}
+
+    def batch():
+        try:
+            out["result"] = cluster_batch()
+        except BaseException as e:  # reported by the callers' assertions
+            out["error"] = e
+
+    worker = threading.Thread(target=batch)
+    worker.start()
+    deadline = time.monotonic() + 120
+    while worker.is_alive() and time.monotonic() < deadline and client.run_on_scheduler(_done_chunks) < chunks_done:
+        time.sleep(0.02)
+    scattered = list(client.__dict__.get("_pcl_probcollision_scattered", {}).values())
+    assert len(scattered) == 2, "the batch's two clouds were not found scattered"
+    answered_before = client.run_on_scheduler(_done_chunks)
+    assert worker.is_alive(), f"the cancel must land in the middle of the batch: {out!r}"
+    client.cancel(scattered, force=True)
+    worker.join(timeout=240)
+    assert not worker.is_alive(), "the batch did not complete after the cancel"
+    return out, answered_before
+
+
+def test_chunks_the_cluster_cancels_are_asked_again(table_path):
+    from distributed import Client, LocalCluster
+
+    P = near_table_poses(POSES, seed=22)
+    gripper = DATA / "gripper.obj"
+    reference = pcd.collide_poses(gripper, table_path, P, client=None, sigma=0.0015, threads=0)
+    chunks = -(-POSES // CHUNK)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            out, answered_before = _cancel_clouds_mid_batch(
+                client, lambda: pcd.collide_poses(gripper, table_path, P, client=client, chunk_size=CHUNK, sigma=0.0015))
+    assert "error" not in out, repr(out.get("error"))
+    assert answered_before < chunks
+    asked_again = [str(w.message) for w in caught if "were asked again" in str(w.message)]
+    assert len(asked_again) == 1, [str(w.message) for w in caught]
+    # Every chunk not fetched before the cancel was asked again, and no other.
+    count = int(asked_again[0].split(": ")[1].split(" ")[0])
+    assert 1 <= count <= chunks - 1
+    r = out["result"]
+    assert len(r) == POSES and r.chunks == chunks
+    for f in FIELDS:
+        np.testing.assert_array_equal(getattr(r, f), getattr(reference, f), err_msg=f)
+
+
+def test_a_chunk_cancelled_past_the_bound_fails_the_batch_by_name(table_path, monkeypatch):
+    from distributed import Client, LocalCluster
+
+    monkeypatch.setattr(pcd, "_RESUBMITS", 0)
+    P = near_table_poses(POSES, seed=23)
+    gripper = DATA / "gripper.obj"
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        out, _ = _cancel_clouds_mid_batch(
+            client, lambda: pcd.collide_poses(gripper, table_path, P, client=client, chunk_size=CHUNK, sigma=0.0015))
+    assert "result" not in out
+    e = out["error"]
+    assert isinstance(e, RuntimeError), repr(e)
+    assert re.search(r"the chunk of poses \d+\.\.\d+ was cancelled by the cluster 1 time", str(e)), str(e)

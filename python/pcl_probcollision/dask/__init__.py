@@ -19,6 +19,7 @@ answers chunks of poses with collide_batch. The library itself stays single-proc
 from __future__ import annotations
 
 import collections
+import concurrent.futures
 import hashlib
 import math
 import operator
@@ -575,7 +576,10 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
         be True (the answer rests on surface the samples do not show; always False otherwise).
         distance=True is pcd_collision's -distance: beyond the query's reach signed_distance is
         the distance between the two clouds' nearest samples (sample_distance True).
-    Returns BatchResults in pose order, identical to the single-process answers.
+    Returns BatchResults in pose order, identical to the single-process answers. A chunk the
+    cluster cancels (Dask may, where a worker dies holding the scattered clouds) is asked again
+    with the clouds scattered anew, at most 3 times (a RuntimeWarning counts them); past that,
+    RuntimeError.
     pcd_collision's warnings (inputs' sizes or sigma in other units, coordinates rounded far from
     the origin, a model's precision, a free answer between two meshes' samples, a mesh under the
     surface layer that is not closed or is wound inward) come as
@@ -621,26 +625,63 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
             if progress is not None:
                 progress(min(s + chunk_size, m), m)
     else:
-        fa, fb = (_scatter(client, x) for x in (sa, sb))
         run = uuid.uuid4().hex[:12]
-        futures = [client.submit(answer_chunk, fa, fb, T[s:s + chunk_size], s, o, key=f"pcl_probcollision-{run}-{s}",
-                                 pure=False) for s in starts]
+        attempts = [0] * len(starts)
+        clouds = [None] * len(starts)  # the scattered clouds each chunk was given
+
+        def submit(i: int):
+            fa, fb = clouds[i] = tuple(_scatter(client, x) for x in (sa, sb))
+            s = starts[i]
+            key = f"pcl_probcollision-{run}-{s}" + (f"-r{attempts[i]}" if attempts[i] else "")
+            return client.submit(answer_chunk, fa, fb, T[s:s + chunk_size], s, o, key=key, pure=False)
+
+        futures = [submit(i) for i in range(len(starts))]
         # Results are fetched as chunks finish, so a worker lost later takes no answer with it;
         # a chunk whose worker died before it was fetched is recomputed by the scheduler.
         from distributed import as_completed
 
         parts = [None] * len(futures)
         where = {f.key: i for i, f in enumerate(futures)}
-        answered = 0
+        answered = resubmitted = 0
         try:
-            for future in as_completed(futures):
-                part = parts[where[future.key]] = future.result()
+            pending = as_completed(futures)
+            for future in pending:
+                i = where[future.key]
+                try:
+                    part = future.result()
+                except (concurrent.futures.CancelledError, TypeError):
+                    # Debian's distributed 2022.12 raises TypeError ("exceptions must derive from
+                    # BaseException") from result() where the cancel lands while it waits.
+                    if future.status != "cancelled":
+                        raise
+                    # Dask cancels the tasks that depend on scattered data it believes lost, which a
+                    # worker's death can cause even with a replica on every worker (dask/distributed
+                    # issue 3149). The chunk is asked again, a bounded number of times, unless
+                    # the client itself is closing.
+                    if client.status != "running" or attempts[i] >= _RESUBMITS:
+                        raise RuntimeError(f"pcl_probcollision.dask: the chunk of poses {starts[i]}.."
+                                           f"{min(starts[i] + chunk_size, m) - 1} was cancelled by the cluster "
+                                           f"{attempts[i] + 1} time(s) (client {client.status})") from None
+                    attempts[i] += 1
+                    resubmitted += 1
+                    # Scattered anew unless a chunk cancelled earlier has already done so.
+                    for spec, given in zip((sa, sb), clouds[i]):
+                        _forget_scattered(client, spec, given)
+                    futures[i] = submit(i)
+                    where[futures[i].key] = i
+                    pending.add(futures[i])
+                    continue
+                parts[i] = part
                 if progress is not None:
                     answered += len(part["index"])
                     progress(answered, m)
         finally:
             for f in futures:
                 f.release()
+        if resubmitted:
+            warnings.warn(f"pcl_probcollision.dask: {resubmitted} chunk(s) cancelled by the cluster (scattered "
+                          f"clouds lost with a worker?) were asked again; every pose was answered once",
+                          RuntimeWarning, stacklevel=2)
     r = _assemble(parts, m, (A, B), chunk_size)
     # The models' precision warnings (built on the workers, which leave them to the client).
     for f, side in zip(facts, "ab"):
@@ -659,6 +700,7 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
 
 
 _SCATTERED = 8  # clouds kept scattered per client, the most recent
+_RESUBMITS = 3  # times a chunk the cluster cancelled is asked again before the batch fails
 
 
 def _scatter(client, spec):
@@ -676,6 +718,14 @@ def _scatter(client, spec):
             cache.popitem(last=False)
     cache.move_to_end(spec["token"])
     return future
+
+
+def _forget_scattered(client, spec, future) -> None:
+    """Drops the client's scattered copy of a cloud if it is still that future, so that the next
+    _scatter sends it again (a chunk given it was cancelled: the cluster may have lost it)."""
+    cache = client.__dict__.get("_pcl_probcollision_scattered", {})
+    if cache.get(spec["token"]) is future:
+        del cache[spec["token"]]
 
 
 def _assemble(parts, m: int, inputs, chunk_size: int) -> BatchResults:
