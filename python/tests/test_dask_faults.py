@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""pcl_probcollision.dask under a fault: one of two worker processes killed in the middle of a batch
-(issue #18). The batch completes, every pose is answered once and the answers are unchanged."""
+"""pcl_probcollision.dask under a fault (issue #18): one of two worker processes killed in the middle
+of a batch, or the batch's scattered clouds cancelled. The batch completes, every pose is answered
+once and the answers are unchanged; past the bound on asking a cancelled chunk again, it fails by
+name."""
 import contextlib
 import os
 import re

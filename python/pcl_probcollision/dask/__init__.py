@@ -627,10 +627,10 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
     else:
         run = uuid.uuid4().hex[:12]
         attempts = [0] * len(starts)
-        clouds = [None] * len(starts)  # the scattered clouds each chunk was given
 
         def submit(i: int):
-            fa, fb = clouds[i] = tuple(_scatter(client, x) for x in (sa, sb))
+            # _scatter sends a cloud again where its scattered copy was cancelled.
+            fa, fb = (_scatter(client, x) for x in (sa, sb))
             s = starts[i]
             key = f"pcl_probcollision-{run}-{s}" + (f"-r{attempts[i]}" if attempts[i] else "")
             return client.submit(answer_chunk, fa, fb, T[s:s + chunk_size], s, o, key=key, pure=False)
@@ -664,9 +664,6 @@ def collide_poses(a, b, poses, client=None, chunk_size: Optional[int] = None,
                                            f"{attempts[i] + 1} time(s) (client {client.status})") from None
                     attempts[i] += 1
                     resubmitted += 1
-                    # Scattered anew unless a chunk cancelled earlier has already done so.
-                    for spec, given in zip((sa, sb), clouds[i]):
-                        _forget_scattered(client, spec, given)
                     futures[i] = submit(i)
                     where[futures[i].key] = i
                     pending.add(futures[i])
@@ -718,14 +715,6 @@ def _scatter(client, spec):
             cache.popitem(last=False)
     cache.move_to_end(spec["token"])
     return future
-
-
-def _forget_scattered(client, spec, future) -> None:
-    """Drops the client's scattered copy of a cloud if it is still that future, so that the next
-    _scatter sends it again (a chunk given it was cancelled: the cluster may have lost it)."""
-    cache = client.__dict__.get("_pcl_probcollision_scattered", {})
-    if cache.get(spec["token"]) is future:
-        del cache[spec["token"]]
 
 
 def _assemble(parts, m: int, inputs, chunk_size: int) -> BatchResults:
