@@ -199,5 +199,68 @@ nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eige
   }
   return out;
 }
+
+NearestSample
+nearestSample (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
+{
+  NearestSample out;
+  if (bvh.empty ())
+    return out;
+  const auto& means = bvh.means ();
+  // The distance from x to a node's box, and a slack for its rounding (the box's frame is
+  // rebuilt from two stored axes, its coordinates rounded): the box is passed over only when
+  // it lies farther than the best by more than the slack.
+  struct Entry
+  {
+    double bound;
+    std::int32_t id;
+    bool operator> (const Entry& o) const { return bound > o.bound || (bound == o.bound && id > o.id); }
+  };
+  const auto lowerBound = [&] (const OrientedBox& box, double& slack) {
+    const Eigen::Vector3d local = box.boxCoordinates (x);
+    const Eigen::Vector3d half = box.halfExtents ();
+    slack = 1e-9 * (local.norm () + half.norm ()) + std::numeric_limits<double>::min ();
+    return ((local.cwiseAbs () - half).cwiseMax (0.0)).norm ();
+  };
+  thread_local std::vector<Entry> heap;
+  heap.clear ();
+  double best2 = std::numeric_limits<double>::infinity (), best = best2;
+  const auto push = [&] (std::int32_t id) {
+    double slack = 0.0;
+    const double bound = lowerBound (bvh.node (id).box, slack);
+    if (bound - slack > best)
+      return;
+    heap.push_back ({bound - slack, id});
+    std::push_heap (heap.begin (), heap.end (), std::greater<Entry> ());
+  };
+  push (ProbabilisticBVH::rootId ());
+  while (!heap.empty ())
+  {
+    std::pop_heap (heap.begin (), heap.end (), std::greater<Entry> ());
+    const Entry e = heap.back ();
+    heap.pop_back ();
+    if (e.bound > best)
+      break;  // every box left lies farther than the best by more than its rounding
+    const ProbabilisticBVH::Node& node = bvh.node (e.id);
+    if (!node.isLeaf ())
+    {
+      for (int c = 0; c < node.num_children; ++c)
+        push (node.first_child + c);
+      continue;
+    }
+    for (const int i : bvh.indices (node))
+    {
+      const double d2 = (means[static_cast<std::size_t> (i)] - x).squaredNorm ();
+      if (d2 < best2 || (d2 == best2 && i < out.index))
+      {
+        best2 = d2;
+        best = std::sqrt (d2);
+        out.index = i;
+      }
+    }
+  }
+  out.distance = best;
+  return out;
+}
 } // namespace detail
 } // namespace pcl_probcollision

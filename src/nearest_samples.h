@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The nearest pair of samples of two hierarchies (CollisionRequest::distance): the clearance
-// collide() reports where neither layer came within reach. Private to the library (src/).
+// collide() reports where neither layer came within reach; and the nearest sample of one
+// hierarchy to a point: the depth of a point deep inside the other object (src/surface_test.cpp).
+// Private to the library (src/).
 #pragma once
 
 #include <pcl_probcollision/probabilistic_bvh.h>
@@ -8,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <limits>
 
 namespace pcl_probcollision
 {
@@ -32,6 +35,23 @@ struct NearestSamples
   * the pose, so is the answer (ties keep the pair found first). */
 NearestSamples
 nearestSamples (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b);
+
+/** \brief The nearest sample (point mean) of a hierarchy to a point. */
+struct NearestSample
+{
+  int index = -1;  ///< hierarchy index; -1 when the hierarchy is empty
+  double distance = std::numeric_limits<double>::infinity ();
+};
+
+/** \brief The sample of `bvh` nearest to x (in the hierarchy's frame), exactly the one a pass
+  * over every mean in index order finds: the smallest (mean - x).squaredNorm (), the lowest index
+  * among equals. A best-first descent of the hierarchy by the distance from x to each node's box;
+  * a box is passed over only when it lies farther than the best so far by more than its
+  * rounding, so no sample that could tie is missed. (The pass over every mean cost a point deep
+  * inside a 495,000-sample mesh about 1 ms: 5 s for an exhaustive query of a 4,957-point cube
+  * wholly inside it.) */
+NearestSample
+nearestSample (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x);
 
 } // namespace detail
 } // namespace pcl_probcollision

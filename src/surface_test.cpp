@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "surface_test.h"
 
+#include "nearest_samples.h"
+
 #include <pcl_probcollision/normal_distribution.h>
 #include <pcl_probcollision/detail/bvh_traversal.h>
 
@@ -1278,22 +1280,6 @@ groupByFirst (std::vector<std::pair<std::int32_t, std::int32_t>>& pairs, std::si
   pairs.swap (scratch.grouped);
 }
 
-/** \brief Distance from x (in `model`'s local frame) to its nearest sample, whose hierarchy index
-  * goes to nearest. */
-double
-nearestSampleDistance (const CloudModel& model, const Eigen::Vector3d& x, int& nearest)
-{
-  double best = std::numeric_limits<double>::infinity ();
-  nearest = -1;
-  const auto& means = model.hierarchy ().means ();
-  for (std::size_t i = 0; i < means.size (); ++i)
-    if (const double d = (means[i] - x).squaredNorm (); d < best)
-    {
-      best = d;
-      nearest = static_cast<int> (i);
-    }
-  return std::sqrt (best);
-}
 /** \brief A point of one object found inside the other, away from its surface. */
 struct DeepPoint
 {
@@ -1324,8 +1310,9 @@ struct DeepPoint
 void
 setDepth (const CloudModel& surface, const Eigen::Isometry3d& T_s, const Eigen::Vector3d& x, DeepPoint& deep)
 {
-  int nearest = -1;
-  deep.depth = nearestSampleDistance (surface, x, nearest);
+  const NearestSample sample = nearestSample (surface.hierarchy (), x);
+  const int nearest = sample.index;
+  deep.depth = sample.distance;
   deep.normal = nearest >= 0 ? Eigen::Vector3d (T_s.linear () * surface.surface ().normals ()[static_cast<std::size_t> (nearest)].cast<double> ())
                              : Eigen::Vector3d::Zero ();
 }
