@@ -600,3 +600,64 @@ TEST (BVHTraversal, CountersAndFlags)
   bad.expanded_k_sigma = std::numeric_limits<double>::quiet_NaN ();
   EXPECT_THROW (bad.validate (), pcl::BadArgumentException);
 }
+
+// TraversalParams::only_a: with a set of A's leaves and their ancestors marked, the traversal
+// visits exactly the whole traversal's pairs of those leaves, in the whole traversal's order
+// (the surface layer's capped enumeration relies on both), for the expanded mode it uses and the
+// default one, with and without the nearest-first order.
+TEST (BVHTraversal, OnlyAVisitsTheMarkedLeavesPairsInTheWholeTraversalsOrder)
+{
+  const ProbabilisticBVH a (shapeCloud (Shape::Sphere, 1500, 31, 0.003));
+  const ProbabilisticBVH b (shapeCloud (Shape::NoisyPlane, 2000, 32, 0.003));
+  std::vector<std::int32_t> parent (a.nodes ().size (), -1), leaves;
+  for (std::size_t id = 0; id < a.nodes ().size (); ++id)
+    if (a.nodes ()[id].isLeaf ())
+      leaves.push_back (static_cast<std::int32_t> (id));
+    else
+      for (int c = 0; c < a.nodes ()[id].num_children; ++c)
+        parent[static_cast<std::size_t> (a.nodes ()[id].first_child + c)] = static_cast<std::int32_t> (id);
+  ASSERT_GT (leaves.size (), 40u);
+  std::mt19937_64 rng (33);
+  std::size_t compared = 0;
+  for (int trial = 0; trial < 12; ++trial)
+  {
+    const Eigen::Isometry3d T = randomPose (rng, 0.3);
+    TraversalParams params;
+    params.exhaustive = true;
+    params.skip_dominated = false;
+    params.box_margin = 0.02;
+    if (trial % 2)
+    {
+      params.mode = TraversalMode::ExpandedBV;
+      params.expanded_k_sigma = 3.0;
+      params.nearest_first = false;
+    }
+    using Pairs = std::vector<std::pair<const Node*, const Node*>>;
+    auto collect = [&] (const TraversalParams& p) {
+      Pairs pairs;
+      detail::traverseHierarchies (a, b, T, p, [&] (const Node& la, const Node& lb, double) {
+        pairs.emplace_back (&la, &lb);
+        return 0.0;
+      });
+      return pairs;
+    };
+    const Pairs all = collect (params);
+    // A batch of consecutive leaves (by id), as the capped enumeration takes them.
+    const std::size_t first = static_cast<std::size_t> (trial) * leaves.size () / 16, last = first + leaves.size () / 8;
+    std::vector<char> marked (a.nodes ().size (), 0);
+    for (std::size_t k = first; k < last; ++k)
+      for (std::int32_t id = leaves[k]; id >= 0; id = parent[static_cast<std::size_t> (id)])
+        marked[static_cast<std::size_t> (id)] = 1;
+    Pairs expected;
+    for (const auto& p : all)
+      if (marked[static_cast<std::size_t> (p.first - a.nodes ().data ())])
+        expected.push_back (p);
+    TraversalParams only = params;
+    only.only_a = &marked;
+    const Pairs got = collect (only);
+    EXPECT_EQ (got, expected) << "trial " << trial;
+    EXPECT_LT (got.size (), all.size ()) << "trial " << trial;
+    compared += expected.size ();
+  }
+  EXPECT_GT (compared, 100u);  // the batches met pairs, not only empty sets
+}

@@ -84,7 +84,9 @@ struct CollisionRequest
     * never Free: contact under free_below), and the winding-number test of parts beyond reach is skipped. In the ladder the separators' answer
     * then stands where they read contact (a collision the capped rung found stands instead), and
     * the pool takes the lower bound where they read free. It bounds the surface layer's worst case, whose contact answers visit every leaf
-    * pair within reach (docs/SURFACE.md, "A cap on the surface layer's work"). */
+    * pair within reach (docs/SURFACE.md, "A cap on the surface layer's work"): capped, only the
+    * pairs the cap lets it reach are enumerated (docs/PERFORMANCE.md, "The surface layer's cap
+    * bounds its enumeration too"). */
   std::size_t max_surface_pairs = 0;
 
   /** \brief The surface layer (METHOD.md 10a), experimental: instead of the separators, test

@@ -65,6 +65,12 @@ struct TraversalParams
     * storage order. Only the order of the leaf tests changes; a traversal that visits every
     * pair (the surface layer's enumeration) gains nothing from it. */
   bool nearest_first = true;
+  /** \brief When set (one entry per node of A), an opened node of A pushes only its children
+    * whose entry is non-zero, so the traversal visits the pairs of those subtrees alone, in the
+    * order the whole traversal visits them (a depth-first order keeps its relative order when
+    * subtrees are left out). The surface layer's capped enumeration marks a batch of A's leaves
+    * and their ancestors. */
+  const std::vector<char>* only_a = nullptr;
 
   /** \brief Throws pcl::BadArgumentException naming the first parameter out of range. */
   void
@@ -311,8 +317,9 @@ traverseHierarchies (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_
     {
       const Eigen::Vector3d other = T_a_b * nb.box.center;
       for (std::int32_t c = na.first_child + na.num_children; c-- > na.first_child;)
-        stack.push_back ({c, e.b, rho,
-                          params.nearest_first ? (nodes_a[static_cast<std::size_t> (c)].box.center - other).squaredNorm () : 0.0});
+        if (!params.only_a || (*params.only_a)[static_cast<std::size_t> (c)])
+          stack.push_back ({c, e.b, rho,
+                            params.nearest_first ? (nodes_a[static_cast<std::size_t> (c)].box.center - other).squaredNorm () : 0.0});
     }
     else
     {
