@@ -1632,7 +1632,23 @@ reachParams (double spacing)
   params.box_margin = std::isfinite (spacing) ? std::max (spacing, 0.0) : 0.0;
   return params;
 }
-} // namespace
+
+/** \brief Appends the leaf pairs `params` reaches (node ids of A and B) to pairs, in the
+  * traversal's order; returns its box tests. */
+std::size_t
+appendLeafPairs (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_b, const Eigen::Isometry3d& T_a_b,
+                 const TraversalParams& params, std::vector<std::pair<std::int32_t, std::int32_t>>& pairs)
+{
+  const auto* nodes_a = bvh_a.nodes ().data ();
+  const auto* nodes_b = bvh_b.nodes ().data ();
+  return traverseHierarchies (bvh_a, bvh_b, T_a_b, params,
+                              [&] (const ProbabilisticBVH::Node& la, const ProbabilisticBVH::Node& lb, double) {
+                                pairs.emplace_back (static_cast<std::int32_t> (&la - nodes_a),
+                                                    static_cast<std::int32_t> (&lb - nodes_b));
+                                return 0.0;
+                              })
+      .node_pairs_tested;
+}
 
 /** \brief The leaf pairs within reach of A's first leaves (in node id order, the order testSide
   * takes them), until they hold at least max_pairs pairs or A's leaves run out: what testSide
@@ -1659,8 +1675,6 @@ enumerateUpToCap (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_b, 
   }
   scratch.marked.assign (nodes.size (), 0);
   params.only_a = &scratch.marked;
-  const auto* nodes_a = nodes.data ();
-  const auto* nodes_b = bvh_b.nodes ().data ();
   auto& pairs = scratch.pairs;
   std::size_t next = 0, batch = 32;
   while (pairs.size () < max_pairs)
@@ -1673,18 +1687,13 @@ enumerateUpToCap (const ProbabilisticBVH& bvh_a, const ProbabilisticBVH& bvh_b, 
       for (std::int32_t id = scratch.leaves[k]; id >= 0 && !scratch.marked[static_cast<std::size_t> (id)];
            id = scratch.parent[static_cast<std::size_t> (id)])
         scratch.marked[static_cast<std::size_t> (id)] = 1;
-    bv_tests += traverseHierarchies (bvh_a, bvh_b, T_a_b, params,
-                                     [&] (const ProbabilisticBVH::Node& la, const ProbabilisticBVH::Node& lb, double) {
-                                       pairs.emplace_back (static_cast<std::int32_t> (&la - nodes_a),
-                                                           static_cast<std::int32_t> (&lb - nodes_b));
-                                       return 0.0;
-                                     })
-                    .node_pairs_tested;
+    bv_tests += appendLeafPairs (bvh_a, bvh_b, T_a_b, params, pairs);
     next = end;
     batch *= 2;
   }
   return next >= scratch.leaves.size ();
 }
+} // namespace
 
 bool
 withinReach (const ProbabilisticBVH& a, const ProbabilisticBVH& b, const Eigen::Isometry3d& T_a_b, double spacing)
@@ -1715,17 +1724,7 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   if (request.max_surface_pairs > 0)
     all_pairs = enumerateUpToCap (bvh_a, bvh_b, T_a_b, params, request.max_surface_pairs, scratch, answer.bv_tests);
   else
-  {
-    const auto* nodes_a = bvh_a.nodes ().data ();
-    const auto* nodes_b = bvh_b.nodes ().data ();
-    answer.bv_tests = traverseHierarchies (bvh_a, bvh_b, T_a_b, params,
-                                           [&] (const ProbabilisticBVH::Node& la, const ProbabilisticBVH::Node& lb, double) {
-                                             pairs.emplace_back (static_cast<std::int32_t> (&la - nodes_a),
-                                                                 static_cast<std::int32_t> (&lb - nodes_b));
-                                             return 0.0;
-                                           })
-                          .node_pairs_tested;
-  }
+    answer.bv_tests = appendLeafPairs (bvh_a, bvh_b, T_a_b, params, pairs);
   answer.leaf_pairs = pairs.size ();
   double best_z = std::numeric_limits<double>::infinity ();
   // Decision mode: once a point's P_in exceeds collision_above the verdict is final (the
