@@ -207,7 +207,7 @@ nearestSample (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
   if (bvh.empty ())
     return out;
   const auto& means = bvh.means ();
-  // The distance from x to a node's box, and a slack for its rounding (the box's frame is
+  // The distance from x to a node's box, less a slack for its rounding (the box's frame is
   // rebuilt from two stored axes, its coordinates rounded): the box is passed over only when
   // it lies farther than the best by more than the slack.
   struct Entry
@@ -216,21 +216,18 @@ nearestSample (const ProbabilisticBVH& bvh, const Eigen::Vector3d& x)
     std::int32_t id;
     bool operator> (const Entry& o) const { return bound > o.bound || (bound == o.bound && id > o.id); }
   };
-  const auto lowerBound = [&] (const OrientedBox& box, double& slack) {
-    const Eigen::Vector3d local = box.boxCoordinates (x);
-    const Eigen::Vector3d half = box.halfExtents ();
-    slack = 1e-9 * (local.norm () + half.norm ()) + std::numeric_limits<double>::min ();
-    return ((local.cwiseAbs () - half).cwiseMax (0.0)).norm ();
+  const auto lowerBound = [&] (const OrientedBox& box) {
+    const double slack = 1e-9 * ((x - box.center).norm () + box.halfExtents ().norm ()) + std::numeric_limits<double>::min ();
+    return box.distanceTo (x) - slack;
   };
   thread_local std::vector<Entry> heap;
   heap.clear ();
   double best2 = std::numeric_limits<double>::infinity (), best = best2;
   const auto push = [&] (std::int32_t id) {
-    double slack = 0.0;
-    const double bound = lowerBound (bvh.node (id).box, slack);
-    if (bound - slack > best)
+    const double bound = lowerBound (bvh.node (id).box);
+    if (bound > best)
       return;
-    heap.push_back ({bound - slack, id});
+    heap.push_back ({bound, id});
     std::push_heap (heap.begin (), heap.end (), std::greater<Entry> ());
   };
   push (ProbabilisticBVH::rootId ());

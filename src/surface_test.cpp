@@ -1052,11 +1052,15 @@ shadowDepth (const CloudModel& surface, const Eigen::Vector3d& x, double margin)
 }
 
 /** \brief The points of `query` (mapped by T_q into A's frame) against `surface` (mapped by
-  * T_s), leaf by leaf: groups[i] = (query leaf, surface leaf) sorted by query leaf. */
+  * T_s), leaf by leaf: groups[i] = (query leaf, surface leaf) sorted by query leaf. Before each
+  * leaf it stops at a sure point (best_z < stop_z), then at the cap (max_pairs); more_leaves says
+  * that leaves not in groups follow (enumerateUpToCap stopped at the cap), so the checks run once
+  * more after the last group. */
 void
 testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudModel& surface, const Eigen::Isometry3d& T_s,
           const std::vector<std::pair<std::int32_t, std::int32_t>>& groups, Scratch& scratch, int side,
-          std::vector<float>* per_point, double stop_z, std::size_t max_pairs, SurfaceAnswer& answer, double& best_z)
+          std::vector<float>* per_point, double stop_z, std::size_t max_pairs, bool more_leaves, SurfaceAnswer& answer,
+          double& best_z)
 {
   const ProbabilisticBVH& q_bvh = query.hierarchy ();
   const ProbabilisticBVH& s_bvh = surface.hierarchy ();
@@ -1103,7 +1107,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       const ProbabilisticBVH::Node& node = s_bvh.node (scratch.stack.back ());
       scratch.stack.pop_back ();
       const OrientedBox& b = node.box;
-      if ((b.boxCoordinates (x_s).cwiseAbs () - b.halfExtents ()).cwiseMax (0.0).norm () > reach)
+      if (b.distanceTo (x_s) > reach)
         continue;
       if (!node.isLeaf ())
       {
@@ -1125,7 +1129,7 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
     }
     return false;
   };
-  for (std::size_t g = 0; g < groups.size ();)
+  for (std::size_t g = 0; g < groups.size () || more_leaves;)
   {
     if (best_z < stop_z)
     {
@@ -1137,6 +1141,8 @@ testSide (const CloudModel& query, const Eigen::Isometry3d& T_q, const CloudMode
       answer.budget_exhausted = true;
       return;
     }
+    if (g == groups.size ())
+      return;  // (not reached: enumerateUpToCap leaves leaves out only past the cap)
     const std::int32_t q_leaf = groups[g].first;
     // The pool: every sample of the surface leaves paired with this query leaf, once.
     const std::uint32_t pool_stamp = scratch.next ();
@@ -1736,17 +1742,15 @@ surfaceTest (const CloudModel& a, const CloudModel& b, const Eigen::Isometry3d& 
   {
     groupByFirst (pairs, bvh_a.nodes ().size (), scratch);
     testSide (a, Eigen::Isometry3d::Identity (), b, T_a_b, pairs, scratch, +1, per_point_a, stop_z, request.max_surface_pairs,
-              answer, best_z);
-    // Pairs left unenumerated: the cap was reached (enumerateUpToCap), and the next leaf's
-    // checks, A's or B's first, stop there as testSide's own would.
-    if (!all_pairs && !answer.stopped_early && !answer.budget_exhausted)
-      (best_z < stop_z ? answer.stopped_early : answer.budget_exhausted) = true;
-    for (auto& p : pairs)
-      std::swap (p.first, p.second);
-    groupByFirst (pairs, bvh_b.nodes ().size (), scratch);
+              !all_pairs, answer, best_z);
     if (!answer.stopped_early && !answer.budget_exhausted)
+    {
+      for (auto& p : pairs)
+        std::swap (p.first, p.second);
+      groupByFirst (pairs, bvh_b.nodes ().size (), scratch);
       testSide (b, T_a_b, a, Eigen::Isometry3d::Identity (), pairs, scratch, -1, per_point_b, stop_z,
-                request.max_surface_pairs, answer, best_z);
+                request.max_surface_pairs, false, answer, best_z);
+    }
   }
   if (answer.stopped_early)
   {

@@ -100,6 +100,13 @@ struct OrientedBox
     return true;
   }
 
+  /** \brief The distance from p (in the box's frame) to the box, 0 inside it (metres). */
+  double
+  distanceTo (const Eigen::Vector3d& p) const
+  {
+    return (boxCoordinates (p).cwiseAbs () - halfExtents ()).cwiseMax (0.0).norm ();
+  }
+
   /** \brief Volume (cubic metres). */
   double
   volume () const
