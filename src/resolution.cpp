@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include <pcl_probcollision/detail/resolution.h>
 #include <pcl_probcollision/detail/huge_pages.h>
+#include <pcl_probcollision/detail/parallel.h>
+#include <pcl_probcollision/impl/covariance_estimation.hpp>  // BatchKdTree
 
-#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -144,7 +145,7 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
 }
 
 std::vector<float>
-localSpacing (const std::vector<Eigen::Vector3f>& positions, int k)
+localSpacing (const std::vector<Eigen::Vector3f>& positions, int k, int threads)
 {
   const std::size_t n = positions.size ();
   std::vector<float> spacing (n, 0.0f);
@@ -154,20 +155,26 @@ localSpacing (const std::vector<Eigen::Vector3f>& positions, int k)
   cloud->resize (n);
   for (std::size_t i = 0; i < n; ++i)
     (*cloud)[i].getVector3fMap () = positions[i];
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree;  // sorted: the last one found is the k-th
+  // PCL's k-d tree (pcl::KdTreeFLANN's, so the same neighbours and distances), searched in
+  // batches on the build's threads: one query at a time cost a quarter of a second on a
+  // 241,407-point scan (docs/PERFORMANCE.md, "A depth scan's dense samples merged").
+  BatchKdTree<pcl::PointXYZ> tree;
   tree.setInputCloud (cloud);
-  const int want = static_cast<int> (std::min<std::size_t> (static_cast<std::size_t> (k) + 1, n));
+  const std::size_t want = std::min<std::size_t> (static_cast<std::size_t> (k) + 1, n);
   const double per = std::sqrt (M_PI / static_cast<double> (want - 1));  // want - 1 others found
-  pcl::Indices found;
-  std::vector<float> distances;
-  for (std::size_t i = 0; i < n; ++i)
-  {
+  constexpr std::size_t kChunk = 4096;
+  parallelChunks (n, kChunk, threadCount (threads), [&] (std::size_t, std::size_t begin, std::size_t end) {
     // The sample itself is among those found (distance 0), so want - 1 others; duplicates of it
     // count as neighbours at distance 0.
-    if (tree.nearestKSearch ((*cloud)[i], want, found, distances) < want)
-      continue;
-    spacing[i] = static_cast<float> (per * std::sqrt (static_cast<double> (distances.back ())));
-  }
+    const std::size_t m = end - begin;
+    std::vector<float> queries (3 * m), distances (m * want);
+    std::vector<std::size_t> found (m * want);
+    for (std::size_t i = begin; i < end; ++i)
+      std::copy_n (positions[i].data (), 3, &queries[3 * (i - begin)]);
+    tree.nearestKSearch (queries.data (), m, want, found.data (), distances.data ());
+    for (std::size_t i = begin; i < end; ++i)
+      spacing[i] = static_cast<float> (per * std::sqrt (static_cast<double> (distances[(i - begin) * want + want - 1])));
+  });
   return spacing;
 }
 

@@ -46,10 +46,12 @@ noiseClusters (const std::vector<Eigen::Vector3f>& positions, const std::vector<
   * k nearest neighbours covers; for samples spread evenly at spacing h on a surface it is about
   * h. With fewer than k + 1 samples, the farthest other sample's distance is used with their
   * count (0 for a single sample).
+  * The same for any thread count.
   * \param[in] positions the samples (finite)
-  * \param[in] k neighbours (>= 1) */
+  * \param[in] k neighbours (>= 1)
+  * \param[in] threads threads of the search (0: one per hardware thread, as CloudModelParams) */
 std::vector<float>
-localSpacing (const std::vector<Eigen::Vector3f>& positions, int k);
+localSpacing (const std::vector<Eigen::Vector3f>& positions, int k, int threads = 1);
 
 /** \brief The spacing at a typical place of a surface rather than of a typical sample: the
   * median of per-sample spacings weighted by the area each stands for (its spacing squared), so
@@ -61,44 +63,86 @@ localSpacing (const std::vector<Eigen::Vector3f>& positions, int k);
 double
 areaWeightedMedian (std::vector<float>& spacings);
 
-/** \brief Samples each statistic of noiseExceedsTypicalSpacing reads, at most. */
+/** \brief Samples each statistic of wholeCloudMerge reads, at most. */
 constexpr std::size_t kWholeCloudGateSamples = 65536;
 
-/** \brief CloudModelParams::ResolutionGate::WholeCloud: whether a cloud is sampled finer than
-  * its noise, its median noise deviation at least its area-weighted spacing (areaWeightedMedian
-  * of sqrt(pi / k) times each sample's distance to its k-th neighbour). Both statistics read an
-  * evenly strided subsample of at most kWholeCloudGateSamples, so the cost does not grow with
-  * the cloud beyond one pass and the decision is the same for any thread count.
+/** \brief The share of a cloud's samples spaced within their noise from which the whole-cloud
+  * gate merges them where most of its area is sampled coarser (WholeCloudMerge::DenseSamples).
+  * A cloud sampled evenly about as finely as its noise already has half or more of its samples
+  * within it, since local spacings scatter about their mean (the evaluation's primitives at 4 mm
+  * noise: 54-65 % on seed 2, its sparse room at 4 %, whose triangle soup's vertices add samples
+  * closer still, 51 %): there a bare majority merged half a cloud and moved answers both ways (W2
+  * at 4 mm on seed 1, the sparse room at 4 % on seeds 2-19: docs/PERFORMANCE.md, "A depth scan's
+  * dense samples merged"). Three of four asks for a cloud of two densities, as a depth camera's
+  * scan of near objects before a far wall (87 % on ../shared/data's Kinect scan at 5 mm noise). */
+constexpr double kDenseSamplesShare = 0.75;
+
+/** \brief What the whole-cloud gate (CloudModelParams::ResolutionGate::WholeCloud) merges. */
+enum class WholeCloudMerge
+{
+  None,          ///< most samples spaced wider than their noise: nothing, the model is the unmerged one
+  DenseSamples,  ///< most samples (kDenseSamplesShare), but not most of the area, finer than their noise: those samples (as WhereNoiseExceedsSpacing)
+  Everything     ///< most of the area sampled finer than its noise: every sample (as Everywhere)
+};
+
+/** \brief The whole-cloud gate's decision (CloudModelParams::ResolutionGate::WholeCloud), from
+  * each sample's spacing, sqrt(pi / k) times its distance to its k-th neighbour, and its noise's
+  * smallest standard deviation:
+  * - Everything where the cloud is sampled finer than its noise, its median deviation at least
+  *   its area-weighted spacing (areaWeightedMedian: most of the surface's area);
+  * - else DenseSamples where at least kDenseSamplesShare of the samples lie closer than their
+  *   noise (the WhereNoiseExceedsSpacing test, sample by sample): a depth camera's scan whose
+  *   near objects are sampled a millimetre or two apart and whose far wall, a few samples holding
+  *   half the area, tens of millimetres; merging only the dense samples leaves the wall as it was;
+  * - else None. Where fewer samples are dense (a triangle soup's repeated vertices among mesh
+  *   samples spaced wider than the noise) merging them saves less and moves answers both ways:
+  *   the evaluation's rooms keep every vertex, and merging those lost easy answers at 0.25-1 %
+  *   noise (docs/PERFORMANCE.md, "Gated by the local spacing").
+  * The statistics read an evenly strided subsample of at most kWholeCloudGateSamples, so the
+  * cost does not grow with the cloud beyond one pass and the decision is the same for any
+  * thread count.
   * \param[in] kth_radii per sample, the distance to its k-th nearest neighbour (the covariance
   *            estimation's CovarianceEstimation::getNeighbourRadii; non-finite entries ignored)
   * \param[in] k neighbours those radii were found with (>= 1)
   * \param[in] deviation per sample index, its noise's smallest standard deviation */
 template <typename Deviation>
-bool
-noiseExceedsTypicalSpacing (const std::vector<float>& kth_radii, int k, const Deviation& deviation)
+WholeCloudMerge
+wholeCloudMerge (const std::vector<float>& kth_radii, int k, const Deviation& deviation)
 {
   const std::size_t n = kth_radii.size ();
   if (n == 0 || k < 1)
-    return false;
+    return WholeCloudMerge::None;
   const std::size_t stride = (n + kWholeCloudGateSamples - 1) / kWholeCloudGateSamples;
   const double per = std::sqrt (3.14159265358979323846 / static_cast<double> (k));
   std::vector<float> spacings, deviations;
   spacings.reserve (n / stride + 1);
   deviations.reserve (n / stride + 1);
+  std::size_t judged = 0, dense = 0;  // samples with both figures; those spaced within their noise
   for (std::size_t i = 0; i < n; i += stride)
   {
+    const double spacing = per * kth_radii[i];
     if (std::isfinite (kth_radii[i]))
-      spacings.push_back (static_cast<float> (per * kth_radii[i]));
+      spacings.push_back (static_cast<float> (spacing));
     const double d = deviation (i);
     if (std::isfinite (d))
       deviations.push_back (static_cast<float> (d));
+    if (std::isfinite (kth_radii[i]) && std::isfinite (d))
+    {
+      ++judged;
+      // As mergeByNoise's gate tests it, in single precision as localSpacing stores it.
+      dense += d > 0.0 && static_cast<float> (spacing) <= d ? 1 : 0;
+    }
   }
   if (deviations.empty ())
-    return false;
+    return WholeCloudMerge::None;
   const auto middle = deviations.begin () + static_cast<std::ptrdiff_t> (deviations.size () / 2);
   std::nth_element (deviations.begin (), middle, deviations.end ());
   const double spacing = areaWeightedMedian (spacings);
-  return spacing > 0.0 && static_cast<double> (*middle) >= spacing;
+  if (spacing > 0.0 && static_cast<double> (*middle) >= spacing)
+    return WholeCloudMerge::Everything;
+  return judged > 0 && static_cast<double> (dense) >= kDenseSamplesShare * static_cast<double> (judged)
+             ? WholeCloudMerge::DenseSamples
+             : WholeCloudMerge::None;
 }
 } // namespace detail
 } // namespace pcl_probcollision

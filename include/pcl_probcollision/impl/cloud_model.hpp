@@ -187,7 +187,8 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
   const auto mergedModel = [&] (int gate_k) -> std::shared_ptr<const CloudModel> {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noiseResolution (), gate_k, merged, cluster_of, seeds))
+    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noiseResolution (), gate_k, params.threads, merged,
+                               cluster_of, seeds))
       return nullptr;
     // The default radius leaves an object smaller than its noise unmerged: its merge would keep no
     // more points than k, which no longer resolve its shape (a radius given says so in a warning).
@@ -319,8 +320,10 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
       }
     }
     copyOf (estimation.getNeighbourRadii (), radii);
-    // Sampled finer than its noise (ResolutionGate::WholeCloud): the merged cloud's model instead,
-    // the estimation above spent once. A cloud sampled coarser goes on, modelled as unmerged.
+    // Sampled finer than its noise (ResolutionGate::WholeCloud, detail::wholeCloudMerge): the
+    // merged cloud's model instead, the estimation above spent once; where only most samples are
+    // (not most of the area), only those merge. A cloud sampled coarser goes on, modelled as
+    // unmerged.
     if (merging && params.noise_resolution_gate == Gate::WholeCloud)
     {
       const detail::SmallestDeviation smallestDeviation (
@@ -331,11 +334,15 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
           return std::numeric_limits<double>::quiet_NaN ();
         return smallestDeviation (p.getVector3fMap ().template cast<double> ());
       };
-      if (!merged_model && detail::noiseExceedsTypicalSpacing (radii, params.k, deviation))
+      const detail::WholeCloudMerge decision =
+          merged_model ? detail::WholeCloudMerge::None : detail::wholeCloudMerge (radii, params.k, deviation);
+      if (decision != detail::WholeCloudMerge::None)
       {
+        // mergedModel's gate_k: 0 merges every sample, k only those spaced within their noise.
+        const int gate_k = decision == detail::WholeCloudMerge::DenseSamples ? params.k : 0;
         if (!params.keep_full_resolution)
         {
-          merged_model = mergedModel (0);
+          merged_model = mergedModel (gate_k);
           if (merged_model)
             return merged_model;
         }
@@ -348,11 +355,11 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
           const bool aside = detail::threadCount (params.threads) > 1;
           try
           {
-            merged_aside = std::async (aside ? std::launch::async : std::launch::deferred, mergedModel, 0);
+            merged_aside = std::async (aside ? std::launch::async : std::launch::deferred, mergedModel, gate_k);
           }
           catch (const std::system_error&)
           {
-            merged_aside = std::async (std::launch::deferred, mergedModel, 0);
+            merged_aside = std::async (std::launch::deferred, mergedModel, gate_k);
           }
         }
       }

@@ -159,6 +159,8 @@ mergeCoincident (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indic
   * \param[in] gate_k 0: every sample may merge (ResolutionGate::Everywhere); k >= 1: only
   *            samples whose localSpacing() with k neighbours is at most their smallest noise
   *            standard deviation (ResolutionGate::WhereNoiseExceedsSpacing)
+  * \param[in] threads threads of the gate's spacing search (localSpacing); the result is the
+  *            same for any count
   * \param[out] merged one point per cluster: the seed's fields, at the members' centroid, with
   *             the members' mean normal for point types with normals; the cloud's viewpoint
   * \param[out] cluster_of per index of cloud, its merged point (-1 when not a sample)
@@ -167,7 +169,8 @@ mergeCoincident (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indic
 template <typename PointT>
 bool
 mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices, const SensorNoiseModel& noise,
-              double factor, int gate_k, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of, std::vector<int>& seeds)
+              double factor, int gate_k, int threads, pcl::PointCloud<PointT>& merged, std::vector<int>& cluster_of,
+              std::vector<int>& seeds)
 {
   if (noise.type () == SensorNoiseModel::Type::None || !(factor > 0.0))
     return false;
@@ -192,7 +195,7 @@ mergeByNoise (const pcl::PointCloud<PointT>& cloud, const pcl::Indices* indices,
   std::vector<char> eligible;
   if (gate_k > 0)
   {
-    spacing = localSpacing (positions, gate_k);
+    spacing = localSpacing (positions, gate_k, threads);
     eligible.assign (positions.size (), 0);
   }
   const SmallestDeviation smallestDeviation (noise, sensor);
