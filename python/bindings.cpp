@@ -1425,8 +1425,8 @@ PYBIND11_MODULE (_core, m)
         &setResolutionGate,
         "Where noise_resolution merges (pcd_collision's -noise_resolution_gate): 'everywhere' (every sample),\n"
         "'spacing' (only samples spaced within their noise sigma) or 'cloud' (the whole cloud where it is\n"
-        "sampled finer than its noise, else the samples spaced within their noise where they are three of\n"
-        "every four, as a depth scan's near objects before a sparse far wall, else nothing).\n"
+        "sampled finer than its noise, else the samples spaced within their noise where most samples are\n"
+        "twice as dense as it, as a depth scan's near objects before a sparse far wall, else nothing).\n"
         "Default: CloudModelParams' ('cloud').")
       .def_property ("noise_resolution_gated",
                      [] (const CloudModelParams& p) {

@@ -1216,16 +1216,19 @@ TEST (NoiseResolutionWholeCloud, AreaWeightedMedianWeighsClustersByTheAreaTheyCo
   radii.insert (radii.end (), 100, static_cast<float> (r));
   using detail::WholeCloudMerge;
   EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 30.5; }), WholeCloudMerge::Everything);
-  // Under the surface's spacing, the cluster's samples (most of them) lie within their noise:
-  // only they merge.
+  // Under the surface's spacing, the cluster's samples (most of them) are at least twice as
+  // dense as their noise (spacing^2 <= deviation^2 / 2): only the samples within it merge.
   EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 29.5; }), WholeCloudMerge::DenseSamples);
-  // Three of every four samples within their noise merge (detail::kDenseSamplesShare); two of
-  // three do not.
-  radii.erase (radii.begin (), radii.begin () + 600);  // 300 of the cluster, 100 of the surface
+  EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return std::sqrt (2.0) + 1e-5; }), WholeCloudMerge::DenseSamples);
+  // Within the noise but not twice as dense: not a cloud of two densities (one sampled evenly
+  // at its noise has most of its samples within it, spacings scattering about their mean).
+  EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return std::sqrt (2.0) - 1e-5; }), WholeCloudMerge::None);
+  EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 1.2; }), WholeCloudMerge::None);
+  // More than half of the samples: half is not enough.
+  radii.erase (radii.begin (), radii.begin () + 799);  // 101 of the cluster, 100 of the surface
   EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 29.5; }), WholeCloudMerge::DenseSamples);
-  radii.erase (radii.begin (), radii.begin () + 100);  // 200 of the cluster, 100 of the surface
+  radii.erase (radii.begin ());  // 100 and 100
   EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 29.5; }), WholeCloudMerge::None);
-  EXPECT_EQ (detail::wholeCloudMerge (radii, 10, [] (std::size_t) { return 0.5; }), WholeCloudMerge::None);
 }
 
 TEST (NoiseResolutionWholeCloud, AllOrNothingByTheCloudsSpacingAgainstItsNoise)
@@ -1295,11 +1298,11 @@ TEST (NoiseResolutionWholeCloud, TheDefaultLeavesAnObjectSmallerThanItsNoiseUnme
 
 TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotMergeTheSurface)
 {
-  // A surface sampled 40-50 mm apart plus, at 16-25 places, 12-19 copies of one vertex within
+  // A surface sampled 20-50 mm apart plus, at 16-25 places, 12-19 copies of one vertex within
   // 0.5 mm (a triangle soup's corners, as the evaluation's sparse room has), 5 mm noise: the
   // area the samples cover is the surface's, so the whole cloud does not merge. Where the copies
-  // are most of the samples (three of four) they merge, and every sample of the surface stays as
-  // it was (the spacing gate's model); where they are fewer, nothing merges. The clusters sit at
+  // are most of the samples they merge, and every sample of the surface stays as it was (the
+  // spacing gate's model); where they are fewer, nothing merges. The clusters sit at
   // the centres of cells of the surface's grid, so that no surface sample lies within the noise
   // of them.
   const auto withClusters = [] (double h, int per_axis, int copies, unsigned seed) {
@@ -1325,7 +1328,7 @@ TEST (NoiseResolutionWholeCloud, ATriangleSoupsVertexClustersDoNotMergeTheSurfac
   for (std::size_t i = 0; i < surface; ++i)
     EXPECT_EQ (members[static_cast<std::size_t> (merged->pointOfSource ()[i])], 1) << "surface sample " << i << " merged";
 
-  const Cloud::Ptr fewer = withClusters (0.04, 5, 12, 24);  // 121 surface samples, 300 copies (71 %)
+  const Cloud::Ptr fewer = withClusters (0.02, 5, 12, 24);  // 441 surface samples, 300 copies (40 %)
   const CloudModel::ConstPtr kept = buildCloudModel (*fewer, wholeCloud (0.005, 2.0));
   EXPECT_EQ (kept->mergedSamples (), 0u);
   EXPECT_EQ (kept->hierarchy ().means (), buildCloudModel (*fewer, merging (0.005, 0.0))->hierarchy ().means ());

@@ -763,8 +763,8 @@ helpText ()
     << "\n                  where -noise_resolution merges: every sample; only samples spaced\n"
        "                  closer than their noise; or a whole cloud sampled finer than its noise\n"
        "                  (its median noise sigma at least its area-weighted spacing), else the\n"
-       "                  samples spaced closer than their noise where they are 3 of 4 (a depth\n"
-       "                  scan's near objects before a sparse far wall), else none;\n"
+       "                  samples spaced closer than their noise where most are twice as dense\n"
+       "                  as it (a depth scan's near objects before a sparse far wall), else none;\n"
        "                  needs a radius C > 0 (with -surface: -noise_resolution C)\n"
        "  -noise_stop C   = "
     << fmt (D::noise_stop)

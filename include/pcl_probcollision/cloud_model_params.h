@@ -146,8 +146,8 @@ struct CloudModelParams
     * sampled coarser than its noise is modelled exactly as with noise_resolution = 0.
     * WholeCloud: the whole cloud merges (as Everywhere) when it is sampled finer than its noise,
     * its median noise deviation at least its typical spacing (the area-weighted median of the
-    * local spacings); else, where three of every four samples (detail::kDenseSamplesShare) are
-    * spaced within their noise though most of its area is not (a depth camera's scan: near objects a millimetre or
+    * local spacings); else, where more than half of its samples are at least twice as dense as
+    * their noise (detail::kDenseSpacingSquaredPerVariance) though most of its area is not (a depth camera's scan: near objects a millimetre or
     * two apart, a far wall's few samples holding half the area), those samples merge, as
     * WhereNoiseExceedsSpacing merges them; otherwise nothing merges and the model is exactly the
     * unmerged one (detail::wholeCloudMerge, read from the covariance estimation's own neighbour

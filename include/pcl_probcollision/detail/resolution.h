@@ -66,22 +66,22 @@ areaWeightedMedian (std::vector<float>& spacings);
 /** \brief Samples each statistic of wholeCloudMerge reads, at most. */
 constexpr std::size_t kWholeCloudGateSamples = 65536;
 
-/** \brief The share of a cloud's samples spaced within their noise from which the whole-cloud
-  * gate merges them where most of its area is sampled coarser (WholeCloudMerge::DenseSamples).
-  * A cloud sampled evenly about as finely as its noise already has half or more of its samples
-  * within it, since local spacings scatter about their mean (the evaluation's primitives at 4 mm
-  * noise: 54-65 % on seed 2, its sparse room at 4 %, whose triangle soup's vertices add samples
-  * closer still, 51 %): there a bare majority merged half a cloud and moved answers both ways (W2
-  * at 4 mm on seed 1, the sparse room at 4 % on seeds 2-19: docs/PERFORMANCE.md, "A depth scan's
-  * dense samples merged"). Three of four asks for a cloud of two densities, as a depth camera's
-  * scan of near objects before a far wall (87 % on ../shared/data's Kinect scan at 5 mm noise). */
-constexpr double kDenseSamplesShare = 0.75;
+/** \brief The whole-cloud gate's test of a cloud of two densities (WholeCloudMerge::DenseSamples):
+  * more than half of its samples at least twice as dense as their noise, spacing^2 at most this
+  * times the deviation^2 (two samples or more to each square of the deviation). A cloud sampled
+  * evenly about as finely as its noise has almost none, though half or more of its samples lie
+  * within the noise itself, since local spacings scatter about their mean (the evaluation's
+  * primitives at 4 mm noise, seed 2: 1 % against 54-65 %; its rooms, their triangle soups'
+  * repeated vertices among them, at most 29 %); a depth camera's scan of near objects before a
+  * far wall has most (../shared/data's Kinect scan: 77 % at 5 mm noise, 61 % at 3 mm).
+  * docs/PERFORMANCE.md, "A depth scan's dense samples merged". */
+constexpr double kDenseSpacingSquaredPerVariance = 0.5;
 
 /** \brief What the whole-cloud gate (CloudModelParams::ResolutionGate::WholeCloud) merges. */
 enum class WholeCloudMerge
 {
   None,          ///< most samples spaced wider than their noise: nothing, the model is the unmerged one
-  DenseSamples,  ///< most samples (kDenseSamplesShare), but not most of the area, finer than their noise: those samples (as WhereNoiseExceedsSpacing)
+  DenseSamples,  ///< most samples twice as dense as their noise, though not most of the area: those within it merge (as WhereNoiseExceedsSpacing)
   Everything     ///< most of the area sampled finer than its noise: every sample (as Everywhere)
 };
 
@@ -90,14 +90,16 @@ enum class WholeCloudMerge
   * smallest standard deviation:
   * - Everything where the cloud is sampled finer than its noise, its median deviation at least
   *   its area-weighted spacing (areaWeightedMedian: most of the surface's area);
-  * - else DenseSamples where at least kDenseSamplesShare of the samples lie closer than their
-  *   noise (the WhereNoiseExceedsSpacing test, sample by sample): a depth camera's scan whose
-  *   near objects are sampled a millimetre or two apart and whose far wall, a few samples holding
-  *   half the area, tens of millimetres; merging only the dense samples leaves the wall as it was;
+  * - else DenseSamples where more than half of the samples are at least twice as dense as their
+  *   noise (kDenseSpacingSquaredPerVariance): a depth camera's scan whose near objects are
+  *   sampled a millimetre or two apart and whose far wall, a few samples holding half the area,
+  *   tens of millimetres. The samples the spacing gate lets merge (WhereNoiseExceedsSpacing: the
+  *   spacing within the noise) then merge, and the wall stays as it was;
   * - else None. Where fewer samples are dense (a triangle soup's repeated vertices among mesh
-  *   samples spaced wider than the noise) merging them saves less and moves answers both ways:
-  *   the evaluation's rooms keep every vertex, and merging those lost easy answers at 0.25-1 %
-  *   noise (docs/PERFORMANCE.md, "Gated by the local spacing").
+  *   samples spaced wider than the noise, or a cloud sampled evenly at its noise) merging them
+  *   saves less and moves answers both ways: the evaluation's rooms keep every vertex, and
+  *   merging those lost easy answers at 0.25-1 % noise (docs/PERFORMANCE.md, "Gated by the
+  *   local spacing").
   * The statistics read an evenly strided subsample of at most kWholeCloudGateSamples, so the
   * cost does not grow with the cloud beyond one pass and the decision is the same for any
   * thread count.
@@ -117,7 +119,7 @@ wholeCloudMerge (const std::vector<float>& kth_radii, int k, const Deviation& de
   std::vector<float> spacings, deviations;
   spacings.reserve (n / stride + 1);
   deviations.reserve (n / stride + 1);
-  std::size_t judged = 0, dense = 0;  // samples with both figures; those spaced within their noise
+  std::size_t judged = 0, dense = 0;  // samples with both figures; those twice as dense as their noise
   for (std::size_t i = 0; i < n; i += stride)
   {
     const double spacing = per * kth_radii[i];
@@ -129,8 +131,7 @@ wholeCloudMerge (const std::vector<float>& kth_radii, int k, const Deviation& de
     if (std::isfinite (kth_radii[i]) && std::isfinite (d))
     {
       ++judged;
-      // As mergeByNoise's gate tests it, in single precision as localSpacing stores it.
-      dense += d > 0.0 && static_cast<float> (spacing) <= d ? 1 : 0;
+      dense += d > 0.0 && spacing * spacing <= kDenseSpacingSquaredPerVariance * d * d ? 1 : 0;
     }
   }
   if (deviations.empty ())
@@ -140,9 +141,7 @@ wholeCloudMerge (const std::vector<float>& kth_radii, int k, const Deviation& de
   const double spacing = areaWeightedMedian (spacings);
   if (spacing > 0.0 && static_cast<double> (*middle) >= spacing)
     return WholeCloudMerge::Everything;
-  return judged > 0 && static_cast<double> (dense) >= kDenseSamplesShare * static_cast<double> (judged)
-             ? WholeCloudMerge::DenseSamples
-             : WholeCloudMerge::None;
+  return 2 * dense > judged ? WholeCloudMerge::DenseSamples : WholeCloudMerge::None;
 }
 } // namespace detail
 } // namespace pcl_probcollision

@@ -66,7 +66,7 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     "noise_resolution": _MODEL.noise_resolution,
     # Where it merges (pcd_collision's -noise_resolution_gate): everywhere, spacing (only samples
     # spaced closer than their noise) or cloud (a whole cloud sampled finer than its noise, else
-    # its samples spaced closer than their noise where they are three of every four).
+    # its samples spaced closer than their noise where most are twice as dense as it).
     "noise_resolution_gate": _MODEL.noise_resolution_gate,
     # A hierarchy node of at most 160 points within this many noise sigmas is not split (0: off).
     "noise_stop": _MODEL.noise_stop,
