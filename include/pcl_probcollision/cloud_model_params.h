@@ -147,11 +147,11 @@ struct CloudModelParams
     * WholeCloud: the whole cloud merges (as Everywhere) when it is sampled finer than its noise,
     * its median noise deviation at least its typical spacing (the area-weighted median of the
     * local spacings); else, where more than half of its samples are at least twice as dense as
-    * their noise (detail::kDenseSpacingSquaredPerVariance) though most of its area is not (a depth camera's scan: near objects a millimetre or
-    * two apart, a far wall's few samples holding half the area), those samples merge, as
-    * WhereNoiseExceedsSpacing merges them; otherwise nothing merges and the model is exactly the
-    * unmerged one (detail::wholeCloudMerge, read from the covariance estimation's own neighbour
-    * search). Default WholeCloud: on the evaluation it changes no answer at noise below the
+    * their noise (detail::kDenseSpacingSquaredPerVariance) though most of its area is not (a
+    * depth camera's scan: near objects a millimetre or two apart, a far wall's few samples
+    * holding half the area), the samples within their noise merge, as WhereNoiseExceedsSpacing
+    * merges them; otherwise nothing merges and the model is exactly the unmerged one
+    * (detail::wholeCloudMerge, read from the covariance estimation's own neighbour search). Default WholeCloud: on the evaluation it changes no answer at noise below the
     * clouds' spacing and, above it, cuts the near-contact Brier score by a third and the query
     * time many times, where Everywhere loses easy answers at 0.25-1 % noise (docs/PERFORMANCE.md,
     * issue #17 item 1); on a Kinect scan under 5 mm noise its dense samples' merge takes the

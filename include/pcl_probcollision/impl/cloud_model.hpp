@@ -321,9 +321,9 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
     }
     copyOf (estimation.getNeighbourRadii (), radii);
     // Sampled finer than its noise (ResolutionGate::WholeCloud, detail::wholeCloudMerge): the
-    // merged cloud's model instead, the estimation above spent once; where only most samples are
-    // (not most of the area), only those merge. A cloud sampled coarser goes on, modelled as
-    // unmerged.
+    // merged cloud's model instead, the estimation above spent once; where most samples are twice
+    // as dense as their noise but most of the area is not, the samples within it merge. A cloud
+    // sampled coarser goes on, modelled as unmerged.
     if (merging && params.noise_resolution_gate == Gate::WholeCloud)
     {
       const detail::SmallestDeviation smallestDeviation (
