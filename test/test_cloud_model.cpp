@@ -1366,6 +1366,22 @@ TEST (NoiseResolutionWholeCloud, ADepthScansDenseNearPartMergesAndItsSparseFarWa
   const Cloud::Ptr near_only = sheet (0.1, 0.002, 0.0, 13);
   EXPECT_EQ (buildCloudModel (*near_only, defaults)->hierarchy ().means (),
              buildCloudModel (*near_only, merging (sigma, 2.0))->hierarchy ().means ());
+  // With the surface model (the surface layer's) the scan's dense samples merge the same way, at
+  // the default radius, which params() gives; a cloud sampled finer than its noise all over stays
+  // whole there.
+  CloudModelParams with_surface = defaults;
+  with_surface.surface = true;
+  const CloudModel::ConstPtr surface_model = buildCloudModel (*a, with_surface);
+  EXPECT_FALSE (surface_model->surface ().empty ());
+  EXPECT_EQ (surface_model->pointOfSource (), model->pointOfSource ());
+  ASSERT_TRUE (surface_model->params ().noise_resolution.has_value ());
+  EXPECT_EQ (*surface_model->params ().noise_resolution, CloudModelParams::kDefaultNoiseResolution);
+  ASSERT_NE (surface_model->fullResolution (), nullptr);
+  EXPECT_FALSE (surface_model->fullResolution ()->surface ().empty ());
+  EXPECT_EQ (buildCloudModel (*near_only, with_surface)->mergedSamples (), 0u);
+  // A gate or a radius given is the caller's: the spacing gate without a radius merges nothing.
+  with_surface.noise_resolution_gate = CloudModelParams::ResolutionGate::WhereNoiseExceedsSpacing;
+  EXPECT_EQ (buildCloudModel (*a, with_surface)->mergedSamples (), 0u);
 }
 
 // Given covariances must be covariances: a negative-definite one is refused naming its point

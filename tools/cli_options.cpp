@@ -661,7 +661,7 @@ parseCommandLine (const std::vector<std::string>& args)
   // a probe); -noise_resolution 0 is "never merge" too.
   if (seen.count ("-noise_resolution_gate") && !(modelParamsFor (o, true).noiseResolution () > 0.0))
     return usage ("option -noise_resolution_gate needs -noise_resolution C > 0: it says where merging applies, and "
-                  "nothing is merged without it (by default with -surface, or with 0)");
+                  "without it nothing is merged (with 0) or only a depth scan's dense samples (by default with -surface)");
   if ((orientation || orientation_a || orientation_b) && !o.surface)
     return usage ("options -orientation, -orientation_a and -orientation_b need -surface (or -surface_pooled, "
                   "-surface_ladder): they orient the surface layer's surfaces");

@@ -123,16 +123,21 @@ struct CloudModelParams
     * as unmerged at 0.25-1 % noise and, at 2-4 %, gain 12 easy answers and lose 1, with a lower
     * Brier score in every cell and a worst query up to 11 times shorter. The surface layer on
     * merged models loses easy answers in the dense room at 2-4 % (docs/PERFORMANCE.md, "The
-    * whole-cloud merge as the separators' default"), so a model with the surface model merges
-    * only when asked. No effect without a noise model (noise None) or with covariances given by
-    * the caller. */
+    * whole-cloud merge as the separators' default"), so a model with the surface model merges a
+    * whole cloud only when asked; with the default gate it merges the dense samples of a cloud of
+    * two densities (a depth camera's scan, ResolutionGate::WholeCloud) at
+    * kDefaultNoiseResolution, as a model without it does, and CloudModel::params() of such a
+    * model gives that radius. No effect without a noise model (noise None) or with covariances
+    * given by the caller. */
   std::optional<double> noise_resolution;
   /** \brief The merge radius of a model without the surface model when noise_resolution is
     * unset, in noise standard deviations: the evaluated choice (docs/PERFORMANCE.md, "The merge
     * radius"). */
   static constexpr double kDefaultNoiseResolution = 2.0;
-  /** \brief noise_resolution as the build applies it: its value when set, else
-    * kDefaultNoiseResolution without the surface model and 0 (nothing merged) with it. */
+  /** \brief noise_resolution as the build applies it to a whole cloud: its value when set, else
+    * kDefaultNoiseResolution without the surface model and 0 with it (where the default gate
+    * still merges a depth scan's dense samples at kDefaultNoiseResolution; see
+    * noise_resolution). */
   double
   noiseResolution () const
   {

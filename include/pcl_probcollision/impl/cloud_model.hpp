@@ -181,14 +181,22 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
       }
     }
 
+  using Gate = CloudModelParams::ResolutionGate;
+  // The merge radius applied. With the surface model and none given, the whole-cloud gate
+  // merges the dense samples of a cloud of two densities alone (detail::WholeCloudMerge::
+  // DenseSamples, a depth scan's near objects), at the default radius, and never a whole cloud:
+  // the surface layer on whole merged clouds lost easy answers in W1's dense room at 2-4 %
+  // (docs/PERFORMANCE.md, "The whole-cloud merge as the separators' default").
+  const bool dense_only = params.surface && !params.noise_resolution && params.noise_resolution_gate == Gate::WholeCloud;
+  const double radius = dense_only ? CloudModelParams::kDefaultNoiseResolution : params.noiseResolution ();
+
   // Samples closer than their noise, merged (CloudModelParams::noise_resolution): the model of
   // the merged cloud, mapped back to every sample of this one; null when no two samples merge.
   // gate_k as detail::mergeByNoise takes it.
   const auto mergedModel = [&] (int gate_k) -> std::shared_ptr<const CloudModel> {
     pcl::PointCloud<PointT> merged;
     std::vector<int> cluster_of, seeds;
-    if (!detail::mergeByNoise (cloud, indices, params.noise, params.noiseResolution (), gate_k, params.threads, merged,
-                               cluster_of, seeds))
+    if (!detail::mergeByNoise (cloud, indices, params.noise, radius, gate_k, params.threads, merged, cluster_of, seeds))
       return nullptr;
     // The default radius leaves an object smaller than its noise unmerged: its merge would keep no
     // more points than k, which no longer resolve its shape (a radius given says so in a warning).
@@ -221,13 +229,15 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
       if ((mhi - mlo).norm () < CloudModel::kMinMergedDiagonal * (hi - lo).norm ())
         return nullptr;
     }
-    model->adoptMerge (params, cloud.size (), n, cluster_of, std::move (seeds), name);
+    CloudModelParams applied = params;  // the radius the merge applied, where the surface model's default set it
+    if (dense_only)
+      applied.noise_resolution = radius;
+    model->adoptMerge (applied, cloud.size (), n, cluster_of, std::move (seeds), name);
     model->neighbour_spacing_ = std::numeric_limits<double>::quiet_NaN ();  // measured on the merged cloud
     model->build_ms_ = std::chrono::duration<double, std::milli> (std::chrono::steady_clock::now () - start).count ();
     return model;
   };
-  using Gate = CloudModelParams::ResolutionGate;
-  const bool merging = params.noiseResolution () > 0.0 && !covariances;
+  const bool merging = radius > 0.0 && !covariances;
   // The whole-cloud gate reads the covariance estimation's neighbour radii (below) and decides
   // there; the other gates merge first.
   // The merged model, when samples merge; with keep_full_resolution the unmerged one is built
@@ -334,8 +344,10 @@ CloudModel::buildFromCloud (const pcl::PointCloud<PointT>& cloud, const CloudMod
           return std::numeric_limits<double>::quiet_NaN ();
         return smallestDeviation (p.getVector3fMap ().template cast<double> ());
       };
-      const detail::WholeCloudMerge decision =
+      detail::WholeCloudMerge decision =
           merged_model ? detail::WholeCloudMerge::None : detail::wholeCloudMerge (radii, params.k, deviation);
+      if (dense_only && decision == detail::WholeCloudMerge::Everything)
+        decision = detail::WholeCloudMerge::None;
       if (decision != detail::WholeCloudMerge::None)
       {
         // mergedModel's gate_k: 0 merges every sample, k only those spaced within their noise.
