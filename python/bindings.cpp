@@ -1415,10 +1415,11 @@ PYBIND11_MODULE (_core, m)
       .def_readwrite ("noise_resolution", &CloudModelParams::noise_resolution,
                       "Merge samples closer than this many sensor-noise sigmas into one (issue #17), where\n"
                       "noise_resolution_gate lets them; 0: never. None (default): 2 without the surface model, 0\n"
-                      "with it (noise_resolution_applied).")
+                      "with it (noise_resolution_applied), where the default gate still merges a depth scan's dense\n"
+                      "samples at 2 (CloudModel.params gives the radius applied).")
       .def_property_readonly ("noise_resolution_applied", &CloudModelParams::noiseResolution,
-                              "The merge radius the build applies (C++ noiseResolution()): noise_resolution when set,\n"
-                              "else 2 without the surface model and 0 with it.")
+                              "The merge radius the build applies to a whole cloud (C++ noiseResolution()):\n"
+                              "noise_resolution when set, else 2 without the surface model and 0 with it.")
       .def_property (
         "noise_resolution_gate",
         [] (const CloudModelParams& p) { return std::string (CloudModelParams::resolutionGateName (p.noise_resolution_gate)); },

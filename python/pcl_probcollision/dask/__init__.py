@@ -62,7 +62,8 @@ DEFAULT_OPTIONS: Dict[str, Any] = {
     # With the surface layer: about this many leaf pairs tested by it a query (0: no cap).
     "max_surface_pairs": _REQUEST.max_surface_pairs,
     # Samples closer than this many noise sigmas merged into one, where the gate lets them (0: none;
-    # None: CloudModelParams' default, 2 without the surface layer and 0 with it).
+    # None: CloudModelParams' default, 2 without the surface layer and 0 with it, where a depth
+    # scan's dense samples still merge at 2).
     "noise_resolution": _MODEL.noise_resolution,
     # Where it merges (pcd_collision's -noise_resolution_gate): everywhere, spacing (only samples
     # spaced closer than their noise) or cloud (a whole cloud sampled finer than its noise, else
