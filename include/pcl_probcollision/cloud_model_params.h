@@ -156,10 +156,11 @@ struct CloudModelParams
     * depth camera's scan: near objects a millimetre or two apart, a far wall's few samples
     * holding half the area), the samples within their noise merge, as WhereNoiseExceedsSpacing
     * merges them; otherwise nothing merges and the model is exactly the unmerged one
-    * (detail::wholeCloudMerge, read from the covariance estimation's own neighbour search). Default WholeCloud: on the evaluation it changes no answer at noise below the
-    * clouds' spacing and, above it, cuts the near-contact Brier score by a third and the query
-    * time many times, where Everywhere loses easy answers at 0.25-1 % noise (docs/PERFORMANCE.md,
-    * issue #17 item 1); on a Kinect scan under 5 mm noise its dense samples' merge takes the
+    * (detail::wholeCloudMerge, read from the covariance estimation's own neighbour search).
+    * Default WholeCloud: on the evaluation it changes no answer at noise below the clouds'
+    * spacing and, above it, cuts the near-contact Brier score by a third and the query time many
+    * times, where Everywhere loses easy answers at 0.25-1 % noise (docs/PERFORMANCE.md, issue #17
+    * item 1); on a Kinect scan under 5 mm noise its dense samples' merge takes the
     * median query from 19 to 0.5 ms and reads 243 of 247 collisions as collision instead of 57
     * (docs/PERFORMANCE.md, "A depth scan's dense samples merged"). */
   enum class ResolutionGate

@@ -80,7 +80,7 @@ constexpr double kDenseSpacingSquaredPerVariance = 0.5;
 /** \brief What the whole-cloud gate (CloudModelParams::ResolutionGate::WholeCloud) merges. */
 enum class WholeCloudMerge
 {
-  None,          ///< most samples spaced wider than their noise: nothing, the model is the unmerged one
+  None,          ///< neither: nothing merges, the model is the unmerged one
   DenseSamples,  ///< most samples twice as dense as their noise, though not most of the area: those within it merge (as WhereNoiseExceedsSpacing)
   Everything     ///< most of the area sampled finer than its noise: every sample (as Everywhere)
 };
@@ -122,16 +122,18 @@ wholeCloudMerge (const std::vector<float>& kth_radii, int k, const Deviation& de
   std::size_t judged = 0, dense = 0;  // samples with both figures; those twice as dense as their noise
   for (std::size_t i = 0; i < n; i += stride)
   {
-    const double spacing = per * kth_radii[i];
-    if (std::isfinite (kth_radii[i]))
-      spacings.push_back (static_cast<float> (spacing));
+    const bool has_spacing = std::isfinite (kth_radii[i]);
+    const double local = per * kth_radii[i];
+    if (has_spacing)
+      spacings.push_back (static_cast<float> (local));
     const double d = deviation (i);
-    if (std::isfinite (d))
-      deviations.push_back (static_cast<float> (d));
-    if (std::isfinite (kth_radii[i]) && std::isfinite (d))
+    if (!std::isfinite (d))
+      continue;
+    deviations.push_back (static_cast<float> (d));
+    if (has_spacing)
     {
       ++judged;
-      dense += d > 0.0 && spacing * spacing <= kDenseSpacingSquaredPerVariance * d * d ? 1 : 0;
+      dense += d > 0.0 && local * local <= kDenseSpacingSquaredPerVariance * d * d ? 1 : 0;
     }
   }
   if (deviations.empty ())
